@@ -1,0 +1,97 @@
+//! `wraptree group`: run the grouping phase and summarise the Subset Tree.
+
+use super::{GroupArgs, SceneArgs};
+use anyhow::Result;
+use clap::Args;
+use std::process::ExitCode;
+use std::time::Instant;
+use wraptree::grouping::{self, Event, Observer};
+
+/// Arguments of `wraptree group`.
+#[derive(Args, Debug)]
+pub struct GroupCmd {
+    #[command(flatten)]
+    scene: SceneArgs,
+    #[command(flatten)]
+    group: GroupArgs,
+    /// Print one JSON object (with the parent array) instead of text.
+    #[arg(long)]
+    json: bool,
+}
+
+/// A progress bar over merges on stderr, shown only when stderr is a terminal.
+pub struct Progress(indicatif::ProgressBar);
+
+impl Progress {
+    /// A bar for `merges` merges, or `None` when stderr is not a terminal or the run is short.
+    pub fn for_merges(merges: u64) -> Option<Progress> {
+        use std::io::IsTerminal;
+        if !std::io::stderr().is_terminal() || merges < 100_000 {
+            return None;
+        }
+        let bar = indicatif::ProgressBar::new(merges);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} grouping {bar:40} {pos}/{len} merges {msg} ({eta})")
+                .expect("the template is valid"),
+        );
+        Some(Progress(bar))
+    }
+}
+
+impl Observer for Progress {
+    fn on_event(&mut self, event: &Event<'_>) {
+        match event {
+            Event::Merge(m) if m.step % 1024 == 0 => self.0.set_position(m.step as u64),
+            Event::RoundStart { round, .. } => self.0.set_message(format!("round {round}")),
+            Event::Finish { .. } => self.0.finish_and_clear(),
+            _ => {}
+        }
+    }
+}
+
+impl GroupCmd {
+    /// Runs the command.
+    pub fn run(self) -> Result<ExitCode> {
+        let loaded = self.scene.load()?;
+        let params = self.group.params()?;
+        let scene = &loaded.scene;
+        let start = Instant::now();
+        let g = match Progress::for_merges(scene.len() as u64) {
+            Some(p) => grouping::group(scene, &params, p),
+            None => grouping::group(scene, &params, ()),
+        };
+        let seconds = start.elapsed().as_secs_f64();
+        let t = &g.tree;
+        if self.json {
+            let out = serde_json::json!({
+                "scene": scene.name,
+                "primitives": scene.len(),
+                "rounds": g.rounds,
+                "depth_max": t.depth_max(),
+                "depth_mean": t.depth_mean(),
+                "seconds": seconds,
+                "params": g.params,
+                "stats": g.stats,
+                "peak_rss_bytes": super::peak_rss_bytes(),
+                "parent": t.parent_i64(),
+            });
+            println!("{out}");
+        } else {
+            println!("scene       {} ({} primitives)", scene.name, scene.len());
+            println!(
+                "params      A={} B={} C={} DLimit0={:.6e} GLimit0={:.6e} pset={:?}",
+                g.params.weights.a, g.params.weights.b, g.params.weights.c, g.params.dlimit0, g.params.glimit0, g.params.pset
+            );
+            println!("rounds      {}", g.rounds);
+            println!(
+                "depth       max {} ({} levels), mean {:.2}, 2·log2 N = {:.1}",
+                t.depth_max(),
+                t.depth_max() + 1,
+                t.depth_mean(),
+                2.0 * (scene.len() as f64).log2()
+            );
+            println!("time        {:.3} ms", seconds * 1e3);
+        }
+        Ok(ExitCode::SUCCESS)
+    }
+}

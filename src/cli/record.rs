@@ -1,0 +1,187 @@
+//! `wraptree record`: group a scene step by step and write `PREFIX.rrd` and `PREFIX.mcap`.
+
+use super::group::Progress;
+use super::{GroupArgs, SceneArgs};
+use anyhow::{Context, Result};
+use clap::Args;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+use wraptree::grouping::{self, Grouping, ResolvedParams, Tee};
+use wraptree::record::mcap::McapRecorder;
+use wraptree::record::output::Pending;
+use wraptree::record::rrd::RrdRecorder;
+use wraptree::record::{Detail, Outcome, RunInfo};
+use wraptree::scene::{Scene, SceneSource};
+use wraptree::wrap::{SphereMethod, sphere_tree};
+
+/// Arguments of `wraptree record`.
+#[derive(Args, Debug)]
+pub struct RecordCmd {
+    #[command(flatten)]
+    scene: SceneArgs,
+    #[command(flatten)]
+    group: GroupArgs,
+    /// Output prefix: writes PREFIX.rrd and PREFIX.mcap [default: recordings/<scene stem>].
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// What to write: levels, merges, or full.
+    #[arg(long, value_enum, default_value_t = Detail::Full)]
+    detail: Detail,
+    /// Replace existing recordings.
+    #[arg(long)]
+    force: bool,
+    /// Leave wall-clock timing out of the .mcap so identical runs give identical bytes.
+    #[arg(long)]
+    reproducible: bool,
+}
+
+/// Where a pair of recordings goes, and the outcome of writing it.
+pub struct Written {
+    /// The `.rrd` path.
+    pub rrd: PathBuf,
+    /// The `.mcap` path.
+    pub mcap: PathBuf,
+    /// The grouping, unless interrupted.
+    pub grouping: Option<Grouping>,
+    /// Grouping + recording wall time.
+    pub seconds: f64,
+}
+
+/// The default output prefix for a scene: `recordings/<stem>`.
+pub fn default_prefix(source: &SceneSource) -> PathBuf {
+    let stem = Path::new(&source.file_name)
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_else(|| "scene".into());
+    PathBuf::from("recordings").join(stem)
+}
+
+fn with_ext(prefix: &Path, ext: &str) -> PathBuf {
+    let mut s = prefix.as_os_str().to_owned();
+    s.push(ext);
+    PathBuf::from(s)
+}
+
+/// Groups `scene` while both recorders listen; commits the files when complete, or sets them
+/// aside as `PREFIX.incomplete.*` when stopped by Ctrl-C/SIGTERM (an existing recording is never
+/// replaced by a partial one).
+pub fn record(
+    scene: &Scene,
+    source: &SceneSource,
+    params: &ResolvedParams,
+    detail: Detail,
+    prefix: &Path,
+    force: bool,
+    reproducible: bool,
+) -> Result<Written> {
+    let (rrd_path, mcap_path) = (with_ext(prefix, ".rrd"), with_ext(prefix, ".mcap"));
+    let rrd_file = Pending::create(&rrd_path, force)?;
+    let mcap_file = Pending::create(&mcap_path, force)?;
+    let info = RunInfo {
+        scene,
+        source,
+        params,
+        detail,
+    };
+    let mut rrd = RrdRecorder::new(rrd_file.path(), &info).with_context(|| format!("{}", rrd_path.display()))?;
+    let writer = std::io::BufWriter::new(mcap_file.file()?);
+    let mut mcap = McapRecorder::new(writer, &info).with_context(|| format!("{}", mcap_path.display()))?;
+    mcap.set_reproducible(reproducible);
+    let stop = stop_flag();
+    let start = Instant::now();
+    let progress = Progress::for_merges(scene.len() as u64);
+    let result = grouping::group_until(scene, params, Tee(&mut rrd, Tee(&mut mcap, progress)), &stop);
+    let seconds = start.elapsed().as_secs_f64();
+    let (grouping, merges, rounds) = match result {
+        Ok(g) => {
+            let m = g.tree.leaves() as u32 - 1;
+            let r = g.rounds;
+            (Some(g), m, r)
+        }
+        Err(s) => (None, s.merges, s.rounds),
+    };
+    let spheres = match (&grouping, detail.levels()) {
+        (Some(g), true) => Some(sphere_tree(&g.tree, scene, SphereMethod::AabbCenter)),
+        _ => None,
+    };
+    let outcome = Outcome {
+        grouping: grouping.as_ref(),
+        spheres: spheres.as_deref(),
+        merges,
+        rounds,
+        seconds,
+    };
+    rrd.finish(&outcome).with_context(|| format!("{}", rrd_path.display()))?;
+    mcap.finish(&outcome).with_context(|| format!("{}", mcap_path.display()))?;
+    let (rrd_dest, mcap_dest) = if grouping.is_some() {
+        (rrd_file.commit()?, mcap_file.commit()?)
+    } else {
+        let r = with_ext(prefix, ".incomplete.rrd");
+        let m = with_ext(prefix, ".incomplete.mcap");
+        (rrd_file.commit_to(Some(&r))?, mcap_file.commit_to(Some(&m))?)
+    };
+    Ok(Written {
+        rrd: rrd_dest,
+        mcap: mcap_dest,
+        grouping,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// A flag set by the first Ctrl-C or SIGTERM (installed once per process).
+fn stop_flag() -> Arc<AtomicBool> {
+    static FLAG: std::sync::OnceLock<Arc<AtomicBool>> = std::sync::OnceLock::new();
+    FLAG.get_or_init(|| {
+        let f = Arc::new(AtomicBool::new(false));
+        let g = f.clone();
+        let _ = ctrlc::set_handler(move || g.store(true, Ordering::Relaxed));
+        f
+    })
+    .clone()
+}
+
+/// Prints what was written.
+pub fn report(w: &Written, scene: &Scene) {
+    let size = |p: &Path| std::fs::metadata(p).map(|m| m.len() as f64 / 1e6).unwrap_or(0.0);
+    match &w.grouping {
+        Some(g) => println!(
+            "{}: {} primitives, {} rounds, depth {} (mean {:.2}); recorded in {:.3} s",
+            scene.name,
+            scene.len(),
+            g.rounds,
+            g.tree.depth_max(),
+            g.tree.depth_mean(),
+            w.seconds
+        ),
+        None => eprintln!("interrupted: wrote what was recorded, marked incomplete"),
+    }
+    println!("  {} ({:.2} MB)", w.rrd.display(), size(&w.rrd));
+    println!("  {} ({:.2} MB)", w.mcap.display(), size(&w.mcap));
+}
+
+impl RecordCmd {
+    /// Runs the command.
+    pub fn run(self) -> Result<ExitCode> {
+        let loaded = self.scene.load()?;
+        let params = self.group.params()?.resolve(&loaded.scene);
+        let prefix = match self.output {
+            Some(p) => p,
+            None => {
+                let p = default_prefix(&loaded.source);
+                std::fs::create_dir_all(p.parent().expect("recordings/<stem> has a parent"))
+                    .context("recordings: cannot create the default output directory")?;
+                p
+            }
+        };
+        let w = record(&loaded.scene, &loaded.source, &params, self.detail, &prefix, self.force, self.reproducible)?;
+        report(&w, &loaded.scene);
+        Ok(if w.grouping.is_some() {
+            ExitCode::SUCCESS
+        } else {
+            ExitCode::from(130)
+        })
+    }
+}

@@ -1,0 +1,389 @@
+//! The round loop of §2.2 (steps 2–5), generic over the p-set wrapper.
+
+use super::events::{Event, Merge, Observer};
+use super::hull_pset::HullBodies;
+use super::mpairs::{Entry, MPairs};
+use super::subset_tree::{NONE, SubsetTree};
+use super::voxel_hash::{Rec, VoxelHash};
+use super::{Grouping, PSet, ResolvedParams, Stats, Stopped, Weights};
+use crate::geom::Aabb;
+use crate::scene::Scene;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// What the round loop needs from a p-set wrapper beyond each body's AABB and diameter.
+pub(super) trait PSetBodies {
+    /// The diameter of the body `x ∪ y` if the pair is eligible (gap ≤ `glimit`), given that
+    /// their AABBs are within L∞ gap `glimit` and `merged` is the union of their AABBs.
+    fn eligible(&self, x: u32, y: u32, merged: &Aabb, glimit: f64) -> Option<f64>;
+    /// Records the merge of `x` and `y` into body `new`; returns the new body's diameter.
+    fn merge(&mut self, x: u32, y: u32, new: u32, merged: &Aabb) -> f64;
+}
+
+/// The AABB p-set: the diameter is the box diagonal and the L∞ box gap is the gap.
+struct AabbBodies;
+
+impl PSetBodies for AabbBodies {
+    #[inline(always)]
+    fn eligible(&self, _: u32, _: u32, merged: &Aabb, _: f64) -> Option<f64> {
+        Some(merged.diameter())
+    }
+    #[inline(always)]
+    fn merge(&mut self, _: u32, _: u32, _: u32, merged: &Aabb) -> f64 {
+        merged.diameter()
+    }
+}
+
+/// Runs the grouping phase; see the module doc of [`super`] for the steps.
+pub(super) fn run<O: Observer>(
+    scene: &Scene,
+    params: &ResolvedParams,
+    observer: O,
+    stop: Option<&AtomicBool>,
+) -> Result<Grouping, Stopped> {
+    assert!(!scene.is_empty(), "grouping needs at least one primitive");
+    match params.pset {
+        PSet::Aabb => {
+            let diameters = (0..scene.len()).map(|i| scene.prim_aabb(i).diameter()).collect();
+            Clusterer::new(scene, params, AabbBodies, diameters, observer).run(stop)
+        }
+        PSet::Hull => {
+            let bodies = HullBodies::new(scene);
+            let diameters = bodies.leaf_diameters();
+            Clusterer::new(scene, params, bodies, diameters, observer).run(stop)
+        }
+    }
+}
+
+/// splitmix64: the seeded tie tag of a body id.
+fn tie_tag(seed: Option<u64>, id: u32) -> u64 {
+    match seed {
+        None => id as u64,
+        Some(s) => {
+            let mut z = s ^ (id as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^ (z >> 31)
+        }
+    }
+}
+
+/// Fill and Balance of a would-be parent of diameter `d` over children of diameters `dx`, `dy`.
+///
+/// Point-like children (diameter 0) get documented fallbacks: Fill = 1 when both children are
+/// points, and Balance uses the smaller diameter floored at 1e-12 × the larger (so it is at
+/// most 1e12) and is 1 when both are points.
+#[inline]
+pub(super) fn fill_balance(d: f64, dx: f64, dy: f64) -> (f64, f64) {
+    let sum = dx + dy;
+    let fill = if sum > 0.0 { d / sum } else { 1.0 };
+    let (lo, hi) = if dx < dy { (dx, dy) } else { (dy, dx) };
+    let balance = if hi > 0.0 { hi / lo.max(hi * 1e-12) } else { 1.0 };
+    (fill, balance)
+}
+
+/// Spreads the low 21 bits of `v` to every third bit.
+fn spread_bits(v: u64) -> u64 {
+    let mut x = v & 0x1f_ffff;
+    x = (x | x << 32) & 0x001f_0000_0000_ffff;
+    x = (x | x << 16) & 0x001f_0000_ff00_00ff;
+    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
+    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
+    x = (x | x << 2) & 0x1249_2492_4924_9249;
+    x
+}
+
+struct Clusterer<'s, P, O> {
+    n: usize,
+    weights: Weights,
+    params: ResolvedParams,
+    pset: P,
+    observer: O,
+    aabb: Vec<Aabb>,
+    diameter: Vec<f64>,
+    /// Parent-less and not yet merged in this round's MPairs (active) — `in_hash[x]`.
+    in_hash: Vec<bool>,
+    parent: Vec<u32>,
+    tag: Vec<u64>,
+    merges: Vec<(u32, u32, Aabb, f64)>,
+    hash: VoxelHash,
+    bounds: Aabb,
+    /// Largest half-extent per axis of the bodies in the hash this round.
+    half_ext: [f64; 3],
+    morton_scale: [f64; 3],
+    mpairs: MPairs,
+    stats: Stats,
+    _scene: std::marker::PhantomData<&'s Scene>,
+}
+
+impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
+    fn new(scene: &'s Scene, params: &ResolvedParams, pset: P, diameter: Vec<f64>, observer: O) -> Self {
+        let n = scene.len();
+        let total = 2 * n - 1;
+        let mut aabb = Vec::with_capacity(total);
+        aabb.extend((0..n).map(|i| scene.prim_aabb(i)));
+        let mut d = diameter;
+        d.reserve(total - n);
+        let bounds = aabb.iter().fold(Aabb::EMPTY, |b, x| b.merge(x));
+        let ext = bounds.extents();
+        let morton_scale = [0, 1, 2].map(|k| if ext[k] > 0.0 { 2_097_151.0 / ext[k] } else { 0.0 });
+        Clusterer {
+            n,
+            weights: params.weights,
+            params: *params,
+            pset,
+            observer,
+            aabb,
+            diameter: d,
+            in_hash: vec![false; total],
+            parent: vec![NONE; total],
+            tag: (0..total as u32).map(|i| tie_tag(params.seed, i)).collect(),
+            merges: Vec::with_capacity(n - 1),
+            hash: VoxelHash::new(bounds.min),
+            bounds,
+            half_ext: [0.0; 3],
+            morton_scale,
+            mpairs: MPairs::default(),
+            stats: Stats::default(),
+            _scene: std::marker::PhantomData,
+        }
+    }
+
+    /// The cheapest eligible partner of active body `x`, and the number of eligible partners.
+    #[inline]
+    fn best_partner(&mut self, x: u32, glimit: f64) -> (Option<Entry>, u32) {
+        // Specialised on A so that A = 1 and A = 0 never evaluate `powf` (which LLVM would
+        // otherwise compute speculatively for every candidate).
+        if self.weights.a == 1.0 {
+            self.scan::<1>(x, glimit)
+        } else if self.weights.a == 0.0 {
+            self.scan::<0>(x, glimit)
+        } else {
+            self.scan::<2>(x, glimit)
+        }
+    }
+
+    #[inline]
+    fn scan<const A: u8>(&mut self, x: u32, glimit: f64) -> (Option<Entry>, u32) {
+        let xa = self.aabb[x as usize];
+        let dx = self.diameter[x as usize];
+        let tx = self.tag[x as usize];
+        let mut best: Option<Entry> = None;
+        let mut eligible = 0u32;
+        let mut candidates = 0u64;
+        let (weights, tags, pset) = (self.weights, &self.tag, &self.pset);
+        // An eligible partner's box comes within GLimit of x's box, and its centre lies at most
+        // half its extent (≤ `half_ext`, the largest among active bodies) inside that box.
+        let reach = self.half_ext.map(|h| h + glimit);
+        let lo = xa.min - nalgebra::Vector3::from(reach);
+        let hi = xa.max + nalgebra::Vector3::from(reach);
+        self.hash.for_each_in_box(&lo, &hi, |r: &Rec| {
+            candidates += 1;
+            if r.id == x || xa.gap_linf(&r.aabb) > glimit {
+                return;
+            }
+            let merged = xa.merge(&r.aabb);
+            let Some(d) = pset.eligible(x, r.id, &merged, glimit) else {
+                return;
+            };
+            eligible += 1;
+            let (fill, balance) = fill_balance(d, dx, r.diameter);
+            let scale = match A {
+                1 => d,
+                0 => 1.0,
+                _ => d.powf(weights.a),
+            };
+            let cost = weights.cost_scaled(scale, fill, balance);
+            // Tie tags are read only when the cost can win or tie.
+            if best.is_some_and(|b| cost > b.cost) {
+                return;
+            }
+            let ty = tags[r.id as usize];
+            let e = Entry {
+                cost,
+                lo: tx.min(ty),
+                hi: tx.max(ty),
+                owner: x,
+                partner: r.id,
+            };
+            if best.is_none_or(|b| e.before(&b)) {
+                best = Some(e);
+            }
+        });
+        self.stats.candidates += candidates;
+        (best, eligible)
+    }
+
+    /// Morton (Z-order) code of body `x`'s centre on a 2^21 grid over the scene box.
+    fn morton_key(&self, x: u32) -> u64 {
+        let c = self.aabb[x as usize].center();
+        let mut key = 0u64;
+        for k in 0..3 {
+            let t = ((c[k] - self.bounds.min[k]) * self.morton_scale[k]).clamp(0.0, 2_097_151.0) as u64;
+            key |= spread_bits(t) << k;
+        }
+        key
+    }
+
+    fn insert_active(&mut self, x: u32) {
+        self.in_hash[x as usize] = true;
+        let e = self.aabb[x as usize].extents();
+        for k in 0..3 {
+            self.half_ext[k] = self.half_ext[k].max(e[k] / 2.0);
+        }
+        self.hash.insert(Rec {
+            id: x,
+            aabb: self.aabb[x as usize],
+            diameter: self.diameter[x as usize],
+        });
+    }
+
+    fn run(mut self, stop: Option<&AtomicBool>) -> Result<Grouping, Stopped> {
+        let n = self.n;
+        let mut parentless: Vec<u32> = (0..n as u32).collect();
+        let (mut dlimit, mut glimit) = (self.params.dlimit0, self.params.glimit0);
+        let mut round = 0u32;
+        let mut active: Vec<u32> = Vec::new();
+        let mut morton: Vec<(u64, u32)> = Vec::new();
+        // Step 2: one parent-less body left is the root.
+        while parentless.len() > 1 {
+            active.clear();
+            active.extend(parentless.iter().copied().filter(|&x| self.diameter[x as usize] <= dlimit));
+            let dormant = (parentless.len() - active.len()) as u32;
+            // Step 3: voxel hash of active centres, CSize = DLimit + GLimit; queue best pairs.
+            // Bodies are inserted and scanned in Morton order of their centres so consecutive
+            // scans reuse the same cells from cache; the order does not change any result.
+            self.hash.reset(dlimit + glimit);
+            self.half_ext = [0.0; 3];
+            morton.clear();
+            morton.extend(active.iter().map(|&x| (self.morton_key(x), x)));
+            morton.sort_unstable();
+            for &(_, x) in &morton {
+                self.insert_active(x);
+            }
+            let mut pairs = 0u64;
+            for &(_, x) in &morton {
+                let (best, k) = self.best_partner(x, glimit);
+                pairs += k as u64;
+                if let Some(e) = best {
+                    self.mpairs.push(e);
+                }
+            }
+            pairs /= 2;
+            self.stats.eligible_pairs += pairs;
+            self.observer.on_event(&Event::RoundStart {
+                round,
+                dlimit,
+                glimit,
+                active: &active,
+                dormant,
+                pairs,
+            });
+            // Step 4: pop and merge until MPairs is empty.
+            let merges_before = self.merges.len();
+            while let Some(e) = self.mpairs.pop() {
+                self.stats.pops += 1;
+                if !self.in_hash[e.owner as usize] {
+                    self.stats.stale_pops += 1;
+                    continue;
+                }
+                if !self.in_hash[e.partner as usize] {
+                    self.stats.stale_pops += 1;
+                    if let (Some(again), _) = self.best_partner(e.owner, glimit) {
+                        self.mpairs.push(again);
+                    }
+                    continue;
+                }
+                if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+                    return Err(Stopped {
+                        merges: self.merges.len() as u32,
+                        rounds: round + 1,
+                    });
+                }
+                self.merge_pair(e, round, dlimit, glimit);
+            }
+            let made = (self.merges.len() - merges_before) as u32;
+            parentless.retain(|&x| self.parent[x as usize] == NONE);
+            parentless.extend(((n + merges_before) as u32..(n + self.merges.len()) as u32).filter(|&x| self.parent[x as usize] == NONE));
+            round += 1;
+            if parentless.len() > 1 {
+                // Step 5: double the limits and go to step 2.
+                dlimit *= 2.0;
+                glimit *= 2.0;
+                self.observer.on_event(&Event::Doubling {
+                    round: round - 1,
+                    merges: made,
+                    dlimit,
+                    glimit,
+                });
+            }
+        }
+        let tree = SubsetTree::from_merges(
+            self.aabb[..n].to_vec(),
+            self.diameter[..n].to_vec(),
+            &self.merges,
+        )
+        .expect("the round loop makes exactly N - 1 valid merges");
+        self.observer.on_event(&Event::Finish {
+            root: tree.root(),
+            rounds: round,
+            merges: self.merges.len() as u32,
+        });
+        Ok(Grouping {
+            tree,
+            rounds: round,
+            params: self.params,
+            stats: self.stats,
+        })
+    }
+
+    /// Step 4(a)–(c) for one popped pair.
+    fn merge_pair(&mut self, e: Entry, round: u32, dlimit: f64, glimit: f64) {
+        let (a, b) = (e.owner.min(e.partner), e.owner.max(e.partner));
+        let new = (self.n + self.merges.len()) as u32;
+        let merged = self.aabb[a as usize].merge(&self.aabb[b as usize]);
+        for x in [a, b] {
+            self.in_hash[x as usize] = false;
+            self.parent[x as usize] = new;
+            let bx = self.aabb[x as usize];
+            self.hash.remove(x, &bx);
+        }
+        let d = self.pset.merge(a, b, new, &merged);
+        let (da, db) = (self.diameter[a as usize], self.diameter[b as usize]);
+        let (fill, balance) = fill_balance(d, da, db);
+        let cost = self.weights.cost(d, fill, balance);
+        self.aabb.push(merged);
+        self.diameter.push(d);
+        self.merges.push((a, b, merged, d));
+        let is_active = d <= dlimit;
+        if is_active {
+            // Step 4(b): the new body joins ABods and queues its best eligible pair.
+            self.insert_active(new);
+            if let (Some(best), _) = self.best_partner(new, glimit) {
+                self.mpairs.push(best);
+            }
+        }
+        self.stats.peak_queue = self.stats.peak_queue.max(self.mpairs.len() as u64);
+        self.observer.on_event(&Event::Merge(Merge {
+            step: (new as usize - self.n) as u32,
+            round,
+            a,
+            b,
+            new,
+            aabb: merged,
+            diameter: d,
+            fill,
+            balance,
+            cost,
+            queue_len: self.mpairs.len() as u32,
+            active: is_active,
+        }));
+        if !is_active {
+            // Step 4(c): too big for this round's DLimit; dormant until a later round.
+            self.observer.on_event(&Event::Dormant {
+                round,
+                body: new,
+                diameter: d,
+            });
+        }
+    }
+}

@@ -1,0 +1,164 @@
+//! Typed events of the grouping phase and the one observer interface recorders subscribe to.
+//!
+//! The algorithm calls [`Observer::on_event`] at each step; it knows nothing about Rerun or
+//! MCAP. The unit observer `()` ignores everything and is inlined away, so grouping without a
+//! listener costs nothing.
+
+use crate::geom::Aabb;
+
+/// One merge of step 4(a): bodies `a` and `b` become the new body `new`.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Merge {
+    /// 0-based merge index; the new body's id is `n + step`.
+    pub step: u32,
+    /// Round (number of DLimit doublings so far) in which the merge happened.
+    pub round: u32,
+    /// First merged body (the smaller id).
+    pub a: u32,
+    /// Second merged body (the larger id).
+    pub b: u32,
+    /// Id of the new body.
+    pub new: u32,
+    /// AABB of the new body.
+    #[serde(serialize_with = "ser_aabb")]
+    pub aabb: Aabb,
+    /// Diameter of the new body.
+    pub diameter: f64,
+    /// Fill = new diameter / (diameter a + diameter b).
+    pub fill: f64,
+    /// Balance = greater ratio of the children's diameters (≥ 1).
+    pub balance: f64,
+    /// Cost = diameter^A × (B·Fill + C·Balance).
+    pub cost: f64,
+    /// Entries left in MPairs after the pop.
+    pub queue_len: u32,
+    /// Whether the new body obeys DLimit (active) or went dormant (step 4c).
+    pub active: bool,
+}
+
+fn ser_aabb<S: serde::Serializer>(b: &Aabb, s: S) -> Result<S::Ok, S::Error> {
+    use serde::Serialize;
+    [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z].serialize(s)
+}
+
+/// A step of the grouping phase.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Event<'a> {
+    /// Step 2–3: a round starts with these limits and sets.
+    RoundStart {
+        /// Round index (0 for the first).
+        round: u32,
+        /// DLimit of this round.
+        dlimit: f64,
+        /// GLimit of this round.
+        glimit: f64,
+        /// Active bodies (parent-less, diameter ≤ DLimit), sorted by id.
+        active: &'a [u32],
+        /// Number of dormant bodies.
+        dormant: u32,
+        /// Eligible pairs found by the voxel scan (the literal MPairs length).
+        pairs: u64,
+    },
+    /// Step 4(a): a pair was popped and merged.
+    Merge(Merge),
+    /// Step 4(c): a new body exceeds DLimit and goes dormant until a later round.
+    Dormant {
+        /// Round index.
+        round: u32,
+        /// The body.
+        body: u32,
+        /// Its diameter.
+        diameter: f64,
+    },
+    /// Step 5: MPairs is empty; DLimit and GLimit double.
+    Doubling {
+        /// Round that just ended.
+        round: u32,
+        /// Merges made in that round.
+        merges: u32,
+        /// New DLimit.
+        dlimit: f64,
+        /// New GLimit.
+        glimit: f64,
+    },
+    /// The root exists; grouping is over.
+    Finish {
+        /// Root body id.
+        root: u32,
+        /// Number of rounds run.
+        rounds: u32,
+        /// Number of merges (N − 1).
+        merges: u32,
+    },
+}
+
+/// Receives every [`Event`] of a grouping run, in order.
+pub trait Observer {
+    /// Called once per event.
+    fn on_event(&mut self, event: &Event<'_>);
+}
+
+/// The silent observer.
+impl Observer for () {
+    #[inline(always)]
+    fn on_event(&mut self, _: &Event<'_>) {}
+}
+
+impl<O: Observer + ?Sized> Observer for &mut O {
+    #[inline]
+    fn on_event(&mut self, event: &Event<'_>) {
+        (**self).on_event(event)
+    }
+}
+
+/// Forwards each event to two observers (e.g. a recorder and a progress bar).
+pub struct Tee<A, B>(pub A, pub B);
+
+impl<A: Observer, B: Observer> Observer for Tee<A, B> {
+    #[inline]
+    fn on_event(&mut self, event: &Event<'_>) {
+        self.0.on_event(event);
+        self.1.on_event(event);
+    }
+}
+
+/// Collects an owned copy of every event; used by tests and by `replay --verify`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct EventLog {
+    /// Every merge, in order.
+    pub merges: Vec<Merge>,
+    /// (round, dlimit, glimit, active count, dormant count, eligible pairs) per round start.
+    pub rounds: Vec<(u32, f64, f64, u32, u32, u64)>,
+    /// Bodies that went dormant, with their round.
+    pub dormant: Vec<(u32, u32)>,
+    /// (round, merges, new dlimit, new glimit) per doubling.
+    pub doublings: Vec<(u32, u32, f64, f64)>,
+    /// Root id once finished.
+    pub root: Option<u32>,
+}
+
+impl Observer for EventLog {
+    fn on_event(&mut self, event: &Event<'_>) {
+        match *event {
+            Event::RoundStart {
+                round,
+                dlimit,
+                glimit,
+                active,
+                dormant,
+                pairs,
+            } => self
+                .rounds
+                .push((round, dlimit, glimit, active.len() as u32, dormant, pairs)),
+            Event::Merge(m) => self.merges.push(m),
+            Event::Dormant { round, body, .. } => self.dormant.push((round, body)),
+            Event::Doubling {
+                round,
+                merges,
+                dlimit,
+                glimit,
+            } => self.doublings.push((round, merges, dlimit, glimit)),
+            Event::Finish { root, .. } => self.root = Some(root),
+        }
+    }
+}

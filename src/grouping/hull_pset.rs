@@ -1,0 +1,157 @@
+//! The convex-hull p-set (§2.2's slower variant): a body is the convex hull of its primitives'
+//! vertices, its diameter the largest distance between two of them, and the gap between two
+//! bodies their L2 distance (GJK on the two vertex sets, via parry).
+//!
+//! Vertices stay `f64`; parry (`f32`) sees them relative to the pair's AABB centre. Merged hulls
+//! keep only the vertices parry's `try_convex_hull` reports on the hull; where it fails (or
+//! panics, parry issue #49) the body keeps the union of both vertex sets, which has the same
+//! hull, so results stay correct at some cost in speed.
+
+use super::cluster::PSetBodies;
+use crate::geom::{Aabb, P3, to_glam_local};
+use crate::scene::Scene;
+use parry3d::math::{Pose, Vector};
+use parry3d::shape::SupportMap;
+use std::cell::RefCell;
+use std::collections::HashMap;
+
+/// A vertex set seen as its convex hull through the support function.
+struct Cloud<'a>(&'a [Vector]);
+
+impl SupportMap for Cloud<'_> {
+    fn local_support_point(&self, dir: Vector) -> Vector {
+        let mut best = self.0[0];
+        let mut best_dot = best.dot(dir);
+        for p in &self.0[1..] {
+            let d = p.dot(dir);
+            if d > best_dot {
+                best_dot = d;
+                best = *p;
+            }
+        }
+        best
+    }
+}
+
+/// Hull vertex sets of every body.
+pub(super) struct HullBodies {
+    points: Vec<Vec<P3>>,
+    diameter: Vec<f64>,
+    scratch: RefCell<(Vec<Vector>, Vec<Vector>)>,
+}
+
+/// Largest distance between two points of `p` (exact, O(n²)).
+fn diameter_of(p: &[P3]) -> f64 {
+    let mut d2: f64 = 0.0;
+    for i in 0..p.len() {
+        for j in i + 1..p.len() {
+            d2 = d2.max((p[i] - p[j]).norm_squared());
+        }
+    }
+    d2.sqrt()
+}
+
+/// Largest distance between a point of `a` and a point of `b`.
+fn cross_diameter(a: &[P3], b: &[P3]) -> f64 {
+    let mut d2: f64 = 0.0;
+    for p in a {
+        for q in b {
+            d2 = d2.max((p - q).norm_squared());
+        }
+    }
+    d2.sqrt()
+}
+
+/// The vertices of `pts` on their convex hull (by parry), or all of them when that fails.
+fn hull_vertices(pts: Vec<P3>) -> Vec<P3> {
+    if pts.len() <= 4 {
+        return pts;
+    }
+    let origin = Aabb::from_points(&pts).center();
+    let local: Vec<Vector> = pts.iter().map(|p| to_glam_local(p, &origin)).collect();
+    let hull = std::panic::catch_unwind(|| parry3d::transformation::try_convex_hull(&local));
+    let Ok(Ok((hv, _))) = hull else {
+        return pts;
+    };
+    let index: HashMap<[u32; 3], usize> = local
+        .iter()
+        .enumerate()
+        .map(|(i, v)| ([v.x.to_bits(), v.y.to_bits(), v.z.to_bits()], i))
+        .collect();
+    let mut kept = Vec::with_capacity(hv.len());
+    for v in &hv {
+        match index.get(&[v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]) {
+            Some(&i) => kept.push(pts[i]),
+            None => return pts,
+        }
+    }
+    kept
+}
+
+impl HullBodies {
+    /// One body per primitive: its distinct vertices.
+    pub(super) fn new(scene: &Scene) -> HullBodies {
+        let mut points: Vec<Vec<P3>> = (0..scene.len())
+            .map(|i| {
+                let mut v: Vec<P3> = Vec::new();
+                for p in scene.prim_vertices(i) {
+                    if !v.contains(p) {
+                        v.push(*p);
+                    }
+                }
+                v
+            })
+            .collect();
+        points.reserve(scene.len().saturating_sub(1));
+        let diameter = points.iter().map(|p| diameter_of(p)).collect();
+        HullBodies {
+            points,
+            diameter,
+            scratch: RefCell::new((Vec::new(), Vec::new())),
+        }
+    }
+
+    /// Exact diameter of every leaf.
+    pub(super) fn leaf_diameters(&self) -> Vec<f64> {
+        self.diameter.clone()
+    }
+
+    /// L2 distance between the hulls of bodies `x` and `y`.
+    fn gap(&self, x: u32, y: u32, origin: &P3) -> f64 {
+        let mut s = self.scratch.borrow_mut();
+        let (a, b) = &mut *s;
+        a.clear();
+        a.extend(self.points[x as usize].iter().map(|p| to_glam_local(p, origin)));
+        b.clear();
+        b.extend(self.points[y as usize].iter().map(|p| to_glam_local(p, origin)));
+        parry3d::query::details::distance_support_map_support_map(&Pose::IDENTITY, &Cloud(a), &Cloud(b))
+            as f64
+    }
+}
+
+impl PSetBodies for HullBodies {
+    fn eligible(&self, x: u32, y: u32, merged: &Aabb, glimit: f64) -> Option<f64> {
+        if self.gap(x, y, &merged.center()) > glimit {
+            return None;
+        }
+        Some(self.union_diameter(x, y))
+    }
+
+    fn merge(&mut self, x: u32, y: u32, new: u32, _: &Aabb) -> f64 {
+        debug_assert_eq!(new as usize, self.points.len());
+        let d = self.union_diameter(x, y);
+        let mut union = std::mem::take(&mut self.points[x as usize]);
+        union.append(&mut std::mem::take(&mut self.points[y as usize]));
+        self.points.push(hull_vertices(union));
+        self.diameter.push(d);
+        d
+    }
+}
+
+impl HullBodies {
+    fn union_diameter(&self, x: u32, y: u32) -> f64 {
+        let (a, b) = (&self.points[x as usize], &self.points[y as usize]);
+        let (da, db) = (self.diameter[x as usize], self.diameter[y as usize]);
+        da.max(db).max(cross_diameter(a, b))
+    }
+}

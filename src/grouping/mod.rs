@@ -1,0 +1,226 @@
+//! The grouping phase of §2.2: bottom-up greedy clustering of convex primitives into a binary
+//! Subset Tree.
+//!
+//! The paper's steps and where they live:
+//!
+//! 1. *GLimit* (largest gap between merged bodies) and *DLimit* (largest diameter of a body that
+//!    may merge) start at [`ResolvedParams::dlimit0`]/[`ResolvedParams::glimit0`]
+//!    ([`Params::resolve`]).
+//! 2. One parent-less body left → it is the root. Otherwise parent-less bodies with
+//!    diameter ≤ DLimit are active (*ABods*), the rest dormant (*DBods*) — `cluster::run`, top of
+//!    its round loop.
+//! 3. Active body centres go into a voxel hash with cell size CSize = DLimit + GLimit
+//!    ([`voxel_hash::VoxelHash`]); scanning the 27 cells around each centre and filtering by
+//!    GLimit gives the eligible pairs, queued in *MPairs* by Cost ([`mpairs::MPairs`]).
+//! 4. Until MPairs is empty: (a) pop the cheapest pair, skipping pairs that lost a member, and
+//!    merge it; (b) if the new body obeys DLimit it becomes active, enters the hash and its
+//!    eligible pairs are queued; (c) otherwise it goes dormant — `cluster::run`, inner loop.
+//! 5. Double DLimit and GLimit and go to 2 — end of the round loop.
+//!
+//! Cost = diameter^A × (B·Fill + C·Balance) ([`Weights::cost`]), Fill = parent diameter / sum of
+//! child diameters, Balance = greater ratio of the child diameters.
+//!
+//! MPairs keeps, for every active body, only its cheapest eligible partner, and searches again
+//! when that partner is merged away. Because pair costs are symmetric and fixed, the pair popped
+//! at every step is the global minimum over all eligible pairs, exactly the pair the literal
+//! queue of every eligible pair would pop, so the tree is the same; the queue is O(N) instead
+//! of O(kN). Ties break by the pair's (smaller id, larger id), or by seeded random tags with
+//! `--seed`.
+
+mod cluster;
+pub mod events;
+mod hull_pset;
+pub mod mpairs;
+pub mod subset_tree;
+pub mod voxel_hash;
+
+pub use events::{Event, EventLog, Merge, Observer, Tee};
+pub use subset_tree::{NONE, SubsetTree};
+
+use crate::scene::Scene;
+use std::sync::atomic::AtomicBool;
+
+/// The p-set wrapper bodies carry while grouping.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum PSet {
+    /// Axis-aligned boxes, diagonal as diameter, L∞ gaps (the paper's fast variant).
+    #[default]
+    Aabb,
+    /// Convex hulls (parry), largest vertex distance as diameter, L2 gaps (GJK).
+    Hull,
+}
+
+/// The Cost weights of eq. (2).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Weights {
+    /// Exponent A on the diameter.
+    pub a: f64,
+    /// Weight B on Fill.
+    pub b: f64,
+    /// Weight C on Balance.
+    pub c: f64,
+}
+
+impl Weights {
+    /// Cost = diameter^A × (B·Fill + C·Balance). When B = C = 0 the bracket would vanish for
+    /// every pair; it is then taken as 1, so the cost is diameter^A.
+    #[inline]
+    pub fn cost(&self, diameter: f64, fill: f64, balance: f64) -> f64 {
+        let scale = if self.a == 1.0 {
+            diameter
+        } else if self.a == 0.0 {
+            1.0
+        } else {
+            diameter.powf(self.a)
+        };
+        self.cost_scaled(scale, fill, balance)
+    }
+
+    /// The cost given `scale` = diameter^A already computed.
+    #[inline(always)]
+    pub fn cost_scaled(&self, scale: f64, fill: f64, balance: f64) -> f64 {
+        if self.b == 0.0 && self.c == 0.0 {
+            scale
+        } else {
+            scale * (self.b * fill + self.c * balance)
+        }
+    }
+}
+
+/// User-facing parameters; `None` limits are derived from the scene by [`Params::resolve`].
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Params {
+    /// Cost weights.
+    pub weights: Weights,
+    /// Initial DLimit (default: median primitive diameter).
+    pub dlimit: Option<f64>,
+    /// Initial GLimit (default: DLimit / 4).
+    pub glimit: Option<f64>,
+    /// P-set wrapper kind.
+    pub pset: PSet,
+    /// Seed for randomised tie-breaking (`None`: ties break by id).
+    pub seed: Option<u64>,
+}
+
+impl Default for Params {
+    /// A = 1, B = 1, C = 0: cost = diameter × Fill. The calibration runs found Balance (C > 0)
+    /// worsened SAH on every scene and could produce degenerate trees with small GLimit.
+    fn default() -> Self {
+        Params {
+            weights: Weights {
+                a: 1.0,
+                b: 1.0,
+                c: 0.0,
+            },
+            dlimit: None,
+            glimit: None,
+            pset: PSet::Aabb,
+            seed: None,
+        }
+    }
+}
+
+/// Parameters with every limit fixed, as recorded in recordings' metadata.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ResolvedParams {
+    /// Cost weights.
+    pub weights: Weights,
+    /// DLimit of the first round.
+    pub dlimit0: f64,
+    /// GLimit of the first round.
+    pub glimit0: f64,
+    /// P-set wrapper kind.
+    pub pset: PSet,
+    /// Seed for randomised ties, if any.
+    pub seed: Option<u64>,
+}
+
+impl Params {
+    /// Fixes the initial limits: DLimit0 = the median primitive diameter (AABB diagonal) and
+    /// GLimit0 = DLimit0 / 4. When that median is 0 (point-like primitives) DLimit0 falls back
+    /// to 1e-6 × the scene diagonal, and to 1 for a scene that is a single point.
+    pub fn resolve(&self, scene: &Scene) -> ResolvedParams {
+        let dlimit0 = match self.dlimit {
+            Some(d) => d,
+            None => {
+                let mut d: Vec<f64> = (0..scene.len()).map(|i| scene.prim_aabb(i).diameter()).collect();
+                let median = if d.is_empty() {
+                    0.0
+                } else {
+                    let mid = d.len() / 2;
+                    *d.select_nth_unstable_by(mid, f64::total_cmp).1
+                };
+                if median > 0.0 {
+                    median
+                } else {
+                    let diag = scene.aabb().diameter();
+                    if diag.is_finite() && diag > 0.0 { diag * 1e-6 } else { 1.0 }
+                }
+            }
+        };
+        let glimit0 = self.glimit.unwrap_or(dlimit0 / 4.0);
+        ResolvedParams {
+            weights: self.weights,
+            dlimit0,
+            glimit0,
+            pset: self.pset,
+            seed: self.seed,
+        }
+    }
+}
+
+/// Counters of one run, for benchmarks and the stability study.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Stats {
+    /// Eligible pairs found by the round-start scans, summed over rounds.
+    pub eligible_pairs: u64,
+    /// Candidate bodies examined in voxel scans.
+    pub candidates: u64,
+    /// MPairs pops.
+    pub pops: u64,
+    /// Pops skipped because a member had merged away.
+    pub stale_pops: u64,
+    /// Largest MPairs length.
+    pub peak_queue: u64,
+}
+
+/// The outcome of the grouping phase.
+#[derive(Clone, Debug)]
+pub struct Grouping {
+    /// The Subset Tree.
+    pub tree: SubsetTree,
+    /// Number of rounds (DLimit values) used.
+    pub rounds: u32,
+    /// The parameters after resolution.
+    pub params: ResolvedParams,
+    /// Work counters.
+    pub stats: Stats,
+}
+
+/// Why a run stopped before the root.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stopped {
+    /// Merges completed before the stop.
+    pub merges: u32,
+    /// Rounds started.
+    pub rounds: u32,
+}
+
+/// Runs the grouping phase on `scene`, reporting every step to `observer`.
+///
+/// Panics only if the scene is empty; loaders reject empty scenes first.
+pub fn group<O: Observer>(scene: &Scene, params: &Params, observer: O) -> Grouping {
+    cluster::run(scene, &params.resolve(scene), observer, None).expect("no stop flag was given")
+}
+
+/// Like [`group`], but checks `stop` between merges and returns [`Stopped`] once it is set
+/// (the observer has then seen every merge made so far).
+pub fn group_until<O: Observer>(
+    scene: &Scene,
+    params: &ResolvedParams,
+    observer: O,
+    stop: &AtomicBool,
+) -> Result<Grouping, Stopped> {
+    cluster::run(scene, params, observer, Some(stop))
+}

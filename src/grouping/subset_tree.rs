@@ -1,0 +1,143 @@
+//! The Subset Tree: a flat arena of the N leaves (ids `0..N`, input order) and the N − 1
+//! interior nodes (ids `N..2N−1`, merge order) made by the grouping phase.
+
+use crate::geom::Aabb;
+
+/// Marker for "no node" (the root's parent).
+pub const NONE: u32 = u32::MAX;
+
+/// A binary Subset Tree with each node's AABB p-set wrapper and diameter.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SubsetTree {
+    n: u32,
+    /// Parent of every node (`NONE` for the root).
+    pub parent: Vec<u32>,
+    /// Children of interior node `N + i` at index `i`.
+    pub children: Vec<[u32; 2]>,
+    /// Depth of every node (root = 0).
+    pub depth: Vec<u32>,
+    /// AABB of every node's set.
+    pub aabb: Vec<Aabb>,
+    /// Diameter of every node's p-set wrapper.
+    pub diameter: Vec<f64>,
+}
+
+impl SubsetTree {
+    /// Builds a tree from the leaves' boxes and diameters and the merges `(a, b)` in order;
+    /// merge `i` creates node `N + i`. Fails unless the merges form one binary tree.
+    pub fn from_merges(
+        leaf_aabb: Vec<Aabb>,
+        leaf_diameter: Vec<f64>,
+        merges: &[(u32, u32, Aabb, f64)],
+    ) -> Result<SubsetTree, String> {
+        let n = leaf_aabb.len();
+        if n == 0 {
+            return Err("a Subset Tree needs at least one leaf".into());
+        }
+        if merges.len() != n - 1 {
+            return Err(format!("{} merges for {n} leaves (want {})", merges.len(), n - 1));
+        }
+        let total = 2 * n - 1;
+        let mut parent = vec![NONE; total];
+        let mut aabb = leaf_aabb;
+        let mut diameter = leaf_diameter;
+        let mut children = Vec::with_capacity(n - 1);
+        for (i, &(a, b, bx, d)) in merges.iter().enumerate() {
+            let new = (n + i) as u32;
+            for c in [a, b] {
+                if c >= new || parent[c as usize] != NONE || a == b {
+                    return Err(format!("merge {i} ({a}, {b}) reuses or forward-references a body"));
+                }
+                parent[c as usize] = new;
+            }
+            children.push([a, b]);
+            aabb.push(bx);
+            diameter.push(d);
+        }
+        let mut depth = vec![0u32; total];
+        for node in (0..total - 1).rev() {
+            depth[node] = depth[parent[node] as usize] + 1;
+        }
+        Ok(SubsetTree {
+            n: n as u32,
+            parent,
+            children,
+            depth,
+            aabb,
+            diameter,
+        })
+    }
+
+    /// Number of leaves N.
+    pub fn leaves(&self) -> usize {
+        self.n as usize
+    }
+
+    /// Number of nodes, 2N − 1.
+    pub fn len(&self) -> usize {
+        self.parent.len()
+    }
+
+    /// Always false: a tree has at least one node.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// The root's id (2N − 2).
+    pub fn root(&self) -> u32 {
+        (self.len() - 1) as u32
+    }
+
+    /// Whether `node` is a leaf (an input primitive).
+    pub fn is_leaf(&self, node: u32) -> bool {
+        node < self.n
+    }
+
+    /// The two children of an interior node.
+    pub fn children_of(&self, node: u32) -> Option<[u32; 2]> {
+        (!self.is_leaf(node)).then(|| self.children[(node - self.n) as usize])
+    }
+
+    /// Largest leaf depth (edges from the root); the tree has `depth_max() + 1` levels.
+    pub fn depth_max(&self) -> u32 {
+        self.depth[..self.leaves()].iter().copied().max().unwrap_or(0)
+    }
+
+    /// Mean leaf depth.
+    pub fn depth_mean(&self) -> f64 {
+        let s: u64 = self.depth[..self.leaves()].iter().map(|&d| d as u64).sum();
+        s as f64 / self.leaves() as f64
+    }
+
+    /// Leaves under `node`, in left-to-right order.
+    pub fn leaves_under(&self, node: u32) -> Vec<u32> {
+        let mut out = Vec::new();
+        let mut stack = vec![node];
+        while let Some(x) = stack.pop() {
+            match self.children_of(x) {
+                Some([a, b]) => {
+                    stack.push(b);
+                    stack.push(a);
+                }
+                None => out.push(x),
+            }
+        }
+        out
+    }
+
+    /// The cut at depth `d`: nodes at depth `d` plus leaves shallower than `d`, sorted by id.
+    /// This is the set the paper's figures draw for one level.
+    pub fn level(&self, d: u32) -> Vec<u32> {
+        (0..self.len() as u32)
+            .filter(|&x| self.depth[x as usize] == d || (self.is_leaf(x) && self.depth[x as usize] < d))
+            .collect()
+    }
+
+    /// Parents as `i64` with −1 for the root (the `--json` form).
+    pub fn parent_i64(&self) -> Vec<i64> {
+        self.parent
+            .iter()
+            .map(|&p| if p == NONE { -1 } else { p as i64 })
+            .collect()
+    }
+}

@@ -1,0 +1,12 @@
+//! wraptree: build, record and inspect bounding-volume hierarchies with the bottom-up grouping
+//! phase of Xavier, "A Generic Algorithm for Constructing Hierarchical Representations of
+//! Geometric Objects" (ICRA 1996).
+//!
+//! Data flows `scene` → `grouping` (Subset Tree, §2.2) → `wrap` (Wrapper Trees, §2.4) →
+//! `record` (`.rrd`, `.mcap`).
+
+pub mod geom;
+pub mod grouping;
+pub mod record;
+pub mod scene;
+pub mod wrap;

@@ -1,0 +1,65 @@
+//! Recordings of a grouping run: `.rrd` for the Rerun viewer ([`rrd`]) and `.mcap` for Foxglove
+//! ([`mcap`]). Both recorders are [`Observer`](crate::grouping::Observer)s fed the same events
+//! and share nothing else; [`output`] makes their files appear atomically.
+
+pub mod mcap;
+pub mod output;
+pub mod rrd;
+
+use crate::grouping::{Grouping, ResolvedParams};
+use crate::scene::{Scene, SceneSource};
+use crate::wrap::Sphere;
+
+/// What a recording holds (`--detail`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Detail {
+    /// Scene, merge events and series, round summaries and every tree level; no per-merge or
+    /// per-round geometry.
+    Levels,
+    /// Scene, merge events with per-merge boxes and each round's active bodies; no levels.
+    Merges,
+    /// Everything.
+    #[default]
+    Full,
+}
+
+impl Detail {
+    /// Whether per-merge and per-round geometry is written.
+    pub fn merges(self) -> bool {
+        matches!(self, Detail::Merges | Detail::Full)
+    }
+
+    /// Whether tree levels are written.
+    pub fn levels(self) -> bool {
+        matches!(self, Detail::Levels | Detail::Full)
+    }
+}
+
+/// What recorders know before the first event.
+#[derive(Clone, Copy, Debug)]
+pub struct RunInfo<'a> {
+    /// The scene being grouped.
+    pub scene: &'a Scene,
+    /// Where it came from (embedded in `.mcap` for `replay --verify`).
+    pub source: &'a SceneSource,
+    /// Resolved parameters.
+    pub params: &'a ResolvedParams,
+    /// What to write.
+    pub detail: Detail,
+}
+
+/// What recorders learn after the last event.
+#[derive(Clone, Copy, Debug)]
+pub struct Outcome<'a> {
+    /// The finished grouping; `None` when the run was interrupted.
+    pub grouping: Option<&'a Grouping>,
+    /// Sphere Wrapper Tree (one per node) when levels are written.
+    pub spheres: Option<&'a [Sphere]>,
+    /// Merges made.
+    pub merges: u32,
+    /// Rounds started.
+    pub rounds: u32,
+    /// Grouping wall time in seconds.
+    pub seconds: f64,
+}

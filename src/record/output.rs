@@ -1,0 +1,89 @@
+//! Output files that appear whole or not at all.
+//!
+//! Data goes to a temporary file in the destination's directory, renamed over the destination
+//! only once it is complete; an existing file is replaced only when the caller allows it. A
+//! failed or interrupted write leaves the old file untouched.
+
+use anyhow::{Context, Result, bail};
+use std::path::{Path, PathBuf};
+
+/// A file being written; [`Pending::commit`] moves it into place.
+#[derive(Debug)]
+pub struct Pending {
+    tmp: tempfile::NamedTempFile,
+    dest: PathBuf,
+}
+
+impl Pending {
+    /// Starts writing `dest`. Fails when its directory is missing or unwritable, or when it
+    /// exists and `force` is false.
+    pub fn create(dest: &Path, force: bool) -> Result<Pending> {
+        if dest.exists() && !force {
+            bail!("{}: already exists (use --force to replace it)", dest.display());
+        }
+        let dir = match dest.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        if !dir.is_dir() {
+            bail!("{}: output directory {} does not exist", dest.display(), dir.display());
+        }
+        let name = dest.file_name().and_then(|n| n.to_str()).unwrap_or("out");
+        let tmp = tempfile::Builder::new()
+            .prefix(&format!(".{name}."))
+            .suffix(".tmp")
+            .tempfile_in(dir)
+            .with_context(|| format!("{}: cannot create a file in {}", dest.display(), dir.display()))?;
+        Ok(Pending {
+            tmp,
+            dest: dest.to_path_buf(),
+        })
+    }
+
+    /// Path of the temporary file (for writers that open paths themselves).
+    pub fn path(&self) -> &Path {
+        self.tmp.path()
+    }
+
+    /// The final destination.
+    pub fn dest(&self) -> &Path {
+        &self.dest
+    }
+
+    /// A second handle on the temporary file, for writing.
+    pub fn file(&self) -> Result<std::fs::File> {
+        self.tmp
+            .reopen()
+            .with_context(|| format!("{}: cannot open for writing", self.path().display()))
+    }
+
+    /// Syncs the temporary file and renames it over the destination.
+    pub fn commit(self) -> Result<PathBuf> {
+        self.commit_to(None)
+    }
+
+    /// Like [`Pending::commit`] but to `other` instead of the destination (used to set an
+    /// interrupted recording aside without touching an existing one).
+    pub fn commit_to(self, other: Option<&Path>) -> Result<PathBuf> {
+        let dest = other.map(Path::to_path_buf).unwrap_or(self.dest);
+        self.tmp
+            .as_file()
+            .sync_all()
+            .with_context(|| format!("{}: cannot sync", dest.display()))?;
+        self.tmp
+            .persist(&dest)
+            .map_err(|e| anyhow::anyhow!("{}: cannot move into place: {}", dest.display(), e.error))?;
+        Ok(dest)
+    }
+}
+
+/// Writes `bytes` to `dest` atomically.
+pub fn write_atomic(dest: &Path, bytes: &[u8], force: bool) -> Result<()> {
+    use std::io::Write;
+    let p = Pending::create(dest, force)?;
+    p.file()?
+        .write_all(bytes)
+        .with_context(|| format!("{}: write failed", dest.display()))?;
+    p.commit()?;
+    Ok(())
+}

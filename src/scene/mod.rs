@@ -1,0 +1,138 @@
+//! Scenes: the convex primitives the grouping phase clusters.
+//!
+//! A [`Scene`] stores its primitives flat (CSR-style) so a million triangles cost a handful of
+//! allocations: primitive `i` owns the vertex indices `prim_points[prim_start[i]..prim_start[i+1]]`
+//! and the triangles `tris[tri_start[i]..tri_start[i+1]]` that draw it (a fan for a convex polygon,
+//! the hull's faces for a polyhedron).
+//!
+//! - [`obj`] loads Wavefront OBJ (via `tobj`) as polygons or as polyhedra, with validation;
+//! - [`generate`] makes the seeded synthetic scenes (robot base, lamp, replicas, soups).
+
+pub mod generate;
+pub mod obj;
+
+pub use obj::{LoadError, LoadOptions, Loaded, SceneSource, load_bytes, load_path};
+
+use crate::geom::{Aabb, P3};
+
+/// What one primitive of a scene is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PrimitiveKind {
+    /// One planar convex polygon per OBJ face.
+    Polygon,
+    /// One convex polyhedron per OBJ object/group.
+    Polyhedron,
+}
+
+/// A set of convex primitives in input order.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    /// Human-readable name (usually the file stem).
+    pub name: String,
+    /// Whether primitives are polygons or polyhedra (`None` for an empty scene).
+    pub kind: Option<PrimitiveKind>,
+    /// All vertex positions.
+    pub points: Vec<P3>,
+    /// Offsets into `prim_points`, length N + 1.
+    pub prim_start: Vec<u32>,
+    /// Vertex indices of every primitive, concatenated (polygon order for polygons).
+    pub prim_points: Vec<u32>,
+    /// Offsets into `tris`, length N + 1.
+    pub tri_start: Vec<u32>,
+    /// Triangles (vertex indices into `points`) that draw each primitive.
+    pub tris: Vec<[u32; 3]>,
+    /// Optional per-primitive label (OBJ group name for polyhedra).
+    pub labels: Vec<String>,
+}
+
+impl Scene {
+    /// An empty scene named `name`, ready for [`Scene::push`].
+    pub fn new(name: impl Into<String>) -> Scene {
+        Scene {
+            name: name.into(),
+            prim_start: vec![0],
+            tri_start: vec![0],
+            ..Scene::default()
+        }
+    }
+
+    /// Number of primitives N.
+    pub fn len(&self) -> usize {
+        self.prim_start.len().saturating_sub(1)
+    }
+
+    /// Whether the scene has no primitives.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Appends a primitive made of existing vertex indices and the triangles that draw it.
+    pub fn push(&mut self, kind: PrimitiveKind, verts: &[u32], tris: &[[u32; 3]]) {
+        self.kind = Some(kind);
+        self.prim_points.extend_from_slice(verts);
+        self.prim_start.push(self.prim_points.len() as u32);
+        self.tris.extend_from_slice(tris);
+        self.tri_start.push(self.tris.len() as u32);
+    }
+
+    /// Vertex indices of primitive `i`.
+    pub fn prim(&self, i: usize) -> &[u32] {
+        &self.prim_points[self.prim_start[i] as usize..self.prim_start[i + 1] as usize]
+    }
+
+    /// Vertex positions of primitive `i`.
+    pub fn prim_vertices(&self, i: usize) -> impl Iterator<Item = &P3> + '_ {
+        self.prim(i).iter().map(|&v| &self.points[v as usize])
+    }
+
+    /// Triangles drawing primitive `i`.
+    pub fn prim_tris(&self, i: usize) -> &[[u32; 3]] {
+        &self.tris[self.tri_start[i] as usize..self.tri_start[i + 1] as usize]
+    }
+
+    /// AABB of primitive `i`.
+    pub fn prim_aabb(&self, i: usize) -> Aabb {
+        Aabb::from_points(self.prim_vertices(i))
+    }
+
+    /// AABB of the whole scene.
+    pub fn aabb(&self) -> Aabb {
+        (0..self.len()).fold(Aabb::EMPTY, |b, i| b.merge(&self.prim_aabb(i)))
+    }
+
+    /// Total number of primitive vertices (with repeats across primitives).
+    pub fn vertex_refs(&self) -> usize {
+        self.prim_points.len()
+    }
+
+    /// Writes the scene as Wavefront OBJ: one face per polygon, one `o` block per polyhedron
+    /// (its hull triangles as faces). Loading the output gives the same primitives.
+    pub fn write_obj(&self, mut out: impl std::io::Write) -> std::io::Result<()> {
+        writeln!(out, "# wraptree scene '{}', {} primitives", self.name, self.len())?;
+        for p in &self.points {
+            writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
+        }
+        let poly = self.kind == Some(PrimitiveKind::Polyhedron);
+        for i in 0..self.len() {
+            if poly {
+                let label = self.labels.get(i).map(String::as_str).unwrap_or("");
+                if label.is_empty() {
+                    writeln!(out, "o part{i}")?;
+                } else {
+                    writeln!(out, "o {label}")?;
+                }
+                for t in self.prim_tris(i) {
+                    writeln!(out, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
+                }
+            } else {
+                write!(out, "f")?;
+                for v in self.prim(i) {
+                    write!(out, " {}", v + 1)?;
+                }
+                writeln!(out)?;
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,88 @@
+//! Bounding-sphere Wrapper Trees.
+
+use crate::geom::P3;
+use crate::grouping::SubsetTree;
+use crate::scene::Scene;
+
+/// A sphere; radius 0 is allowed (a point-like leaf).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Centre.
+    pub center: P3,
+    /// Radius (≥ 0).
+    pub radius: f64,
+}
+
+impl Sphere {
+    /// The smallest sphere holding both spheres.
+    pub fn merge(&self, o: &Sphere) -> Sphere {
+        let d = o.center - self.center;
+        let dist = d.norm();
+        if dist + o.radius <= self.radius {
+            return *self;
+        }
+        if dist + self.radius <= o.radius {
+            return *o;
+        }
+        let radius = (dist + self.radius + o.radius) / 2.0;
+        let center = self.center + d * ((radius - self.radius) / dist);
+        Sphere { center, radius }
+    }
+
+    /// Whether `p` lies inside, with `tol` of slack.
+    pub fn contains(&self, p: &P3, tol: f64) -> bool {
+        (p - self.center).norm() <= self.radius + tol
+    }
+}
+
+/// How a sphere Wrapper Tree is computed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SphereMethod {
+    /// Merge the children's spheres (O(N), loosest).
+    Merged,
+    /// Centre at the node's AABB centre, radius to the farthest leaf vertex (the paper's choice).
+    #[default]
+    AabbCenter,
+}
+
+/// One sphere per Subset Tree node (index = node id), each holding every vertex below it.
+pub fn sphere_tree(tree: &SubsetTree, scene: &Scene, method: SphereMethod) -> Vec<Sphere> {
+    let n = tree.leaves();
+    let mut out: Vec<Sphere> = (0..tree.len())
+        .map(|x| Sphere {
+            center: tree.aabb[x].center(),
+            radius: 0.0,
+        })
+        .collect();
+    for leaf in 0..n {
+        let c = out[leaf].center;
+        out[leaf].radius = scene
+            .prim_vertices(leaf)
+            .map(|p| (p - c).norm())
+            .fold(0.0, f64::max);
+    }
+    match method {
+        SphereMethod::Merged => {
+            for (i, [a, b]) in tree.children.iter().enumerate() {
+                out[n + i] = out[*a as usize].merge(&out[*b as usize]);
+            }
+        }
+        SphereMethod::AabbCenter => {
+            for leaf in 0..n {
+                let mut node = tree.parent[leaf];
+                while node != crate::grouping::NONE {
+                    let c = out[node as usize].center;
+                    let r = scene
+                        .prim_vertices(leaf)
+                        .map(|p| (p - c).norm())
+                        .fold(0.0, f64::max);
+                    let s = &mut out[node as usize];
+                    s.radius = s.radius.max(r);
+                    node = tree.parent[node as usize];
+                }
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,63 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use wraptree::geom::P3;
+use wraptree::grouping::{EventLog, Grouping, Params, SubsetTree, group};
+use wraptree::scene::{PrimitiveKind, Scene};
+
+/// A scene of right triangles with legs `size` whose right-angle corners are `corners`.
+pub fn triangles(corners: &[[f64; 3]], size: f64) -> Scene {
+    let mut s = Scene::new("triangles");
+    for c in corners {
+        let base = s.points.len() as u32;
+        s.points.push(P3::new(c[0], c[1], c[2]));
+        s.points.push(P3::new(c[0] + size, c[1], c[2]));
+        s.points.push(P3::new(c[0], c[1] + size, c[2]));
+        s.push(PrimitiveKind::Polygon, &[base, base + 1, base + 2], &[[base, base + 1, base + 2]]);
+    }
+    s
+}
+
+/// Groups `scene` and returns the result with the full event log.
+pub fn run(scene: &Scene, params: &Params) -> (Grouping, EventLog) {
+    let mut log = EventLog::default();
+    let g = group(scene, params, &mut log);
+    (g, log)
+}
+
+/// Checks the Subset Tree invariants; panics with a message on the first violation.
+pub fn check_tree(scene: &Scene, g: &Grouping, log: &EventLog) {
+    let n = scene.len();
+    let t: &SubsetTree = &g.tree;
+    assert_eq!(log.merges.len(), n - 1, "N - 1 merges");
+    assert_eq!(t.len(), 2 * n - 1);
+    let mut seen = vec![0u32; 2 * n - 1];
+    for (i, m) in log.merges.iter().enumerate() {
+        assert_eq!(m.step as usize, i);
+        assert_eq!(m.new as usize, n + i);
+        assert!(m.a < m.b && m.b < m.new, "children precede parent");
+        seen[m.a as usize] += 1;
+        seen[m.b as usize] += 1;
+        assert_eq!(t.children_of(m.new), Some([m.a, m.b]));
+    }
+    for (x, c) in seen.iter().enumerate() {
+        let want = if x == 2 * n - 2 { 0 } else { 1 };
+        assert_eq!(*c, want, "node {x} is a child {c} times");
+    }
+    let mut leaves = t.leaves_under(t.root());
+    leaves.sort();
+    assert_eq!(leaves, (0..n as u32).collect::<Vec<_>>(), "each leaf once under the root");
+    for leaf in 0..n {
+        for p in scene.prim_vertices(leaf) {
+            assert!(t.aabb[leaf].contains_point(p, 0.0));
+        }
+    }
+    for x in n as u32..t.len() as u32 {
+        let [a, b] = t.children_of(x).unwrap();
+        for c in [a, b] {
+            assert!(t.aabb[x as usize].contains_aabb(&t.aabb[c as usize], 0.0), "parent {x} box holds child {c}");
+            assert!(t.diameter[x as usize] + 1e-12 >= t.diameter[c as usize], "diameter grows");
+            assert_eq!(t.depth[c as usize], t.depth[x as usize] + 1);
+        }
+    }
+}

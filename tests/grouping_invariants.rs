@@ -1,0 +1,161 @@
+//! Subset Tree invariants on property-generated scenes, bundled scenes and the paper-like
+//! generated scenes, and determinism of the event stream.
+
+mod common;
+
+use common::{check_tree, run};
+use proptest::prelude::*;
+use wraptree::geom::P3;
+use wraptree::grouping::{PSet, Params, Weights};
+use wraptree::scene::{LoadOptions, PrimitiveKind, Scene, generate};
+use wraptree::wrap::{SphereMethod, sphere_tree};
+
+/// Random triangles: corners in a box of side `spread`, edge vectors up to `size` long.
+fn scene_from(tris: &[([f64; 3], [f64; 3], [f64; 3])]) -> Scene {
+    let mut s = Scene::new("prop");
+    for (c, u, v) in tris {
+        let b = s.points.len() as u32;
+        let c = P3::new(c[0], c[1], c[2]);
+        s.points.push(c);
+        s.points.push(c + nalgebra::Vector3::from(*u));
+        s.points.push(c + nalgebra::Vector3::from(*v));
+        s.push(PrimitiveKind::Polygon, &[b, b + 1, b + 2], &[[b, b + 1, b + 2]]);
+    }
+    s
+}
+
+fn arb_scene(max_n: usize) -> impl Strategy<Value = Scene> {
+    let coord = -50.0f64..50.0;
+    let edge = prop_oneof![Just(0.0f64), -3.0f64..3.0];
+    let tri = (
+        [coord.clone(), coord.clone(), coord],
+        [edge.clone(), edge.clone(), edge.clone()],
+        [edge.clone(), edge.clone(), edge],
+    );
+    prop::collection::vec(tri, 1..max_n).prop_map(|t| scene_from(&t))
+}
+
+fn arb_params() -> impl Strategy<Value = Params> {
+    (
+        prop_oneof![Just(0.0), Just(1.0), Just(2.0)],
+        prop_oneof![Just(0.0), Just(0.5), Just(1.0)],
+        prop_oneof![Just(0.0), Just(1.0)],
+        prop::option::of(0.01f64..20.0),
+        prop::option::of(0.01f64..20.0),
+        prop::option::of(any::<u64>()),
+    )
+        .prop_map(|(a, b, c, dlimit, glimit, seed)| Params {
+            weights: Weights { a, b, c },
+            dlimit,
+            glimit,
+            pset: PSet::Aabb,
+            seed,
+        })
+}
+
+fn check_spheres(scene: &Scene, g: &wraptree::grouping::Grouping) {
+    let diag = scene.aabb().diameter().max(1e-300);
+    for method in [SphereMethod::Merged, SphereMethod::AabbCenter] {
+        let spheres = sphere_tree(&g.tree, scene, method);
+        for x in 0..g.tree.len() as u32 {
+            for leaf in g.tree.leaves_under(x) {
+                for p in scene.prim_vertices(leaf as usize) {
+                    assert!(spheres[x as usize].contains(p, 1e-9 * diag), "{method:?} sphere {x} misses a vertex");
+                }
+            }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, .. ProptestConfig::default() })]
+
+    #[test]
+    fn aabb_pset_invariants(scene in arb_scene(80), params in arb_params()) {
+        let (g, log) = run(&scene, &params);
+        check_tree(&scene, &g, &log);
+        check_spheres(&scene, &g);
+        let (_, again) = run(&scene, &params);
+        prop_assert_eq!(log, again);
+    }
+
+    #[test]
+    fn hull_pset_invariants(scene in arb_scene(30), params in arb_params()) {
+        let params = Params { pset: PSet::Hull, ..params };
+        let (g, log) = run(&scene, &params);
+        check_tree(&scene, &g, &log);
+        let (_, again) = run(&scene, &params);
+        prop_assert_eq!(log, again);
+    }
+}
+
+/// With the hull p-set a body's diameter is its vertices' largest distance, never more than
+/// the AABB diagonal.
+#[test]
+fn hull_diameters_are_at_most_box_diagonals() {
+    let s = generate::robot_base();
+    let (g, log) = run(&s, &Params { pset: PSet::Hull, ..Params::default() });
+    check_tree(&s, &g, &log);
+    for x in 0..g.tree.len() {
+        assert!(g.tree.diameter[x] <= g.tree.aabb[x].diameter() * (1.0 + 1e-12));
+    }
+}
+
+fn bundled() -> Vec<(String, Scene)> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut out = Vec::new();
+    let mut paths: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
+    paths.sort();
+    for p in paths {
+        if p.extension().and_then(|e| e.to_str()) != Some("obj") {
+            continue;
+        }
+        let name = p.file_name().unwrap().to_string_lossy().to_string();
+        let polyhedra = name.starts_with("random-urdf");
+        let opts = LoadOptions { polyhedra, strict: false };
+        let loaded = wraptree::scene::load_path(&p, &opts).unwrap_or_else(|e| panic!("{e}"));
+        out.push((name, loaded.scene));
+    }
+    assert!(out.len() >= 5, "bundled scenes present");
+    out
+}
+
+#[test]
+fn bundled_scenes_group_validly_and_deterministically() {
+    for (name, s) in bundled() {
+        for pset in [PSet::Aabb, PSet::Hull] {
+            if pset == PSet::Hull && s.len() > 4000 {
+                continue;
+            }
+            let params = Params { pset, ..Params::default() };
+            let (g, log) = run(&s, &params);
+            check_tree(&s, &g, &log);
+            let (_, again) = run(&s, &params);
+            assert_eq!(log, again, "{name} {pset:?} is deterministic");
+        }
+    }
+}
+
+/// The paper observed trees no deeper than 2·log2 N on its scenes.
+#[test]
+fn paper_like_scenes_are_shallow() {
+    let base = generate::robot_base();
+    let lamp = generate::lamp();
+    let scenes = [
+        base.clone(),
+        lamp.clone(),
+        generate::replicate(&lamp, 5, 1),
+        generate::replicate(&base, 44, 1),
+    ];
+    for s in &scenes {
+        let (g, log) = run(s, &Params::default());
+        check_tree(s, &g, &log);
+        let bound = 2.0 * (s.len() as f64).log2();
+        assert!(
+            (g.tree.depth_max() as f64) <= bound,
+            "{}: depth {} > 2·log2 N = {bound:.1}",
+            s.name,
+            g.tree.depth_max()
+        );
+    }
+}
