@@ -41,7 +41,10 @@ fn parry_binned(scene: &Scene) {
             )
         })
         .collect();
-    let bvh = parry3d::partitioning::Bvh::from_leaves(parry3d::partitioning::BvhBuildStrategy::Binned, &leaves);
+    let bvh = parry3d::partitioning::Bvh::from_leaves(
+        parry3d::partitioning::BvhBuildStrategy::Binned,
+        &leaves,
+    );
     std::hint::black_box(bvh);
 }
 
@@ -57,12 +60,24 @@ impl BenchCmd {
         }
         println!(
             "{:<18} {:>9} {:>10} {:>9} {:>11} {:>10} {:>8} {:>6} {:>9}",
-            "scene", "N", "group ms", "ns/prim", "ns/NlogN", "parry ms", "ratio", "depth", "peak MB"
+            "scene",
+            "N",
+            "group ms",
+            "ns/prim",
+            "ns/NlogN",
+            "parry ms",
+            "ratio",
+            "depth",
+            "peak MB"
         );
         let params = Params::default();
         for scene in &cases {
             let n = scene.len();
-            let repeat = if n >= 1_000_000 { self.repeat.min(2) } else { self.repeat };
+            let repeat = if n >= 1_000_000 {
+                self.repeat.min(2)
+            } else {
+                self.repeat
+            };
             let mut depth = 0;
             let t = best_of(repeat, || {
                 let g = grouping::group(scene, &params, ());
@@ -85,7 +100,9 @@ impl BenchCmd {
                 super::peak_rss_bytes().unwrap_or(0) as f64 / 1e6
             );
         }
-        println!("ratio = grouping time / parry3d Bvh (Binned) build time on the same AABBs, same run.");
+        println!(
+            "ratio = grouping time / parry3d Bvh (Binned) build time on the same AABBs, same run."
+        );
         println!("peak MB = process peak RSS after the case (cases run in increasing size).");
         Ok(ExitCode::SUCCESS)
     }

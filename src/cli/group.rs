@@ -31,8 +31,10 @@ impl Progress {
         }
         let bar = indicatif::ProgressBar::new(merges);
         bar.set_style(
-            indicatif::ProgressStyle::with_template("{spinner} grouping {bar:40} {pos}/{len} merges {msg} ({eta})")
-                .expect("the template is valid"),
+            indicatif::ProgressStyle::with_template(
+                "{spinner} grouping {bar:40} {pos}/{len} merges {msg} ({eta})",
+            )
+            .expect("the template is valid"),
         );
         Some(Progress(bar))
     }
@@ -80,7 +82,12 @@ impl GroupCmd {
             println!("scene       {} ({} primitives)", scene.name, scene.len());
             println!(
                 "params      A={} B={} C={} DLimit0={:.6e} GLimit0={:.6e} pset={:?}",
-                g.params.weights.a, g.params.weights.b, g.params.weights.c, g.params.dlimit0, g.params.glimit0, g.params.pset
+                g.params.weights.a,
+                g.params.weights.b,
+                g.params.weights.c,
+                g.params.dlimit0,
+                g.params.glimit0,
+                g.params.pset
             );
             println!("rounds      {}", g.rounds);
             println!(

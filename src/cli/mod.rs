@@ -2,6 +2,8 @@
 
 mod bench;
 mod group;
+mod record;
+mod replay;
 mod scene_cmd;
 
 use anyhow::Result;
@@ -24,6 +26,10 @@ pub struct Cli {
 enum Command {
     /// Run the grouping phase on a scene and print the Subset Tree's summary.
     Group(group::GroupCmd),
+    /// Group a scene step by step and record it to PREFIX.rrd (Rerun) and PREFIX.mcap (Foxglove).
+    Record(record::RecordCmd),
+    /// Rebuild a run from its .mcap; --verify re-runs it; --a/--b/--c re-weights it.
+    Replay(replay::ReplayCmd),
     /// Generate a seeded synthetic scene as Wavefront OBJ.
     Scene(scene_cmd::SceneCmd),
     /// Time the grouping phase on the standard scenes (12,144-polygon robot bases, soups).
@@ -117,6 +123,8 @@ impl GroupArgs {
 pub fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
         Command::Group(c) => c.run(),
+        Command::Record(c) => c.run(),
+        Command::Replay(c) => c.run(),
         Command::Scene(c) => c.run(),
         Command::Bench(c) => c.run(),
     }

@@ -86,14 +86,21 @@ pub fn record(
         params,
         detail,
     };
-    let mut rrd = RrdRecorder::new(rrd_file.path(), &info).with_context(|| format!("{}", rrd_path.display()))?;
+    let mut rrd = RrdRecorder::new(rrd_file.path(), &info)
+        .with_context(|| format!("{}", rrd_path.display()))?;
     let writer = std::io::BufWriter::new(mcap_file.file()?);
-    let mut mcap = McapRecorder::new(writer, &info).with_context(|| format!("{}", mcap_path.display()))?;
+    let mut mcap =
+        McapRecorder::new(writer, &info).with_context(|| format!("{}", mcap_path.display()))?;
     mcap.set_reproducible(reproducible);
     let stop = stop_flag();
     let start = Instant::now();
     let progress = Progress::for_merges(scene.len() as u64);
-    let result = grouping::group_until(scene, params, Tee(&mut rrd, Tee(&mut mcap, progress)), &stop);
+    let result = grouping::group_until(
+        scene,
+        params,
+        Tee(&mut rrd, Tee(&mut mcap, progress)),
+        &stop,
+    );
     let seconds = start.elapsed().as_secs_f64();
     let (grouping, merges, rounds) = match result {
         Ok(g) => {
@@ -114,14 +121,19 @@ pub fn record(
         rounds,
         seconds,
     };
-    rrd.finish(&outcome).with_context(|| format!("{}", rrd_path.display()))?;
-    mcap.finish(&outcome).with_context(|| format!("{}", mcap_path.display()))?;
+    rrd.finish(&outcome)
+        .with_context(|| format!("{}", rrd_path.display()))?;
+    mcap.finish(&outcome)
+        .with_context(|| format!("{}", mcap_path.display()))?;
     let (rrd_dest, mcap_dest) = if grouping.is_some() {
         (rrd_file.commit()?, mcap_file.commit()?)
     } else {
         let r = with_ext(prefix, ".incomplete.rrd");
         let m = with_ext(prefix, ".incomplete.mcap");
-        (rrd_file.commit_to(Some(&r))?, mcap_file.commit_to(Some(&m))?)
+        (
+            rrd_file.commit_to(Some(&r))?,
+            mcap_file.commit_to(Some(&m))?,
+        )
     };
     Ok(Written {
         rrd: rrd_dest,
@@ -145,7 +157,11 @@ fn stop_flag() -> Arc<AtomicBool> {
 
 /// Prints what was written.
 pub fn report(w: &Written, scene: &Scene) {
-    let size = |p: &Path| std::fs::metadata(p).map(|m| m.len() as f64 / 1e6).unwrap_or(0.0);
+    let size = |p: &Path| {
+        std::fs::metadata(p)
+            .map(|m| m.len() as f64 / 1e6)
+            .unwrap_or(0.0)
+    };
     match &w.grouping {
         Some(g) => println!(
             "{}: {} primitives, {} rounds, depth {} (mean {:.2}); recorded in {:.3} s",
@@ -176,7 +192,15 @@ impl RecordCmd {
                 p
             }
         };
-        let w = record(&loaded.scene, &loaded.source, &params, self.detail, &prefix, self.force, self.reproducible)?;
+        let w = record(
+            &loaded.scene,
+            &loaded.source,
+            &params,
+            self.detail,
+            &prefix,
+            self.force,
+            self.reproducible,
+        )?;
         report(&w, &loaded.scene);
         Ok(if w.grouping.is_some() {
             ExitCode::SUCCESS

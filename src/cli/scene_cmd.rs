@@ -31,11 +31,16 @@ pub struct SceneCmd {
 impl SceneCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
-        let scene = wraptree::scene::generate::by_name(&self.kind, self.copies, self.n, self.seed).map_err(|e| anyhow!(e))?;
+        let scene = wraptree::scene::generate::by_name(&self.kind, self.copies, self.n, self.seed)
+            .map_err(|e| anyhow!(e))?;
         let mut bytes = Vec::new();
         scene.write_obj(&mut bytes)?;
         wraptree::record::output::write_atomic(&self.output, &bytes, self.force)?;
-        eprintln!("wrote {} ({} primitives)", self.output.display(), scene.len());
+        eprintln!(
+            "wrote {} ({} primitives)",
+            self.output.display(),
+            scene.len()
+        );
         Ok(ExitCode::SUCCESS)
     }
 }

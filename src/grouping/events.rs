@@ -111,6 +111,16 @@ impl<O: Observer + ?Sized> Observer for &mut O {
     }
 }
 
+/// An optional observer (e.g. a progress bar shown only on a terminal).
+impl<O: Observer> Observer for Option<O> {
+    #[inline]
+    fn on_event(&mut self, event: &Event<'_>) {
+        if let Some(o) = self {
+            o.on_event(event)
+        }
+    }
+}
+
 /// Forwards each event to two observers (e.g. a recorder and a progress bar).
 pub struct Tee<A, B>(pub A, pub B);
 
