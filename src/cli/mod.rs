@@ -68,19 +68,19 @@ impl SceneArgs {
 #[derive(Args, Debug, Clone)]
 pub struct GroupArgs {
     /// Cost exponent A in Cost = diameter^A × (B·Fill + C·Balance).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     pub a: f64,
     /// Fill weight B.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     pub b: f64,
     /// Balance weight C.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub c: f64,
     /// Initial DLimit [default: median primitive diameter].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub dlimit: Option<f64>,
     /// Initial GLimit [default: DLimit / 4].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub glimit: Option<f64>,
     /// P-set wrapper: aabb (boxes, L∞ gaps) or hull (convex hulls, L2 gaps).
     #[arg(long, value_enum, default_value_t = PSet::Aabb)]

@@ -144,7 +144,7 @@ pub fn record(
 }
 
 /// A flag set by the first Ctrl-C or SIGTERM (installed once per process).
-fn stop_flag() -> Arc<AtomicBool> {
+pub fn stop_flag() -> Arc<AtomicBool> {
     static FLAG: std::sync::OnceLock<Arc<AtomicBool>> = std::sync::OnceLock::new();
     FLAG.get_or_init(|| {
         let f = Arc::new(AtomicBool::new(false));
@@ -181,6 +181,8 @@ pub fn report(w: &Written, scene: &Scene) {
 impl RecordCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
+        // Installed before loading so an early Ctrl-C still ends in readable, incomplete files.
+        stop_flag();
         let loaded = self.scene.load()?;
         let params = self.group.params()?.resolve(&loaded.scene);
         let prefix = match self.output {
