@@ -7,7 +7,11 @@ use wraptree::grouping::{Params, Weights};
 
 fn params(dlimit: f64, glimit: f64) -> Params {
     Params {
-        weights: Weights { a: 1.0, b: 1.0, c: 0.0 },
+        weights: Weights {
+            a: 1.0,
+            b: 1.0,
+            c: 0.0,
+        },
         dlimit: Some(dlimit),
         glimit: Some(glimit),
         ..Params::default()
@@ -24,7 +28,15 @@ fn params(dlimit: f64, glimit: f64) -> Params {
 /// √39.44 ≈ 6.28 exceeds DLimit 4, so step 4(c) files it as dormant too.
 #[test]
 fn merge_order_follows_the_rules() {
-    let s = triangles(&[[0.0, 0.0, 0.0], [1.5, 0.0, 0.0], [4.0, 0.0, 0.0], [5.2, 0.0, 0.0]], 1.0);
+    let s = triangles(
+        &[
+            [0.0, 0.0, 0.0],
+            [1.5, 0.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [5.2, 0.0, 0.0],
+        ],
+        1.0,
+    );
     let (g, log) = run(&s, &params(2.0, 1.0));
     let pairs: Vec<(u32, u32, u32)> = log.merges.iter().map(|m| (m.a, m.b, m.new)).collect();
     assert_eq!(pairs, vec![(2, 3, 4), (0, 1, 5), (4, 5, 6)]);
@@ -49,7 +61,15 @@ fn merge_order_follows_the_rules() {
 /// Equal costs break by the pair's smaller id, then larger id.
 #[test]
 fn ties_break_by_id() {
-    let s = triangles(&[[0.0, 0.0, 0.0], [1.5, 0.0, 0.0], [3.0, 0.0, 0.0], [4.5, 0.0, 0.0]], 1.0);
+    let s = triangles(
+        &[
+            [0.0, 0.0, 0.0],
+            [1.5, 0.0, 0.0],
+            [3.0, 0.0, 0.0],
+            [4.5, 0.0, 0.0],
+        ],
+        1.0,
+    );
     let (_, log) = run(&s, &params(2.0, 1.0));
     let pairs: Vec<(u32, u32)> = log.merges.iter().map(|m| (m.a, m.b)).collect();
     assert_eq!(pairs, vec![(0, 1), (2, 3), (4, 5)]);
@@ -66,7 +86,10 @@ fn seeded_ties_are_reproducible() {
     let (_, a) = run(&s, &p);
     let (_, b) = run(&s, &p);
     assert_eq!(a, b);
-    assert_ne!(a.merges, by_id.merges, "seeded tags change which equal-cost pair goes first");
+    assert_ne!(
+        a.merges, by_id.merges,
+        "seeded tags change which equal-cost pair goes first"
+    );
     p.seed = Some(8);
     let (_, c) = run(&s, &p);
     assert_ne!(a.merges, c.merges);
@@ -112,5 +135,9 @@ fn coincident_and_point_like_primitives() {
     let s = triangles(&[[1.0, 1.0, 1.0]; 9], 0.0);
     let (g, log) = run(&s, &Params::default());
     common::check_tree(&s, &g, &log);
-    assert!(log.merges.iter().all(|m| m.cost.is_finite() && m.fill == 1.0 && m.balance == 1.0));
+    assert!(
+        log.merges
+            .iter()
+            .all(|m| m.cost.is_finite() && m.fill == 1.0 && m.balance == 1.0)
+    );
 }

@@ -19,7 +19,11 @@ fn scene_from(tris: &[([f64; 3], [f64; 3], [f64; 3])]) -> Scene {
         s.points.push(c);
         s.points.push(c + nalgebra::Vector3::from(*u));
         s.points.push(c + nalgebra::Vector3::from(*v));
-        s.push(PrimitiveKind::Polygon, &[b, b + 1, b + 2], &[[b, b + 1, b + 2]]);
+        s.push(
+            PrimitiveKind::Polygon,
+            &[b, b + 1, b + 2],
+            &[[b, b + 1, b + 2]],
+        );
     }
     s
 }
@@ -60,7 +64,10 @@ fn check_spheres(scene: &Scene, g: &wraptree::grouping::Grouping) {
         for x in 0..g.tree.len() as u32 {
             for leaf in g.tree.leaves_under(x) {
                 for p in scene.prim_vertices(leaf as usize) {
-                    assert!(spheres[x as usize].contains(p, 1e-9 * diag), "{method:?} sphere {x} misses a vertex");
+                    assert!(
+                        spheres[x as usize].contains(p, 1e-9 * diag),
+                        "{method:?} sphere {x} misses a vertex"
+                    );
                 }
             }
         }
@@ -94,7 +101,13 @@ proptest! {
 #[test]
 fn hull_diameters_are_at_most_box_diagonals() {
     let s = generate::robot_base();
-    let (g, log) = run(&s, &Params { pset: PSet::Hull, ..Params::default() });
+    let (g, log) = run(
+        &s,
+        &Params {
+            pset: PSet::Hull,
+            ..Params::default()
+        },
+    );
     check_tree(&s, &g, &log);
     for x in 0..g.tree.len() {
         assert!(g.tree.diameter[x] <= g.tree.aabb[x].diameter() * (1.0 + 1e-12));
@@ -104,7 +117,10 @@ fn hull_diameters_are_at_most_box_diagonals() {
 fn bundled() -> Vec<(String, Scene)> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
     let mut out = Vec::new();
-    let mut paths: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
+    let mut paths: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
     paths.sort();
     for p in paths {
         if p.extension().and_then(|e| e.to_str()) != Some("obj") {
@@ -112,7 +128,10 @@ fn bundled() -> Vec<(String, Scene)> {
         }
         let name = p.file_name().unwrap().to_string_lossy().to_string();
         let polyhedra = name.starts_with("random-urdf");
-        let opts = LoadOptions { polyhedra, strict: false };
+        let opts = LoadOptions {
+            polyhedra,
+            strict: false,
+        };
         let loaded = wraptree::scene::load_path(&p, &opts).unwrap_or_else(|e| panic!("{e}"));
         out.push((name, loaded.scene));
     }
@@ -127,7 +146,10 @@ fn bundled_scenes_group_validly_and_deterministically() {
             if pset == PSet::Hull && s.len() > 4000 {
                 continue;
             }
-            let params = Params { pset, ..Params::default() };
+            let params = Params {
+                pset,
+                ..Params::default()
+            };
             let (g, log) = run(&s, &params);
             check_tree(&s, &g, &log);
             let (_, again) = run(&s, &params);

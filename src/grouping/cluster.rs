@@ -43,7 +43,9 @@ pub(super) fn run<O: Observer>(
     assert!(!scene.is_empty(), "grouping needs at least one primitive");
     match params.pset {
         PSet::Aabb => {
-            let diameters = (0..scene.len()).map(|i| scene.prim_aabb(i).diameter()).collect();
+            let diameters = (0..scene.len())
+                .map(|i| scene.prim_aabb(i).diameter())
+                .collect();
             Clusterer::new(scene, params, AabbBodies, diameters, observer).run(stop)
         }
         PSet::Hull => {
@@ -77,7 +79,11 @@ pub(super) fn fill_balance(d: f64, dx: f64, dy: f64) -> (f64, f64) {
     let sum = dx + dy;
     let fill = if sum > 0.0 { d / sum } else { 1.0 };
     let (lo, hi) = if dx < dy { (dx, dy) } else { (dy, dx) };
-    let balance = if hi > 0.0 { hi / lo.max(hi * 1e-12) } else { 1.0 };
+    let balance = if hi > 0.0 {
+        hi / lo.max(hi * 1e-12)
+    } else {
+        1.0
+    };
     (fill, balance)
 }
 
@@ -116,7 +122,13 @@ struct Clusterer<'s, P, O> {
 }
 
 impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
-    fn new(scene: &'s Scene, params: &ResolvedParams, pset: P, diameter: Vec<f64>, observer: O) -> Self {
+    fn new(
+        scene: &'s Scene,
+        params: &ResolvedParams,
+        pset: P,
+        diameter: Vec<f64>,
+        observer: O,
+    ) -> Self {
         let n = scene.len();
         let total = 2 * n - 1;
         let mut aabb = Vec::with_capacity(total);
@@ -125,7 +137,13 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
         d.reserve(total - n);
         let bounds = aabb.iter().fold(Aabb::EMPTY, |b, x| b.merge(x));
         let ext = bounds.extents();
-        let morton_scale = [0, 1, 2].map(|k| if ext[k] > 0.0 { 2_097_151.0 / ext[k] } else { 0.0 });
+        let morton_scale = [0, 1, 2].map(|k| {
+            if ext[k] > 0.0 {
+                2_097_151.0 / ext[k]
+            } else {
+                0.0
+            }
+        });
         Clusterer {
             n,
             weights: params.weights,
@@ -218,7 +236,8 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
         let c = self.aabb[x as usize].center();
         let mut key = 0u64;
         for k in 0..3 {
-            let t = ((c[k] - self.bounds.min[k]) * self.morton_scale[k]).clamp(0.0, 2_097_151.0) as u64;
+            let t =
+                ((c[k] - self.bounds.min[k]) * self.morton_scale[k]).clamp(0.0, 2_097_151.0) as u64;
             key |= spread_bits(t) << k;
         }
         key
@@ -247,7 +266,12 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
         // Step 2: one parent-less body left is the root.
         while parentless.len() > 1 {
             active.clear();
-            active.extend(parentless.iter().copied().filter(|&x| self.diameter[x as usize] <= dlimit));
+            active.extend(
+                parentless
+                    .iter()
+                    .copied()
+                    .filter(|&x| self.diameter[x as usize] <= dlimit),
+            );
             let dormant = (parentless.len() - active.len()) as u32;
             // Step 3: voxel hash of active centres, CSize = DLimit + GLimit; queue best pairs.
             // Bodies are inserted and scanned in Morton order of their centres so consecutive
@@ -303,7 +327,10 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
             }
             let made = (self.merges.len() - merges_before) as u32;
             parentless.retain(|&x| self.parent[x as usize] == NONE);
-            parentless.extend(((n + merges_before) as u32..(n + self.merges.len()) as u32).filter(|&x| self.parent[x as usize] == NONE));
+            parentless.extend(
+                ((n + merges_before) as u32..(n + self.merges.len()) as u32)
+                    .filter(|&x| self.parent[x as usize] == NONE),
+            );
             round += 1;
             if parentless.len() > 1 {
                 // Step 5: double the limits and go to step 2.

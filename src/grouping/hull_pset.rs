@@ -121,11 +121,22 @@ impl HullBodies {
         let mut s = self.scratch.borrow_mut();
         let (a, b) = &mut *s;
         a.clear();
-        a.extend(self.points[x as usize].iter().map(|p| to_glam_local(p, origin)));
+        a.extend(
+            self.points[x as usize]
+                .iter()
+                .map(|p| to_glam_local(p, origin)),
+        );
         b.clear();
-        b.extend(self.points[y as usize].iter().map(|p| to_glam_local(p, origin)));
-        parry3d::query::details::distance_support_map_support_map(&Pose::IDENTITY, &Cloud(a), &Cloud(b))
-            as f64
+        b.extend(
+            self.points[y as usize]
+                .iter()
+                .map(|p| to_glam_local(p, origin)),
+        );
+        parry3d::query::details::distance_support_map_support_map(
+            &Pose::IDENTITY,
+            &Cloud(a),
+            &Cloud(b),
+        ) as f64
     }
 }
 

@@ -41,7 +41,17 @@ use crate::scene::Scene;
 use std::sync::atomic::AtomicBool;
 
 /// The p-set wrapper bodies carry while grouping.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum PSet {
     /// Axis-aligned boxes, diagonal as diameter, L∞ gaps (the paper's fast variant).
@@ -144,7 +154,9 @@ impl Params {
         let dlimit0 = match self.dlimit {
             Some(d) => d,
             None => {
-                let mut d: Vec<f64> = (0..scene.len()).map(|i| scene.prim_aabb(i).diameter()).collect();
+                let mut d: Vec<f64> = (0..scene.len())
+                    .map(|i| scene.prim_aabb(i).diameter())
+                    .collect();
                 let median = if d.is_empty() {
                     0.0
                 } else {
@@ -155,7 +167,11 @@ impl Params {
                     median
                 } else {
                     let diag = scene.aabb().diameter();
-                    if diag.is_finite() && diag > 0.0 { diag * 1e-6 } else { 1.0 }
+                    if diag.is_finite() && diag > 0.0 {
+                        diag * 1e-6
+                    } else {
+                        1.0
+                    }
                 }
             }
         };

@@ -35,7 +35,11 @@ impl SubsetTree {
             return Err("a Subset Tree needs at least one leaf".into());
         }
         if merges.len() != n - 1 {
-            return Err(format!("{} merges for {n} leaves (want {})", merges.len(), n - 1));
+            return Err(format!(
+                "{} merges for {n} leaves (want {})",
+                merges.len(),
+                n - 1
+            ));
         }
         let total = 2 * n - 1;
         let mut parent = vec![NONE; total];
@@ -46,7 +50,9 @@ impl SubsetTree {
             let new = (n + i) as u32;
             for c in [a, b] {
                 if c >= new || parent[c as usize] != NONE || a == b {
-                    return Err(format!("merge {i} ({a}, {b}) reuses or forward-references a body"));
+                    return Err(format!(
+                        "merge {i} ({a}, {b}) reuses or forward-references a body"
+                    ));
                 }
                 parent[c as usize] = new;
             }
@@ -100,7 +106,11 @@ impl SubsetTree {
 
     /// Largest leaf depth (edges from the root); the tree has `depth_max() + 1` levels.
     pub fn depth_max(&self) -> u32 {
-        self.depth[..self.leaves()].iter().copied().max().unwrap_or(0)
+        self.depth[..self.leaves()]
+            .iter()
+            .copied()
+            .max()
+            .unwrap_or(0)
     }
 
     /// Mean leaf depth.
@@ -129,7 +139,9 @@ impl SubsetTree {
     /// This is the set the paper's figures draw for one level.
     pub fn level(&self, d: u32) -> Vec<u32> {
         (0..self.len() as u32)
-            .filter(|&x| self.depth[x as usize] == d || (self.is_leaf(x) && self.depth[x as usize] < d))
+            .filter(|&x| {
+                self.depth[x as usize] == d || (self.is_leaf(x) && self.depth[x as usize] < d)
+            })
             .collect()
     }
 

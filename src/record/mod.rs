@@ -11,7 +11,17 @@ use crate::scene::{Scene, SceneSource};
 use crate::wrap::Sphere;
 
 /// What a recording holds (`--detail`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    clap::ValueEnum,
+    serde::Serialize,
+    serde::Deserialize,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Detail {
     /// Scene, merge events and series, round summaries and every tree level; no per-merge or

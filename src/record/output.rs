@@ -19,21 +19,34 @@ impl Pending {
     /// exists and `force` is false.
     pub fn create(dest: &Path, force: bool) -> Result<Pending> {
         if dest.exists() && !force {
-            bail!("{}: already exists (use --force to replace it)", dest.display());
+            bail!(
+                "{}: already exists (use --force to replace it)",
+                dest.display()
+            );
         }
         let dir = match dest.parent() {
             Some(d) if !d.as_os_str().is_empty() => d,
             _ => Path::new("."),
         };
         if !dir.is_dir() {
-            bail!("{}: output directory {} does not exist", dest.display(), dir.display());
+            bail!(
+                "{}: output directory {} does not exist",
+                dest.display(),
+                dir.display()
+            );
         }
         let name = dest.file_name().and_then(|n| n.to_str()).unwrap_or("out");
         let tmp = tempfile::Builder::new()
             .prefix(&format!(".{name}."))
             .suffix(".tmp")
             .tempfile_in(dir)
-            .with_context(|| format!("{}: cannot create a file in {}", dest.display(), dir.display()))?;
+            .with_context(|| {
+                format!(
+                    "{}: cannot create a file in {}",
+                    dest.display(),
+                    dir.display()
+                )
+            })?;
         Ok(Pending {
             tmp,
             dest: dest.to_path_buf(),
@@ -70,9 +83,9 @@ impl Pending {
             .as_file()
             .sync_all()
             .with_context(|| format!("{}: cannot sync", dest.display()))?;
-        self.tmp
-            .persist(&dest)
-            .map_err(|e| anyhow::anyhow!("{}: cannot move into place: {}", dest.display(), e.error))?;
+        self.tmp.persist(&dest).map_err(|e| {
+            anyhow::anyhow!("{}: cannot move into place: {}", dest.display(), e.error)
+        })?;
         Ok(dest)
     }
 }

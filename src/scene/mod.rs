@@ -109,7 +109,12 @@ impl Scene {
     /// Writes the scene as Wavefront OBJ: one face per polygon, one `o` block per polyhedron
     /// (its hull triangles as faces). Loading the output gives the same primitives.
     pub fn write_obj(&self, mut out: impl std::io::Write) -> std::io::Result<()> {
-        writeln!(out, "# wraptree scene '{}', {} primitives", self.name, self.len())?;
+        writeln!(
+            out,
+            "# wraptree scene '{}', {} primitives",
+            self.name,
+            self.len()
+        )?;
         for p in &self.points {
             writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
         }

@@ -13,7 +13,11 @@ pub fn triangles(corners: &[[f64; 3]], size: f64) -> Scene {
         s.points.push(P3::new(c[0], c[1], c[2]));
         s.points.push(P3::new(c[0] + size, c[1], c[2]));
         s.points.push(P3::new(c[0], c[1] + size, c[2]));
-        s.push(PrimitiveKind::Polygon, &[base, base + 1, base + 2], &[[base, base + 1, base + 2]]);
+        s.push(
+            PrimitiveKind::Polygon,
+            &[base, base + 1, base + 2],
+            &[[base, base + 1, base + 2]],
+        );
     }
     s
 }
@@ -46,7 +50,11 @@ pub fn check_tree(scene: &Scene, g: &Grouping, log: &EventLog) {
     }
     let mut leaves = t.leaves_under(t.root());
     leaves.sort();
-    assert_eq!(leaves, (0..n as u32).collect::<Vec<_>>(), "each leaf once under the root");
+    assert_eq!(
+        leaves,
+        (0..n as u32).collect::<Vec<_>>(),
+        "each leaf once under the root"
+    );
     for leaf in 0..n {
         for p in scene.prim_vertices(leaf) {
             assert!(t.aabb[leaf].contains_point(p, 0.0));
@@ -55,8 +63,14 @@ pub fn check_tree(scene: &Scene, g: &Grouping, log: &EventLog) {
     for x in n as u32..t.len() as u32 {
         let [a, b] = t.children_of(x).unwrap();
         for c in [a, b] {
-            assert!(t.aabb[x as usize].contains_aabb(&t.aabb[c as usize], 0.0), "parent {x} box holds child {c}");
-            assert!(t.diameter[x as usize] + 1e-12 >= t.diameter[c as usize], "diameter grows");
+            assert!(
+                t.aabb[x as usize].contains_aabb(&t.aabb[c as usize], 0.0),
+                "parent {x} box holds child {c}"
+            );
+            assert!(
+                t.diameter[x as usize] + 1e-12 >= t.diameter[c as usize],
+                "diameter grows"
+            );
             assert_eq!(t.depth[c as usize], t.depth[x as usize] + 1);
         }
     }
