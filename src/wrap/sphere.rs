@@ -65,9 +65,9 @@ pub fn sphere_tree(tree: &SubsetTree, scene: &Scene, method: SphereMethod) -> Ve
             radius: 0.0,
         })
         .collect();
-    for leaf in 0..n {
-        let c = out[leaf].center;
-        out[leaf].radius = scene
+    for (leaf, s) in out.iter_mut().enumerate().take(n) {
+        let c = s.center;
+        s.radius = scene
             .prim_vertices(leaf)
             .map(|p| (p - c).norm())
             .fold(0.0, f64::max);

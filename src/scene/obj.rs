@@ -1,0 +1,484 @@
+//! Wavefront OBJ loading (via `tobj`) into a [`Scene`] of convex primitives, with validation.
+//!
+//! Each file goes through two passes:
+//! 1. [`scan`] reads the text once and reports the first problem with its line: not UTF-8,
+//!    malformed `v`/`f` statements, non-finite or out-of-range coordinates, face indices out
+//!    of range (including relative ones reaching before the first vertex). It parses the
+//!    coordinates in `f64` and produces a cleaned copy for `tobj` in which each `v` line holds
+//!    its vertex index instead (`tobj` parses `f32` unless its `use_f64` feature is on, and
+//!    `f32` would lose detail; small integers it holds exactly), faces with fewer than 3
+//!    vertices and every statement we ignore (`vt`, `vn`, `l`, `p`, `mtllib`, `usemtl`, `s`, …)
+//!    are blanked, and `f`, `o` and `g` lines are kept verbatim;
+//! 2. `tobj::load_obj_buf` parses the cleaned copy into groups and faces (materials refused);
+//!    the vertex indices in its positions lead back to the `f64` coordinates.
+//!
+//! Then, in polygon mode (default) every face becomes one `PrimitiveKind::Polygon` by the
+//! rules of [`polygon`]; with [`LoadOptions::polyhedra`] every OBJ object/group becomes one
+//! `PrimitiveKind::Polyhedron` by the rules of [`polyhedron`]. Vertices with bit-identical
+//! positions are merged; everything is deterministic, so loading the same bytes twice gives
+//! the same scene.
+
+use std::fmt::{self, Write as _};
+use std::path::Path;
+
+use sha2::{Digest, Sha256};
+
+use self::polygon::PolygonStats;
+use self::polyhedron::PolyhedronStats;
+use super::Scene;
+use crate::geom::P3;
+
+pub mod polygon;
+pub mod polyhedron;
+
+/// How to turn an OBJ file into primitives.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
+pub struct LoadOptions {
+    /// One convex polyhedron per OBJ object/group instead of one polygon per face.
+    pub polyhedra: bool,
+    /// With `polyhedra`: a group whose vertices are not in convex position is an error instead
+    /// of being replaced by its convex hull with a warning.
+    pub strict: bool,
+}
+
+/// The exact input of a loaded scene, kept so recordings can re-create it.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct SceneSource {
+    /// File name (no directory), e.g. `mug.obj`.
+    pub file_name: String,
+    /// The file's bytes, verbatim.
+    pub bytes: Vec<u8>,
+    /// The options it was loaded with.
+    pub options: LoadOptions,
+    /// Lowercase hex SHA-256 of `bytes`.
+    pub sha256: String,
+}
+
+/// A loaded scene, its source and the warnings raised while loading it.
+#[derive(Clone, Debug)]
+pub struct Loaded {
+    /// The primitives.
+    pub scene: Scene,
+    /// What it was loaded from.
+    pub source: SceneSource,
+    /// One line per kind of repair (dropped, split or hulled primitives), naming the file.
+    pub warnings: Vec<String>,
+}
+
+/// What went wrong while loading.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LoadErrorKind {
+    /// The file could not be read.
+    Read,
+    /// The bytes are not a well-formed OBJ file.
+    Malformed,
+    /// A vertex has a NaN, infinite or absurdly large coordinate.
+    NonFinite,
+    /// A face refers to a vertex that does not exist.
+    BadIndex,
+    /// Nothing usable: no faces, or only degenerate ones.
+    NoFaces,
+    /// `--strict --polyhedra` and a group is not in convex position.
+    NotConvex,
+}
+
+/// A loading failure; its `Display` is one line `FILE: PROBLEM`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LoadError {
+    /// The file as the user named it.
+    pub file: String,
+    /// The category of the problem.
+    pub kind: LoadErrorKind,
+    /// The problem, one line, with the OBJ line number where known.
+    pub problem: String,
+}
+
+impl fmt::Display for LoadError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.file, self.problem)
+    }
+}
+
+impl std::error::Error for LoadError {}
+
+/// Largest accepted coordinate magnitude: squared distances must stay finite in `f64`.
+pub const MAX_COORDINATE: f64 = 1e100;
+
+/// Reads and loads the OBJ file at `path`; errors name the path as given.
+pub fn load_path(path: &Path, opts: &LoadOptions) -> Result<Loaded, LoadError> {
+    let shown = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| {
+        let msg = e.to_string();
+        let msg = msg.split(" (os error").next().unwrap_or(&msg).to_string();
+        LoadError {
+            file: shown.clone(),
+            kind: LoadErrorKind::Read,
+            problem: format!("cannot read: {msg}"),
+        }
+    })?;
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| shown.clone());
+    load_bytes(&name, bytes, opts).map_err(|e| LoadError { file: shown, ..e })
+}
+
+/// Loads OBJ `bytes` named `file_name` (the scene is named after its stem).
+///
+/// Deterministic: the same bytes and options always give the same scene and warnings.
+pub fn load_bytes(
+    file_name: &str,
+    bytes: Vec<u8>,
+    opts: &LoadOptions,
+) -> Result<Loaded, LoadError> {
+    let err = |kind, problem: String| LoadError {
+        file: file_name.to_string(),
+        kind,
+        problem,
+    };
+    let text = std::str::from_utf8(&bytes).map_err(|e| {
+        let line = bytes[..e.valid_up_to()]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count()
+            + 1;
+        err(
+            LoadErrorKind::Malformed,
+            format!("not a valid OBJ file (line {line}: not UTF-8 text)"),
+        )
+    })?;
+    let scanned = scan(text).map_err(|(kind, problem)| err(kind, problem))?;
+    if scanned.faces == 0 {
+        let why = match scanned.short_faces {
+            0 => String::new(),
+            n => format!(" ({n} faces with fewer than 3 vertices were dropped)"),
+        };
+        return Err(err(LoadErrorKind::NoFaces, format!("no faces{why}")));
+    }
+    let tobj_opts = tobj::LoadOptions {
+        single_index: true,
+        triangulate: false,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let (models, _materials) = tobj::load_obj_buf(&mut scanned.text.as_bytes(), &tobj_opts, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| {
+        err(
+            LoadErrorKind::Malformed,
+            format!("not a valid OBJ file ({e})"),
+        )
+    })?;
+
+    let stem = Path::new(file_name)
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut scene = Scene::new(stem);
+    let groups = collect_groups(&models, &scanned.coords, &mut scene.points)
+        .map_err(|p| err(LoadErrorKind::Malformed, p))?;
+    let mut warnings = Vec::new();
+    if opts.polyhedra {
+        let mut stats = PolyhedronStats::default();
+        for g in &groups {
+            let faces: Vec<&[u32]> = g.faces().collect();
+            polyhedron::add(&mut scene, &g.name, &faces, opts.strict, &mut stats)
+                .map_err(|p| err(LoadErrorKind::NotConvex, p))?;
+        }
+        warnings.extend(
+            stats
+                .warnings()
+                .into_iter()
+                .map(|w| format!("{file_name}: {w}")),
+        );
+    } else {
+        let diag = crate::geom::Aabb::from_points(&scene.points).diameter();
+        let mut stats = PolygonStats {
+            degenerate: scanned.short_faces,
+            ..PolygonStats::default()
+        };
+        let mut scratch = polygon::Scratch::default();
+        for face in groups.iter().flat_map(Group::faces) {
+            polygon::add(&mut scene, face, diag, &mut stats, &mut scratch);
+        }
+        warnings.extend(
+            stats
+                .warnings()
+                .into_iter()
+                .map(|w| format!("{file_name}: {w}")),
+        );
+    }
+    if scene.is_empty() {
+        return Err(err(
+            LoadErrorKind::NoFaces,
+            format!(
+                "no faces (all {} faces are degenerate)",
+                scanned.faces + scanned.short_faces
+            ),
+        ));
+    }
+    debug_assert!(scene.points.iter().all(|p| p.iter().all(|c| c.is_finite())));
+    let sha256 = Sha256::digest(&bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    let source = SceneSource {
+        file_name: file_name.to_string(),
+        bytes,
+        options: *opts,
+        sha256,
+    };
+    Ok(Loaded {
+        scene,
+        source,
+        warnings,
+    })
+}
+
+/// One OBJ object/group: its name and its faces as indices into the scene's points.
+struct Group {
+    name: String,
+    /// All faces' vertex indices, concatenated.
+    verts: Vec<u32>,
+    /// Offsets into `verts`, one more than the faces.
+    starts: Vec<usize>,
+}
+
+impl Group {
+    /// The faces, in file order.
+    fn faces(&self) -> impl Iterator<Item = &[u32]> {
+        self.starts.windows(2).map(|w| &self.verts[w[0]..w[1]])
+    }
+}
+
+/// Splits a vertex index into two parts that `f32` holds exactly (`tobj` parses `f32`).
+const INDEX_SPLIT: u64 = 1 << 20;
+
+/// Moves `tobj`'s models into `points` (merging bit-identical positions) and returns the groups.
+///
+/// `coords` are the file's vertices as parsed by [`scan`]; `tobj`'s positions only carry the
+/// vertex indices (see [`scan`]).
+fn collect_groups(
+    models: &[tobj::Model],
+    coords: &[[f64; 3]],
+    points: &mut Vec<P3>,
+) -> Result<Vec<Group>, String> {
+    let malformed = |what: &str| format!("not a valid OBJ file ({what})");
+    let mut ids = std::collections::HashMap::<[u64; 3], u32>::new();
+    let mut of_file = vec![u32::MAX; coords.len()];
+    let mut groups = Vec::with_capacity(models.len());
+    for model in models {
+        let mesh = &model.mesh;
+        let mut local = Vec::with_capacity(mesh.positions.len() / 3);
+        for c in mesh.positions.chunks_exact(3) {
+            let file = (f64::from(c[1]) as u64 * INDEX_SPLIT + f64::from(c[0]) as u64) as usize;
+            let slot = of_file
+                .get_mut(file)
+                .ok_or_else(|| malformed("vertex index"))?;
+            if *slot == u32::MAX {
+                // `+ 0.0` turns -0.0 into 0.0 so both spellings merge.
+                let p = coords[file].map(|x| x + 0.0);
+                *slot = *ids.entry(p.map(f64::to_bits)).or_insert_with(|| {
+                    points.push(P3::from(p));
+                    (points.len() - 1) as u32
+                });
+            }
+            local.push(*slot);
+        }
+        let arities: Box<dyn Iterator<Item = usize>> = if mesh.face_arities.is_empty() {
+            Box::new(std::iter::repeat_n(3, mesh.indices.len() / 3))
+        } else {
+            Box::new(mesh.face_arities.iter().map(|&a| a as usize))
+        };
+        let mut g = Group {
+            name: model.name.clone(),
+            verts: Vec::with_capacity(mesh.indices.len()),
+            starts: vec![0],
+        };
+        let mut at = 0usize;
+        for n in arities {
+            let idx = mesh
+                .indices
+                .get(at..at + n)
+                .ok_or_else(|| malformed("face list"))?;
+            at += n;
+            if n >= 3 {
+                for &i in idx {
+                    g.verts.push(
+                        *local
+                            .get(i as usize)
+                            .ok_or_else(|| malformed("face index"))?,
+                    );
+                }
+                g.starts.push(g.verts.len());
+            }
+        }
+        if g.starts.len() > 1 {
+            groups.push(g);
+        }
+    }
+    Ok(groups)
+}
+
+/// Result of [`scan`]: the cleaned text for `tobj`, the `f64` vertices and the face counts.
+#[derive(Default)]
+struct Scanned {
+    text: String,
+    coords: Vec<[f64; 3]>,
+    faces: usize,
+    short_faces: usize,
+}
+
+/// A problem found by [`scan`], before its line number is attached.
+struct Problem(LoadErrorKind, String);
+
+impl Problem {
+    fn malformed(what: String) -> Problem {
+        Problem(LoadErrorKind::Malformed, what)
+    }
+
+    /// The message with its line, e.g. `not a valid OBJ file (line 5: bad number "x")`.
+    fn at(self, line: usize) -> (LoadErrorKind, String) {
+        let msg = match self.0 {
+            LoadErrorKind::Malformed => format!("not a valid OBJ file (line {line}: {})", self.1),
+            _ => format!("{} (line {line})", self.1),
+        };
+        (self.0, msg)
+    }
+}
+
+/// Quotes a token for an error message, shortened to 32 characters.
+fn shown(tok: &str) -> String {
+    let t: String = tok.chars().take(32).collect();
+    let more = if t.len() < tok.len() { "…" } else { "" };
+    format!("{t:?}{more}")
+}
+
+/// Validates `text` line by line and builds the cleaned copy handed to `tobj`.
+fn scan(text: &str) -> Result<Scanned, (LoadErrorKind, String)> {
+    let mut s = Scanned {
+        text: String::with_capacity(text.len()),
+        ..Scanned::default()
+    };
+    let mut face_no = 0;
+    // Positive indices may point forward: the largest (with its face and line) is checked
+    // once all vertices are known.
+    let mut forward: Option<(i64, usize, usize)> = None;
+    for (i, raw) in text.split('\n').enumerate() {
+        let line = i + 1;
+        let raw = raw.strip_suffix('\r').unwrap_or(raw);
+        let mut words = raw.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let toks: Vec<&str> = words.collect();
+                let c = parse_vertex(&toks, s.coords.len() + 1).map_err(|p| p.at(line))?;
+                let k = s.coords.len() as u64;
+                s.coords.push(c);
+                // Writing to a `String` cannot fail.
+                let _ = writeln!(s.text, "v {} {} 0", k % INDEX_SPLIT, k / INDEX_SPLIT);
+                continue;
+            }
+            Some("f") => {
+                face_no += 1;
+                let mut n = 0;
+                for tok in words {
+                    n += 1;
+                    let idx =
+                        parse_face_vertex(tok, face_no, s.coords.len()).map_err(|p| p.at(line))?;
+                    if idx > forward.map_or(s.coords.len() as i64, |f| f.0) {
+                        forward = Some((idx, face_no, line));
+                    }
+                }
+                if n >= 3 {
+                    s.faces += 1;
+                    s.text.push_str(raw);
+                } else {
+                    s.short_faces += 1;
+                }
+            }
+            Some("o" | "g") => s.text.push_str(raw),
+            _ => {}
+        }
+        s.text.push('\n');
+    }
+    if let Some((idx, face, line)) = forward.filter(|f| f.0 > s.coords.len() as i64) {
+        let n = s.coords.len();
+        let why = format!("face {face} refers to vertex {idx} but the file has {n} vertices");
+        return Err(Problem(LoadErrorKind::BadIndex, why).at(line));
+    }
+    Ok(s)
+}
+
+/// Parses the numbers after `v` (`x y z`, `x y z w` or `x y z r g b`) of vertex `number`.
+fn parse_vertex(toks: &[&str], number: usize) -> Result<[f64; 3], Problem> {
+    use LoadErrorKind::NonFinite;
+    if !matches!(toks.len(), 3 | 4 | 6) {
+        return Err(Problem::malformed(format!(
+            "vertex {number} needs 3 coordinates"
+        )));
+    }
+    let num = |tok: &str| {
+        tok.parse::<f64>()
+            .map_err(|_| Problem::malformed(format!("bad number {}", shown(tok))))
+    };
+    let mut c = [0.0; 3];
+    for (x, tok) in c.iter_mut().zip(toks) {
+        *x = num(tok)?;
+        if !x.is_finite() {
+            let tok = shown(tok);
+            let why = format!(
+                "vertex {number} has a non-finite coordinate ({})",
+                tok.trim_matches('"')
+            );
+            return Err(Problem(NonFinite, why));
+        }
+    }
+    if toks.len() == 4 {
+        let w = num(toks[3])?;
+        if w == 0.0 || !w.is_finite() {
+            return Err(Problem(
+                NonFinite,
+                format!("vertex {number} has weight w = {w}"),
+            ));
+        }
+        c = c.map(|x| x / w);
+    }
+    if c.iter().any(|x| !x.is_finite() || x.abs() > MAX_COORDINATE) {
+        let why = format!("vertex {number} has a coordinate beyond ±{MAX_COORDINATE:e}");
+        return Err(Problem(NonFinite, why));
+    }
+    Ok(c)
+}
+
+/// Parses one `v`, `v/vt`, `v//vn` or `v/vt/vn` token of face `face` when `defined` vertices
+/// precede it; returns the vertex index as written (relative ones checked here, positive ones
+/// by the caller).
+fn parse_face_vertex(tok: &str, face: usize, defined: usize) -> Result<i64, Problem> {
+    let bad = || Problem::malformed(format!("bad face vertex {}", shown(tok)));
+    let mut parts = tok.split('/');
+    let idx = parts
+        .next()
+        .unwrap_or("")
+        .parse::<isize>()
+        .map_err(|_| bad())? as i64;
+    for (k, p) in parts.enumerate() {
+        if k >= 2 || (!p.is_empty() && p.parse::<isize>().is_err()) {
+            return Err(bad());
+        }
+    }
+    if idx == 0 {
+        let why = format!("face {face} uses vertex index 0 (OBJ indices start at 1)");
+        return Err(Problem(LoadErrorKind::BadIndex, why));
+    }
+    if idx < 0 && idx.unsigned_abs() > defined as u64 {
+        let why = format!(
+            "face {face} uses relative vertex index {idx}, which reaches before the first \
+             vertex ({defined} defined so far)"
+        );
+        return Err(Problem(LoadErrorKind::BadIndex, why));
+    }
+    Ok(idx)
+}

@@ -1,0 +1,221 @@
+//! Polygon mode: one OBJ face becomes one convex planar polygon, or the triangles of its split.
+//!
+//! For each face (vertex order kept from the file, consecutive repeats removed):
+//! - **degenerate** — fewer than 3 distinct vertices, or area ≤ [`AREA_EPS`] × (scene
+//!   diagonal)²: dropped and counted;
+//! - **non-planar** — a vertex further than [`PLANAR_EPS`] × face diameter (the diagonal of the
+//!   face's AABB) from the plane through the vertex centroid with the Newell normal: split;
+//! - **non-convex** — in that plane, a reflex corner or a boundary winding more than once: split;
+//! - otherwise kept as one [`PrimitiveKind::Polygon`] drawn as a fan.
+//!
+//! A split is an ear-clipping triangulation in the face's plane, so the triangles lie inside the
+//! polygon; if no ear exists (a self-intersecting outline) the remaining corners are clipped in
+//! order anyway. Split triangles of (near) zero area are dropped silently.
+
+use crate::geom::{Aabb, P3, V3};
+use crate::scene::{PrimitiveKind, Scene};
+
+/// Relative area below which a face is degenerate (times the squared scene diagonal).
+pub const AREA_EPS: f64 = 1e-12;
+/// Relative distance from the face plane above which a face is non-planar (times its diameter).
+pub const PLANAR_EPS: f64 = 1e-6;
+
+/// Counts of repaired faces, reported as warnings.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PolygonStats {
+    /// Faces dropped as degenerate (including faces with fewer than 3 vertices).
+    pub degenerate: usize,
+    /// Faces split because they were not planar.
+    pub non_planar: usize,
+    /// Planar faces split because they were not convex.
+    pub non_convex: usize,
+    /// Triangles made by the splits.
+    pub pieces: usize,
+}
+
+impl PolygonStats {
+    /// One line per kind of repair (without the file name).
+    pub fn warnings(&self) -> Vec<String> {
+        let mut w = Vec::new();
+        if self.degenerate > 0 {
+            w.push(format!(
+                "dropped {} degenerate faces (fewer than 3 distinct vertices or zero area)",
+                self.degenerate
+            ));
+        }
+        if self.non_planar + self.non_convex > 0 {
+            w.push(format!(
+                "split {} non-planar and {} non-convex faces into {} triangles",
+                self.non_planar, self.non_convex, self.pieces
+            ));
+        }
+        w
+    }
+}
+
+/// Buffers reused from face to face.
+#[derive(Debug, Default)]
+pub struct Scratch {
+    verts: Vec<u32>,
+    flat: Vec<[f64; 2]>,
+    ears: Vec<[usize; 3]>,
+}
+
+/// Adds `face` (indices into `scene.points`) as a polygon, its split triangles, or nothing.
+pub fn add(
+    scene: &mut Scene,
+    face: &[u32],
+    scene_diag: f64,
+    stats: &mut PolygonStats,
+    s: &mut Scratch,
+) {
+    s.verts.clear();
+    for &i in face {
+        if s.verts.last() != Some(&i) {
+            s.verts.push(i);
+        }
+    }
+    while s.verts.len() > 1 && s.verts.first() == s.verts.last() {
+        s.verts.pop();
+    }
+    let area_eps = AREA_EPS * scene_diag * scene_diag;
+    let v = &s.verts;
+    let n = v.len();
+    if n < 3 || !three_distinct(v) {
+        stats.degenerate += 1;
+        return;
+    }
+    let p = |k: usize| scene.points[v[k % n] as usize];
+    let o = p(0);
+    let normal: V3 = (0..n).map(|k| (p(k) - o).cross(&(p(k + 1) - o))).sum();
+    let area = normal.norm() / 2.0;
+    if area <= area_eps || !area.is_finite() {
+        stats.degenerate += 1;
+        return;
+    }
+    let nh = normal / normal.norm();
+    if n == 3 {
+        push_polygon(scene, &s.verts);
+        return;
+    }
+    let planar = is_planar(&(0..n).map(p).collect::<Vec<_>>(), &nh);
+    if planar && is_convex(n, p, &nh) {
+        push_polygon(scene, &s.verts);
+        return;
+    }
+    if planar {
+        stats.non_convex += 1;
+    } else {
+        stats.non_planar += 1;
+    }
+    let u = nh.cross(&any_perpendicular(&nh)).normalize();
+    let w = nh.cross(&u);
+    s.flat.clear();
+    s.flat.extend((0..n).map(|k| {
+        let d = p(k) - o;
+        [d.dot(&u), d.dot(&w)]
+    }));
+    ear_clip(&s.flat, &mut s.ears);
+    for &[a, b, c] in &s.ears {
+        let tri = [s.verts[a], s.verts[b], s.verts[c]];
+        let [pa, pb, pc] = tri.map(|i| scene.points[i as usize]);
+        if (pb - pa).cross(&(pc - pa)).norm() / 2.0 > area_eps {
+            push_polygon(scene, &tri);
+            stats.pieces += 1;
+        }
+    }
+}
+
+/// Pushes a convex polygon drawn as a fan.
+fn push_polygon(scene: &mut Scene, v: &[u32]) {
+    let tris: Vec<[u32; 3]> = (1..v.len() - 1).map(|k| [v[0], v[k], v[k + 1]]).collect();
+    scene.push(PrimitiveKind::Polygon, v, &tris);
+}
+
+/// Whether `v` holds at least three distinct indices.
+fn three_distinct(v: &[u32]) -> bool {
+    let a = v[0];
+    match v.iter().find(|&&x| x != a) {
+        Some(&b) => v.iter().any(|&x| x != a && x != b),
+        None => false,
+    }
+}
+
+/// A unit vector not parallel to `n`.
+fn any_perpendicular(n: &V3) -> V3 {
+    if n.x.abs() < 0.9 { V3::x() } else { V3::y() }
+}
+
+/// Whether every vertex lies within `PLANAR_EPS` × diameter of the plane through the vertex
+/// centroid with normal `nh`.
+fn is_planar(pts: &[P3], nh: &V3) -> bool {
+    let c = P3::from(pts.iter().map(|p| p.coords).sum::<V3>() / pts.len() as f64);
+    let tol = PLANAR_EPS * Aabb::from_points(pts).diameter();
+    pts.iter().all(|q| (q - c).dot(nh).abs() <= tol)
+}
+
+/// Whether the planar polygon `p(0..n)` (counter-clockwise about `nh`) is convex: no reflex
+/// corner and a total turn of one full circle.
+fn is_convex(n: usize, p: impl Fn(usize) -> P3, nh: &V3) -> bool {
+    let mut turn = 0.0;
+    for k in 0..n {
+        let e1 = p(k + 1) - p(k);
+        let e2 = p(k + 2) - p(k + 1);
+        let cross = e1.cross(&e2).dot(nh);
+        if cross < -1e-9 * e1.norm() * e2.norm() {
+            return false;
+        }
+        turn += cross.atan2(e1.dot(&e2));
+    }
+    (turn - std::f64::consts::TAU).abs() < 1e-6
+}
+
+/// Twice the signed area of triangle `abc`.
+fn cross2(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+}
+
+/// Ear-clipping triangulation of the counter-clockwise polygon `pts` into `out` (corner indices).
+fn ear_clip(pts: &[[f64; 2]], out: &mut Vec<[usize; 3]>) {
+    out.clear();
+    let n = pts.len();
+    let mut prev: Vec<usize> = (0..n).map(|i| (i + n - 1) % n).collect();
+    let mut next: Vec<usize> = (0..n).map(|i| (i + 1) % n).collect();
+    let is_ear = |prev: &[usize], next: &[usize], b: usize| {
+        let (a, c) = (prev[b], next[b]);
+        let (pa, pb, pc) = (pts[a], pts[b], pts[c]);
+        if cross2(pa, pb, pc) <= 0.0 {
+            return false;
+        }
+        let mut q = next[c];
+        while q != a {
+            let pq = pts[q];
+            let corner = pq == pa || pq == pb || pq == pc;
+            if !corner
+                && cross2(pa, pb, pq) >= 0.0
+                && cross2(pb, pc, pq) >= 0.0
+                && cross2(pc, pa, pq) >= 0.0
+            {
+                return false;
+            }
+            q = next[q];
+        }
+        true
+    };
+    let (mut left, mut b, mut misses) = (n, 0, 0);
+    while left > 3 {
+        if is_ear(&prev, &next, b) || misses > left {
+            let (a, c) = (prev[b], next[b]);
+            out.push([a, b, c]);
+            next[a] = c;
+            prev[c] = a;
+            left -= 1;
+            misses = 0;
+            b = c;
+        } else {
+            misses += 1;
+            b = next[b];
+        }
+    }
+    out.push([prev[b], b, next[b]]);
+}
