@@ -1,0 +1,140 @@
+//! The `wraptree` and `wraptree.timing` metadata records: what makes a recording
+//! self-contained for a bug report, and how `replay` reads the run back.
+//!
+//! Every value is a string; numbers use Rust's shortest round-trip formatting, so parsing
+//! them gives back the exact `f64`.
+
+use crate::grouping::{PSet, ResolvedParams, Weights};
+use crate::record::{Detail, Outcome, RunInfo};
+use anyhow::{Context, Result, anyhow};
+use clap::ValueEnum;
+use std::collections::BTreeMap;
+
+/// Name of the run metadata record (no wall-clock values).
+pub const RUN: &str = "wraptree";
+/// Name of the metadata record holding wall-clock values (omitted by reproducible recordings).
+pub const TIMING: &str = "wraptree.timing";
+
+/// Keys of the `wraptree` record, in the order the README lists them.
+pub const KEYS: &[&str] = &[
+    "version",
+    "git_commit",
+    "a",
+    "b",
+    "c",
+    "dlimit0",
+    "glimit0",
+    "pset",
+    "seed",
+    "detail",
+    "scene",
+    "scene_file",
+    "scene_sha256",
+    "polyhedra",
+    "strict",
+    "primitives",
+    "rounds",
+    "merges",
+    "depth_max",
+    "depth_mean",
+    "complete",
+    "log_time",
+];
+
+/// How log times map to grouping steps (also stored under `log_time`).
+pub const LOG_TIME: &str = "scene and attachment at 0 ms; the k-th grouping event (k = 1, 2, ...) at k ms; \
+     /levels/<d> at (events + 1 + d) ms";
+
+fn value_name<T: ValueEnum>(v: &T) -> String {
+    v.to_possible_value()
+        .map(|p| p.get_name().to_string())
+        .unwrap_or_default()
+}
+
+/// The `wraptree` record of a run. `depth_max`/`depth_mean` are present only for a finished
+/// grouping, and `complete` is `"false"` when it is missing (an interrupted run).
+pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String, String> {
+    let p = info.params;
+    let mut m = BTreeMap::new();
+    let mut put = |k: &str, v: String| {
+        m.insert(k.to_string(), v);
+    };
+    put("version", env!("CARGO_PKG_VERSION").to_string());
+    put(
+        "git_commit",
+        option_env!("WRAPTREE_GIT_COMMIT")
+            .unwrap_or("unknown")
+            .to_string(),
+    );
+    put("a", p.weights.a.to_string());
+    put("b", p.weights.b.to_string());
+    put("c", p.weights.c.to_string());
+    put("dlimit0", p.dlimit0.to_string());
+    put("glimit0", p.glimit0.to_string());
+    put("pset", value_name(&p.pset));
+    put("seed", p.seed.map_or("none".to_string(), |s| s.to_string()));
+    put("detail", value_name(&info.detail));
+    put("scene", info.scene.name.clone());
+    put("scene_file", info.source.file_name.clone());
+    put("scene_sha256", info.source.sha256.clone());
+    put("polyhedra", info.source.options.polyhedra.to_string());
+    put("strict", info.source.options.strict.to_string());
+    put("primitives", info.scene.len().to_string());
+    put("rounds", outcome.rounds.to_string());
+    put("merges", outcome.merges.to_string());
+    if let Some(g) = outcome.grouping {
+        put("depth_max", g.tree.depth_max().to_string());
+        put("depth_mean", g.tree.depth_mean().to_string());
+    }
+    put("complete", outcome.grouping.is_some().to_string());
+    put("log_time", LOG_TIME.to_string());
+    m
+}
+
+/// The `wraptree.timing` record: wall-clock grouping time.
+pub fn timing_record(outcome: &Outcome<'_>) -> BTreeMap<String, String> {
+    BTreeMap::from([("seconds".to_string(), outcome.seconds.to_string())])
+}
+
+/// Reads one key of the `wraptree` record.
+pub fn get<'m>(m: &'m BTreeMap<String, String>, key: &str) -> Result<&'m str> {
+    m.get(key)
+        .map(String::as_str)
+        .ok_or_else(|| anyhow!("`{RUN}` metadata lacks `{key}`"))
+}
+
+/// Parses one key of the `wraptree` record.
+pub fn parse<T: std::str::FromStr>(m: &BTreeMap<String, String>, key: &str) -> Result<T> {
+    let v = get(m, key)?;
+    v.parse()
+        .map_err(|_| anyhow!("`{RUN}` metadata has a bad `{key}`: {v:?}"))
+}
+
+fn parse_enum<T: ValueEnum>(m: &BTreeMap<String, String>, key: &str) -> Result<T> {
+    let v = get(m, key)?;
+    T::from_str(v, false).map_err(|_| anyhow!("`{RUN}` metadata has a bad `{key}`: {v:?}"))
+}
+
+/// The run's parameters, exactly as recorded.
+pub fn params(m: &BTreeMap<String, String>) -> Result<ResolvedParams> {
+    let seed = match get(m, "seed")? {
+        "none" => None,
+        _ => Some(parse::<u64>(m, "seed")?),
+    };
+    Ok(ResolvedParams {
+        weights: Weights {
+            a: parse(m, "a")?,
+            b: parse(m, "b")?,
+            c: parse(m, "c")?,
+        },
+        dlimit0: parse(m, "dlimit0")?,
+        glimit0: parse(m, "glimit0")?,
+        pset: parse_enum::<PSet>(m, "pset")?,
+        seed,
+    })
+}
+
+/// The recording's detail level.
+pub fn detail(m: &BTreeMap<String, String>) -> Result<Detail> {
+    parse_enum(m, "detail").context("reading the detail level")
+}

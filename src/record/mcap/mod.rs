@@ -1,0 +1,397 @@
+//! Foxglove `.mcap` recordings of a grouping run ([`McapRecorder`]) and their reader
+//! ([`read_recording`], used by `wraptree replay`).
+//!
+//! The file is chunked, zstd-compressed (level 3, single-threaded, so the same run gives the
+//! same bytes on every machine) with chunk, data-section, summary and attachment CRCs. Geometry
+//! uses the well-known `foxglove.SceneUpdate` schema; grouping events use small typed protobuf
+//! messages derived with `foxglove::Encode` ([`messages`]). Message encoding is `protobuf`
+//! everywhere; every entity is in frame `world`.
+//!
+//! | topic | schema | what | written when |
+//! |---|---|---|---|
+//! | `/scene` | `foxglove.SceneUpdate` | entity `scene`: every input primitive in one indexed `TriangleListPrimitive`, light grey | always, once |
+//! | `/grouping/round` | `roundevent.RoundEvent` | each round start (DLimit, GLimit, active, dormant, eligible pairs) and each DLimit doubling (`doubling = true`, merges of the ended round, new limits) | always |
+//! | `/grouping/merge` | `mergeevent.MergeEvent` | every merge: step, round, a, b, new, AABB, diameter, Fill, Balance, Cost, queue length, active | always |
+//! | `/grouping/finish` | `finishevent.FinishEvent` | root, rounds, merges | always, once |
+//! | `/grouping/active` | `foxglove.SceneUpdate` | entity `active`: one translucent green box per active body at each round start | `--detail merges` or `full` |
+//! | `/grouping/bodies` | `foxglove.SceneUpdate` | entity `merge`: the merged pair (red) and the new body (yellow) as boxes, per merge | `--detail merges` or `full` |
+//! | `/grouping/dormant` | `dormantevent.DormantEvent` | round, body, diameter of each body going dormant | `--detail merges` or `full` |
+//! | `/levels/<d>` | `foxglove.SceneUpdate` | one snapshot of the cut at depth d (d = 0..=depth max): entity `spheres` (interior nodes as `SpherePrimitive`s, size = diameter) and entity `leaves` (the cut's leaves as one orange `TriangleListPrimitive`) | `--detail levels` or `full`, finished runs |
+//!
+//! The input scene file is attached (name = its file name, media type `model/obj`, log time 0),
+//! and two metadata records describe the run ([`metadata`]): `wraptree` (version, git commit,
+//! every parameter, scene name/file/sha256, load options, N, rounds, merges, depth, complete) and
+//! `wraptree.timing` (`seconds`, the only wall-clock value; left out by
+//! [`McapRecorder::set_reproducible`]).
+//!
+//! **Log times** are synthetic and monotonic, never wall-clock: the scene at 0; the k-th grouping
+//! event (k = 1, 2, …, counting every event, written at this detail or not: round starts,
+//! merges, dormant bodies, doublings, the finish) at k ms; the level snapshots after the last event at consecutive milliseconds,
+//! `/levels/<d>` at (events + 1 + d) ms. Sequence numbers count up from 0 on each channel.
+
+pub mod messages;
+pub mod metadata;
+mod read;
+pub mod scene_msgs;
+
+pub use read::{Recorded, read_recording};
+
+use crate::geom::Aabb;
+use crate::grouping::{Event, Observer};
+use crate::record::{Outcome, RunInfo};
+use anyhow::{Context, Result, anyhow, bail};
+use foxglove::Encode;
+use foxglove::messages::SceneUpdate;
+use messages::{DormantEvent, FinishEvent, MergeEvent, RoundEvent};
+use scene_msgs::Remap;
+use std::collections::BTreeMap;
+use std::io::{Seek, Write};
+
+/// Zstd level of every chunk.
+pub const ZSTD_LEVEL: u32 = 3;
+/// Target uncompressed chunk size.
+pub const CHUNK_SIZE: u64 = 1 << 20;
+/// Media type of the embedded scene.
+pub const SCENE_MEDIA_TYPE: &str = "model/obj";
+/// The MCAP header's profile (none of the registered profiles applies).
+pub const PROFILE: &str = "";
+/// The MCAP header's library string.
+pub const LIBRARY: &str = concat!("wraptree ", env!("CARGO_PKG_VERSION"), " (mcap-rs 0.26)");
+const MS: u64 = 1_000_000;
+
+/// A channel and its next sequence number.
+#[derive(Clone, Copy, Debug)]
+struct Topic {
+    id: u16,
+    seq: u32,
+}
+
+/// Channels registered for the grouping events.
+#[derive(Clone, Copy, Debug)]
+struct Topics {
+    round: Topic,
+    merge: Topic,
+    finish: Topic,
+    /// `/grouping/active`, `/grouping/bodies`, `/grouping/dormant` with per-merge detail.
+    detail: Option<[Topic; 3]>,
+}
+
+/// Writes a grouping run to an `.mcap` file; feed it events as an [`Observer`], then call
+/// [`McapRecorder::finish`].
+///
+/// `W` is written in many small pieces: give it a `BufWriter` around a file. Write errors do
+/// not panic: the first one is kept, later events are ignored, and `finish` returns it.
+pub struct McapRecorder<'a, W: Write + Seek> {
+    writer: mcap::Writer<W>,
+    info: RunInfo<'a>,
+    topics: Topics,
+    scene_update: u16,
+    /// AABB of every body seen so far, indexed by body id.
+    bodies: Vec<Aabb>,
+    events: u64,
+    reproducible: bool,
+    error: Option<anyhow::Error>,
+    buf: Vec<u8>,
+    remap: Remap,
+}
+
+fn add_schema<T: Encode, W: Write + Seek>(w: &mut mcap::Writer<W>) -> Result<u16> {
+    let s = T::get_schema().ok_or_else(|| anyhow!("message type without a schema"))?;
+    Ok(w.add_schema(&s.name, &s.encoding, &s.data)?)
+}
+
+fn add_topic<W: Write + Seek>(w: &mut mcap::Writer<W>, schema: u16, name: &str) -> Result<Topic> {
+    let id = w.add_channel(schema, name, "protobuf", &BTreeMap::new())?;
+    Ok(Topic { id, seq: 0 })
+}
+
+/// Encodes `msg` into `buf` and writes it on `topic` at `t_ns`.
+fn emit<T: Encode, W: Write + Seek>(
+    w: &mut mcap::Writer<W>,
+    buf: &mut Vec<u8>,
+    topic: &mut Topic,
+    t_ns: u64,
+    msg: &T,
+) -> Result<()> {
+    buf.clear();
+    msg.encode(buf)
+        .map_err(|e| anyhow!("encoding a message: {e}"))?;
+    let header = mcap::records::MessageHeader {
+        channel_id: topic.id,
+        sequence: topic.seq,
+        log_time: t_ns,
+        publish_time: t_ns,
+    };
+    topic.seq += 1;
+    Ok(w.write_to_known_channel(&header, buf)?)
+}
+
+impl<'a, W: Write + Seek> McapRecorder<'a, W> {
+    /// Starts a recording: writes the header, schemas, channels, the `/scene` message and the
+    /// scene attachment.
+    pub fn new(writer: W, info: &RunInfo<'a>) -> Result<Self> {
+        let options = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .compression_level(ZSTD_LEVEL)
+            .compression_threads(0)
+            .chunk_size(Some(CHUNK_SIZE))
+            .use_chunks(true)
+            .profile(PROFILE)
+            .library(LIBRARY)
+            .calculate_chunk_crcs(true)
+            .calculate_data_section_crc(true)
+            .calculate_summary_section_crc(true)
+            .calculate_attachment_crcs(true);
+        let mut w = options.create(writer).context("starting the MCAP file")?;
+        let scene_update = add_schema::<SceneUpdate, W>(&mut w)?;
+        let round_schema = add_schema::<RoundEvent, W>(&mut w)?;
+        let merge_schema = add_schema::<MergeEvent, W>(&mut w)?;
+        let finish_schema = add_schema::<FinishEvent, W>(&mut w)?;
+        let mut scene_topic = add_topic(&mut w, scene_update, "/scene")?;
+        let topics = Topics {
+            round: add_topic(&mut w, round_schema, "/grouping/round")?,
+            merge: add_topic(&mut w, merge_schema, "/grouping/merge")?,
+            finish: add_topic(&mut w, finish_schema, "/grouping/finish")?,
+            detail: if info.detail.merges() {
+                let dormant_schema = add_schema::<DormantEvent, W>(&mut w)?;
+                Some([
+                    add_topic(&mut w, scene_update, "/grouping/active")?,
+                    add_topic(&mut w, scene_update, "/grouping/bodies")?,
+                    add_topic(&mut w, dormant_schema, "/grouping/dormant")?,
+                ])
+            } else {
+                None
+            },
+        };
+        let scene = info.scene;
+        let mut remap = Remap::default();
+        let mut entity = scene_msgs::entity("scene", 0);
+        entity.triangles.push(scene_msgs::triangles(
+            scene,
+            0..scene.len(),
+            scene_msgs::SCENE_COLOR,
+            &mut remap,
+        ));
+        let mut buf = Vec::new();
+        emit(
+            &mut w,
+            &mut buf,
+            &mut scene_topic,
+            0,
+            &scene_msgs::update(vec![entity]),
+        )?;
+        w.attach(&mcap::Attachment {
+            log_time: 0,
+            create_time: 0,
+            name: info.source.file_name.clone(),
+            media_type: SCENE_MEDIA_TYPE.to_string(),
+            data: std::borrow::Cow::Borrowed(&info.source.bytes),
+        })
+        .context("attaching the scene")?;
+        let mut bodies = Vec::with_capacity(2 * scene.len());
+        bodies.extend((0..scene.len()).map(|i| scene.prim_aabb(i)));
+        Ok(McapRecorder {
+            writer: w,
+            info: *info,
+            topics,
+            scene_update,
+            bodies,
+            events: 0,
+            reproducible: false,
+            error: None,
+            buf,
+            remap,
+        })
+    }
+
+    /// Leaves out the `wraptree.timing` record, the only wall-clock value, so two recordings of
+    /// the same run are byte-identical.
+    pub fn set_reproducible(&mut self, on: bool) {
+        self.reproducible = on;
+    }
+
+    fn record(&mut self, event: &Event<'_>) -> Result<()> {
+        let t = self.events * MS;
+        let (w, buf) = (&mut self.writer, &mut self.buf);
+        let detail = self.topics.detail.as_mut();
+        match *event {
+            Event::RoundStart {
+                round,
+                dlimit,
+                glimit,
+                active,
+                dormant,
+                pairs,
+            } => {
+                let msg = RoundEvent {
+                    doubling: false,
+                    round,
+                    dlimit,
+                    glimit,
+                    active: active.len() as u32,
+                    dormant,
+                    pairs,
+                    merges: 0,
+                };
+                emit(w, buf, &mut self.topics.round, t, &msg)?;
+                if let Some([active_topic, ..]) = detail {
+                    let mut e = scene_msgs::entity("active", t);
+                    let bodies = &self.bodies;
+                    e.cubes = active
+                        .iter()
+                        .map(|&id| {
+                            let b = bodies.get(id as usize).copied().unwrap_or(Aabb::EMPTY);
+                            scene_msgs::cube(&b, scene_msgs::ACTIVE_COLOR)
+                        })
+                        .collect();
+                    emit(w, buf, active_topic, t, &scene_msgs::update(vec![e]))?;
+                }
+            }
+            Event::Merge(m) => {
+                emit(w, buf, &mut self.topics.merge, t, &MergeEvent::from(&m))?;
+                let new = m.new as usize;
+                if self.bodies.len() <= new {
+                    self.bodies.resize(new + 1, Aabb::EMPTY);
+                }
+                self.bodies[new] = m.aabb;
+                if let Some([_, bodies_topic, _]) = detail {
+                    let mut e = scene_msgs::entity("merge", t);
+                    let get =
+                        |id: u32| self.bodies.get(id as usize).copied().unwrap_or(Aabb::EMPTY);
+                    e.cubes = vec![
+                        scene_msgs::cube(&get(m.a), scene_msgs::PAIR_COLOR),
+                        scene_msgs::cube(&get(m.b), scene_msgs::PAIR_COLOR),
+                        scene_msgs::cube(&m.aabb, scene_msgs::NEW_COLOR),
+                    ];
+                    emit(w, buf, bodies_topic, t, &scene_msgs::update(vec![e]))?;
+                }
+            }
+            Event::Dormant {
+                round,
+                body,
+                diameter,
+            } => {
+                if let Some([_, _, dormant_topic]) = detail {
+                    let msg = DormantEvent {
+                        round,
+                        body,
+                        diameter,
+                    };
+                    emit(w, buf, dormant_topic, t, &msg)?;
+                }
+            }
+            Event::Doubling {
+                round,
+                merges,
+                dlimit,
+                glimit,
+            } => {
+                let msg = RoundEvent {
+                    doubling: true,
+                    round,
+                    dlimit,
+                    glimit,
+                    active: 0,
+                    dormant: 0,
+                    pairs: 0,
+                    merges,
+                };
+                emit(w, buf, &mut self.topics.round, t, &msg)?;
+            }
+            Event::Finish {
+                root,
+                rounds,
+                merges,
+            } => {
+                let msg = FinishEvent {
+                    root,
+                    rounds,
+                    merges,
+                };
+                emit(w, buf, &mut self.topics.finish, t, &msg)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes one `/levels/<d>` snapshot per depth of the finished tree.
+    fn write_levels(&mut self, outcome: &Outcome<'_>) -> Result<()> {
+        let (Some(grouping), Some(spheres)) = (outcome.grouping, outcome.spheres) else {
+            return Ok(());
+        };
+        let tree = &grouping.tree;
+        if spheres.len() != tree.len() {
+            bail!("{} spheres for {} tree nodes", spheres.len(), tree.len());
+        }
+        let scene = self.info.scene;
+        for d in 0..=tree.depth_max() {
+            let t = (self.events + 1 + u64::from(d)) * MS;
+            let mut topic =
+                add_topic(&mut self.writer, self.scene_update, &format!("/levels/{d}"))?;
+            let cut = tree.level(d);
+            let mut balls = scene_msgs::entity("spheres", t);
+            balls.spheres = cut
+                .iter()
+                .filter(|&&x| !tree.is_leaf(x))
+                .map(|&x| scene_msgs::sphere(&spheres[x as usize], scene_msgs::SPHERE_COLOR))
+                .collect();
+            let mut leaves = scene_msgs::entity("leaves", t);
+            let leaf_ids = cut
+                .iter()
+                .filter(|&&x| tree.is_leaf(x))
+                .map(|&x| x as usize);
+            leaves.triangles.push(scene_msgs::triangles(
+                scene,
+                leaf_ids,
+                scene_msgs::LEAF_COLOR,
+                &mut self.remap,
+            ));
+            let msg = scene_msgs::update(vec![balls, leaves]);
+            emit(&mut self.writer, &mut self.buf, &mut topic, t, &msg)
+                .with_context(|| format!("writing level {d}"))?;
+        }
+        Ok(())
+    }
+
+    /// Levels, metadata records and the summary section.
+    fn write_tail(&mut self, outcome: &Outcome<'_>) -> Result<()> {
+        if self.info.detail.levels() {
+            self.write_levels(outcome)?;
+        }
+        self.writer.write_metadata(&mcap::records::Metadata {
+            name: metadata::RUN.to_string(),
+            metadata: metadata::run_record(&self.info, outcome),
+        })?;
+        if !self.reproducible {
+            self.writer.write_metadata(&mcap::records::Metadata {
+                name: metadata::TIMING.to_string(),
+                metadata: metadata::timing_record(outcome),
+            })?;
+        }
+        self.writer.finish()?;
+        Ok(())
+    }
+
+    /// Writes the level snapshots (when the detail asks for them and the run finished), the
+    /// metadata records, the summary and the footer, and returns the underlying writer, already
+    /// flushed. Returns the first write error of the run instead, if any.
+    pub fn finish(mut self, outcome: &Outcome<'_>) -> Result<W> {
+        if let Some(e) = self.error.take() {
+            return Err(e.context("writing the MCAP recording"));
+        }
+        self.write_tail(outcome)
+            .context("writing the MCAP recording")?;
+        Ok(self.writer.into_inner())
+    }
+}
+
+impl<W: Write + Seek> Observer for McapRecorder<'_, W> {
+    fn on_event(&mut self, event: &Event<'_>) {
+        self.events += 1;
+        if self.error.is_none()
+            && let Err(e) = self.record(event)
+        {
+            self.error = Some(e);
+        }
+    }
+}

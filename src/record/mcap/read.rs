@@ -1,0 +1,303 @@
+//! Reads a wraptree `.mcap` recording back: the run's metadata, the embedded scene and the
+//! grouping events (what `wraptree replay` rebuilds the Subset Tree from).
+//!
+//! The file is read in one validated linear pass (mcap's sans-io reader with chunk,
+//! data-section and summary CRC checks and a record length limit), so truncated or corrupted
+//! files give an error, never a panic, and no index offset from the file is trusted.
+
+use super::messages::{DormantEvent, FinishEvent, MergeEvent, RoundEvent};
+use super::metadata;
+use crate::grouping::{EventLog, Merge, ResolvedParams};
+use crate::record::Detail;
+use crate::scene::LoadOptions;
+use anyhow::{Result, anyhow, bail};
+use mcap::records::Record;
+use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
+use sha2::{Digest, Sha256};
+use std::collections::{BTreeMap, HashMap};
+use std::path::Path;
+
+/// What a recording holds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Recorded {
+    /// The `wraptree` metadata record (see [`metadata::KEYS`]).
+    pub metadata: BTreeMap<String, String>,
+    /// The `wraptree.timing` record (empty for reproducible recordings).
+    pub timing: BTreeMap<String, String>,
+    /// The run's parameters.
+    pub params: ResolvedParams,
+    /// What the recording holds.
+    pub detail: Detail,
+    /// Scene name.
+    pub scene_name: String,
+    /// File name of the embedded scene.
+    pub scene_file_name: String,
+    /// The embedded scene file's bytes.
+    pub scene_bytes: Vec<u8>,
+    /// The options the scene was loaded with (`--polyhedra`, `--strict`).
+    pub load_options: LoadOptions,
+    /// Number of primitives N.
+    pub primitives: u32,
+    /// Rounds run.
+    pub rounds: u32,
+    /// Whether grouping reached the root (false for an interrupted run).
+    pub complete: bool,
+    /// Every merge, in order (N − 1 when complete).
+    pub merges: Vec<Merge>,
+    /// (round, dlimit, glimit, active count, dormant count, eligible pairs) per round start.
+    pub round_starts: Vec<(u32, f64, f64, u32, u32, u64)>,
+    /// (round, merges, new dlimit, new glimit) per doubling.
+    pub doublings: Vec<(u32, u32, f64, f64)>,
+    /// (round, body) of bodies going dormant; only recorded with merge detail.
+    pub dormant: Vec<(u32, u32)>,
+    /// Root body id, once finished.
+    pub root: Option<u32>,
+}
+
+impl Recorded {
+    /// The recorded events as an [`EventLog`] (dormant bodies only with merge detail).
+    pub fn event_log(&self) -> EventLog {
+        EventLog {
+            merges: self.merges.clone(),
+            rounds: self.round_starts.clone(),
+            dormant: self.dormant.clone(),
+            doublings: self.doublings.clone(),
+            root: self.root,
+        }
+    }
+}
+
+/// Raw content gathered by the linear pass.
+#[derive(Default)]
+struct Raw {
+    schemas: HashMap<u16, String>,
+    channels: HashMap<u16, (String, u16, String)>,
+    metadata: Vec<(String, BTreeMap<String, String>)>,
+    attachments: Vec<(String, Vec<u8>)>,
+    merges: Vec<Merge>,
+    rounds: Vec<RoundEvent>,
+    dormant: Vec<DormantEvent>,
+    finish: Option<FinishEvent>,
+}
+
+/// The schema each decoded topic must carry.
+const TYPED_TOPICS: &[(&str, &str)] = &[
+    ("/grouping/merge", "mergeevent.MergeEvent"),
+    ("/grouping/round", "roundevent.RoundEvent"),
+    ("/grouping/dormant", "dormantevent.DormantEvent"),
+    ("/grouping/finish", "finishevent.FinishEvent"),
+];
+
+impl Raw {
+    fn message(&mut self, channel_id: u16, data: &[u8]) -> Result<(), String> {
+        let Some((topic, schema_id, encoding)) = self.channels.get(&channel_id) else {
+            return Err(format!("message on unknown channel {channel_id}"));
+        };
+        let Some(&(_, want)) = TYPED_TOPICS.iter().find(|(t, _)| t == topic) else {
+            return Ok(());
+        };
+        let schema = self.schemas.get(schema_id).map_or("", String::as_str);
+        if schema != want || encoding != "protobuf" {
+            return Err(format!(
+                "{topic} has schema {schema:?} ({encoding}), expected {want} (protobuf)"
+            ));
+        }
+        let bad = |e: String| format!("bad {topic} message: {e}");
+        match topic.as_str() {
+            "/grouping/merge" => self
+                .merges
+                .push(Merge::from(&MergeEvent::decode(data).map_err(bad)?)),
+            "/grouping/round" => self.rounds.push(RoundEvent::decode(data).map_err(bad)?),
+            "/grouping/dormant" => self.dormant.push(DormantEvent::decode(data).map_err(bad)?),
+            _ => self.finish = Some(FinishEvent::decode(data).map_err(bad)?),
+        }
+        Ok(())
+    }
+
+    fn record(&mut self, rec: Record<'_>) -> Result<(), String> {
+        match rec {
+            Record::Schema { header, .. } => {
+                self.schemas.insert(header.id, header.name);
+            }
+            Record::Channel(c) => {
+                self.channels
+                    .insert(c.id, (c.topic, c.schema_id, c.message_encoding));
+            }
+            Record::Message { header, data } => self.message(header.channel_id, &data)?,
+            Record::Attachment { header, data, .. } => {
+                self.attachments.push((header.name, data.into_owned()))
+            }
+            Record::Metadata(m) => self.metadata.push((m.name, m.metadata)),
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
+/// Flattens an error and its sources into one line.
+fn one_line(e: &dyn std::error::Error) -> String {
+    let mut s = e.to_string();
+    let mut src = e.source();
+    while let Some(cause) = src {
+        s.push_str(": ");
+        s.push_str(&cause.to_string());
+        src = cause.source();
+    }
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// Describes an MCAP-level failure for a user.
+fn describe(e: &mcap::McapError) -> String {
+    use mcap::McapError as E;
+    let what = match e {
+        E::UnexpectedEof | E::UnexpectedEoc => "truncated MCAP file",
+        E::BadMagic => "not an MCAP file",
+        E::BadChunkCrc { .. }
+        | E::BadDataCrc { .. }
+        | E::BadSummaryCrc { .. }
+        | E::BadAttachmentCrc { .. } => "corrupted MCAP file (checksum mismatch)",
+        _ => "corrupted or unreadable MCAP file",
+    };
+    format!("{what}: {}", one_line(e))
+}
+
+/// One validated pass over every record of `bytes`.
+fn scan(bytes: &[u8]) -> Result<Raw, String> {
+    let limit = bytes.len().saturating_mul(64).max(64 << 20);
+    let mut reader = LinearReader::new_with_options(
+        LinearReaderOptions::default()
+            .with_prevalidate_chunk_crcs(true)
+            .with_validate_chunk_crcs(true)
+            .with_validate_data_section_crc(true)
+            .with_validate_summary_section_crc(true)
+            .with_check_finishes_after_end_magic(true)
+            .with_record_length_limit(limit),
+    );
+    let mut raw = Raw::default();
+    let mut rest = bytes;
+    while let Some(event) = reader.next_event() {
+        match event.map_err(|e| describe(&e))? {
+            LinearReadEvent::ReadRequest(n) => {
+                let k = n.min(rest.len());
+                reader.insert(k).copy_from_slice(&rest[..k]);
+                reader.notify_read(k);
+                rest = &rest[k..];
+            }
+            LinearReadEvent::Record { data, opcode } => {
+                let rec = mcap::parse_record(opcode, data).map_err(|e| describe(&e))?;
+                raw.record(rec)?;
+            }
+        }
+    }
+    Ok(raw)
+}
+
+/// Checks the merges form the sequence a run of N primitives makes.
+fn check_merges(merges: &[Merge], n: u32, complete: bool) -> Result<(), String> {
+    if complete && merges.len() as u64 + 1 != u64::from(n) {
+        return Err(format!(
+            "complete run of {n} primitives holds {} merges",
+            merges.len()
+        ));
+    }
+    for (i, m) in merges.iter().enumerate() {
+        let i = i as u32;
+        if m.step != i
+            || u64::from(m.new) != u64::from(n) + u64::from(i)
+            || m.a >= m.b
+            || m.b >= m.new
+        {
+            return Err(format!(
+                "merge {i} is inconsistent (step {}, bodies {} + {} -> {})",
+                m.step, m.a, m.b, m.new
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn interpret(raw: Raw) -> Result<Recorded> {
+    let mut meta = None;
+    let mut timing = BTreeMap::new();
+    for (name, m) in raw.metadata {
+        match name.as_str() {
+            metadata::RUN if meta.is_none() => meta = Some(m),
+            metadata::TIMING => timing = m,
+            _ => {}
+        }
+    }
+    let m = meta.ok_or_else(|| {
+        anyhow!(
+            "not a wraptree recording (no `{}` metadata record)",
+            metadata::RUN
+        )
+    })?;
+    let scene_file_name = metadata::get(&m, "scene_file")?.to_string();
+    let scene_bytes = raw
+        .attachments
+        .into_iter()
+        .find(|(name, _)| *name == scene_file_name)
+        .map(|(_, data)| data)
+        .ok_or_else(|| anyhow!("the embedded scene `{scene_file_name}` is missing"))?;
+    let sha256: String = Sha256::digest(&scene_bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    if !sha256.eq_ignore_ascii_case(metadata::get(&m, "scene_sha256")?) {
+        bail!("the embedded scene `{scene_file_name}` does not match its recorded sha256");
+    }
+    let complete = metadata::parse::<bool>(&m, "complete")?;
+    let primitives = metadata::parse::<u32>(&m, "primitives")?;
+    check_merges(&raw.merges, primitives, complete).map_err(|e| anyhow!(e))?;
+    let round_starts = raw.rounds.iter().filter(|r| !r.doubling);
+    let rounds = match m.get("rounds") {
+        Some(_) => metadata::parse(&m, "rounds")?,
+        None => round_starts.clone().count() as u32,
+    };
+    Ok(Recorded {
+        params: metadata::params(&m)?,
+        detail: metadata::detail(&m)?,
+        scene_name: metadata::get(&m, "scene")?.to_string(),
+        load_options: LoadOptions {
+            polyhedra: metadata::parse(&m, "polyhedra")?,
+            strict: metadata::parse(&m, "strict")?,
+        },
+        scene_file_name,
+        scene_bytes,
+        primitives,
+        rounds,
+        complete,
+        merges: raw.merges,
+        round_starts: round_starts
+            .map(|r| (r.round, r.dlimit, r.glimit, r.active, r.dormant, r.pairs))
+            .collect(),
+        doublings: raw
+            .rounds
+            .iter()
+            .filter(|r| r.doubling)
+            .map(|r| (r.round, r.merges, r.dlimit, r.glimit))
+            .collect(),
+        dormant: raw.dormant.iter().map(|d| (d.round, d.body)).collect(),
+        root: raw.finish.map(|f| f.root),
+        metadata: m,
+        timing,
+    })
+}
+
+/// Reads a wraptree `.mcap` recording. Truncated, corrupted or foreign files give one error line
+/// naming the file and the problem.
+pub fn read_recording(path: &Path) -> Result<Recorded> {
+    let name = path.display();
+    let bytes =
+        std::fs::read(path).map_err(|e| anyhow!("{name}: cannot read: {}", one_line(&e)))?;
+    let raw = scan(&bytes).map_err(|e| anyhow!("{name}: {e}"))?;
+    interpret(raw).map_err(|e| {
+        anyhow!(
+            "{name}: {}",
+            format!("{e:#}")
+                .split_whitespace()
+                .collect::<Vec<_>>()
+                .join(" ")
+        )
+    })
+}
