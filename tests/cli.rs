@@ -12,7 +12,11 @@ fn wraptree(args: &[&str], dir: &Path) -> Output {
 }
 
 fn scene(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name).display().to_string()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
+        .display()
+        .to_string()
 }
 
 /// Asserts a failure with exactly one `error:` line on stderr mentioning `needle`, and no panic.
@@ -21,7 +25,11 @@ fn assert_one_line_error(out: &Output, needle: &str) {
     let err = String::from_utf8_lossy(&out.stderr);
     let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
     assert_eq!(errors.len(), 1, "one error line, got: {err}");
-    assert!(errors[0].contains(needle), "{:?} should mention {needle}", errors[0]);
+    assert!(
+        errors[0].contains(needle),
+        "{:?} should mention {needle}",
+        errors[0]
+    );
     assert!(!err.contains("panicked"), "no panic: {err}");
 }
 
@@ -29,7 +37,11 @@ fn assert_one_line_error(out: &Output, needle: &str) {
 fn group_json_has_the_tree() {
     let dir = tempfile::tempdir().unwrap();
     let out = wraptree(&["group", &scene("robot-base.obj"), "--json"], dir.path());
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let n = v["primitives"].as_u64().unwrap() as usize;
     assert_eq!(n, 276);
@@ -52,7 +64,10 @@ fn bad_scene_inputs_give_one_error_line() {
     let out = wraptree(&["record", "nan.obj", "-o", "rec"], dir.path());
     assert_one_line_error(&out, "nan.obj");
     assert!(!dir.path().join("rec.rrd").exists() && !dir.path().join("rec.mcap").exists());
-    let out = wraptree(&["group", &scene("robot-base.obj"), "--a", "-1"], dir.path());
+    let out = wraptree(
+        &["group", &scene("robot-base.obj"), "--a", "-1"],
+        dir.path(),
+    );
     assert_one_line_error(&out, "--a");
 }
 
@@ -67,7 +82,11 @@ fn record(dir: &Path, prefix: &str, extra: &[&str]) -> Output {
 fn record_never_clobbers_without_force() {
     let dir = tempfile::tempdir().unwrap();
     let out = record(dir.path(), "rb", &["--detail", "levels"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let mcap = dir.path().join("rb.mcap");
     let before = std::fs::read(&mcap).unwrap();
     let again = record(dir.path(), "rb", &[]);
@@ -75,13 +94,20 @@ fn record_never_clobbers_without_force() {
     assert_eq!(std::fs::read(&mcap).unwrap(), before, "untouched");
     let forced = record(dir.path(), "rb", &["--force"]);
     assert!(forced.status.success());
-    assert_ne!(std::fs::read(&mcap).unwrap(), before, "replaced (full detail is larger)");
+    assert_ne!(
+        std::fs::read(&mcap).unwrap(),
+        before,
+        "replaced (full detail is larger)"
+    );
     let leftovers: Vec<PathBuf> = std::fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.to_string_lossy().ends_with(".tmp"))
         .collect();
-    assert!(leftovers.is_empty(), "no temporary files left: {leftovers:?}");
+    assert!(
+        leftovers.is_empty(),
+        "no temporary files left: {leftovers:?}"
+    );
     let missing_dir = record(dir.path(), "nowhere/rb", &[]);
     assert_one_line_error(&missing_dir, "does not exist");
 }
@@ -89,24 +115,44 @@ fn record_never_clobbers_without_force() {
 #[test]
 fn reproducible_recordings_are_byte_identical_and_replay_verifies() {
     let dir = tempfile::tempdir().unwrap();
-    assert!(record(dir.path(), "a", &["--reproducible"]).status.success());
-    assert!(record(dir.path(), "b", &["--reproducible"]).status.success());
+    assert!(
+        record(dir.path(), "a", &["--reproducible"])
+            .status
+            .success()
+    );
+    assert!(
+        record(dir.path(), "b", &["--reproducible"])
+            .status
+            .success()
+    );
     let (a, b) = (dir.path().join("a.mcap"), dir.path().join("b.mcap"));
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
     let out = wraptree(&["replay", "a.mcap", "--verify"], dir.path());
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{text} {}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{text} {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(text.contains("identical (275 merges)"), "{text}");
     let out = wraptree(&["replay", "a.mcap", "--c", "1", "-o", "c1"], dir.path());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{text}");
-    assert!(text.contains("depth max") && dir.path().join("c1.rrd").exists() && dir.path().join("c1.mcap").exists());
+    assert!(
+        text.contains("depth max")
+            && dir.path().join("c1.rrd").exists()
+            && dir.path().join("c1.mcap").exists()
+    );
 }
 
 #[test]
 fn replay_rejects_broken_and_foreign_files() {
     let dir = tempfile::tempdir().unwrap();
-    assert!(record(dir.path(), "ok", &["--detail", "levels"]).status.success());
+    assert!(
+        record(dir.path(), "ok", &["--detail", "levels"])
+            .status
+            .success()
+    );
     let bytes = std::fs::read(dir.path().join("ok.mcap")).unwrap();
     std::fs::write(dir.path().join("cut.mcap"), &bytes[..bytes.len() / 2]).unwrap();
     let mut flipped = bytes.clone();
@@ -115,8 +161,18 @@ fn replay_rejects_broken_and_foreign_files() {
     }
     std::fs::write(dir.path().join("flip.mcap"), &flipped).unwrap();
     std::fs::write(dir.path().join("junk.mcap"), b"\x89not an mcap file at all").unwrap();
-    std::fs::write(dir.path().join("scene.mcap"), std::fs::read(scene("robot-base.obj")).unwrap()).unwrap();
-    for f in ["cut.mcap", "flip.mcap", "junk.mcap", "scene.mcap", "absent.mcap"] {
+    std::fs::write(
+        dir.path().join("scene.mcap"),
+        std::fs::read(scene("robot-base.obj")).unwrap(),
+    )
+    .unwrap();
+    for f in [
+        "cut.mcap",
+        "flip.mcap",
+        "junk.mcap",
+        "scene.mcap",
+        "absent.mcap",
+    ] {
         let out = wraptree(&["replay", f, "--verify"], dir.path());
         assert_one_line_error(&out, f);
     }
@@ -126,7 +182,10 @@ fn replay_rejects_broken_and_foreign_files() {
 #[test]
 fn interrupted_recording_keeps_what_was_recorded() {
     let dir = tempfile::tempdir().unwrap();
-    let made = wraptree(&["scene", "soup", "-n", "200000", "-o", "big.obj"], dir.path());
+    let made = wraptree(
+        &["scene", "soup", "-n", "200000", "-o", "big.obj"],
+        dir.path(),
+    );
     assert!(made.status.success());
     let child = Command::new(env!("CARGO_BIN_EXE_wraptree"))
         .args(["record", "big.obj", "-o", "big", "--detail", "levels"])
@@ -138,17 +197,38 @@ fn interrupted_recording_keeps_what_was_recorded() {
     // The handler is installed before loading; whether the signal lands while loading or while
     // grouping, the run stops before the root (200k triangles take over a second to load and group).
     std::thread::sleep(std::time::Duration::from_millis(400));
-    let kill = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
     assert!(kill.success());
     let out = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(130), "interrupted exit code; stderr: {err}");
-    assert!(!dir.path().join("big.mcap").exists(), "no complete-looking file");
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "interrupted exit code; stderr: {err}"
+    );
+    assert!(
+        !dir.path().join("big.mcap").exists(),
+        "no complete-looking file"
+    );
     let rep = wraptree(&["replay", "big.incomplete.mcap", "--verify"], dir.path());
     let text = String::from_utf8_lossy(&rep.stdout);
-    assert!(rep.status.success(), "{text} {}", String::from_utf8_lossy(&rep.stderr));
+    assert!(
+        rep.status.success(),
+        "{text} {}",
+        String::from_utf8_lossy(&rep.stderr)
+    );
     assert!(text.contains("incomplete recording"), "{text}");
-    let verify = Command::new("rerun").args(["rrd", "verify"]).arg(dir.path().join("big.incomplete.rrd")).output();
+    let verify = Command::new("rerun")
+        .args(["rrd", "verify"])
+        .arg(dir.path().join("big.incomplete.rrd"))
+        .output();
     let verify = verify.expect("the rerun CLI (pip install rerun-sdk==0.36.3) is needed");
-    assert!(verify.status.success(), "{}", String::from_utf8_lossy(&verify.stderr));
+    assert!(
+        verify.status.success(),
+        "{}",
+        String::from_utf8_lossy(&verify.stderr)
+    );
 }

@@ -45,7 +45,11 @@ fn tree_of(rec: &Recorded, loaded: &Loaded) -> Result<SubsetTree> {
     let s = &loaded.scene;
     let boxes: Vec<Aabb> = (0..s.len()).map(|i| s.prim_aabb(i)).collect();
     let diam = boxes.iter().map(Aabb::diameter).collect();
-    let merges: Vec<_> = rec.merges.iter().map(|m| (m.a, m.b, m.aabb, m.diameter)).collect();
+    let merges: Vec<_> = rec
+        .merges
+        .iter()
+        .map(|m| (m.a, m.b, m.aabb, m.diameter))
+        .collect();
     SubsetTree::from_merges(boxes, diam, &merges).map_err(anyhow::Error::msg)
 }
 
@@ -61,11 +65,15 @@ fn first_divergence(a: &[Merge], b: &[Merge]) -> Option<usize> {
     (0..a.len().max(b.len())).find(|&i| a.get(i) != b.get(i))
 }
 
+/// A table row: field name and how to print it from a merge.
+type Row<'a> = (&'a str, &'a dyn Fn(&Merge) -> String);
+
 fn side_by_side(i: usize, left: (&str, Option<&Merge>), right: (&str, Option<&Merge>)) {
     println!("first divergence at merge step {i}:");
     println!("  {:<10} {:>24} {:>24}", "field", left.0, right.0);
-    let f = |m: Option<&Merge>, g: &dyn Fn(&Merge) -> String| m.map(g).unwrap_or_else(|| "-".into());
-    let rows: [(&str, &dyn Fn(&Merge) -> String); 10] = [
+    let f =
+        |m: Option<&Merge>, g: &dyn Fn(&Merge) -> String| m.map(g).unwrap_or_else(|| "-".into());
+    let rows: [Row; 10] = [
         ("round", &|m| m.round.to_string()),
         ("a", &|m| m.a.to_string()),
         ("b", &|m| m.b.to_string()),
@@ -93,10 +101,18 @@ impl ReplayCmd {
     pub fn run(self) -> Result<ExitCode> {
         let rec = read_recording(&self.file)?;
         let name = self.file.display().to_string();
-        let loaded = load_bytes(&rec.scene_file_name, rec.scene_bytes.clone(), &rec.load_options)
-            .with_context(|| format!("{name}: the embedded scene does not load"))?;
+        let loaded = load_bytes(
+            &rec.scene_file_name,
+            rec.scene_bytes.clone(),
+            &rec.load_options,
+        )
+        .with_context(|| format!("{name}: the embedded scene does not load"))?;
         if loaded.scene.len() as u32 != rec.primitives {
-            bail!("{name}: the embedded scene has {} primitives, the metadata says {}", loaded.scene.len(), rec.primitives);
+            bail!(
+                "{name}: the embedded scene has {} primitives, the metadata says {}",
+                loaded.scene.len(),
+                rec.primitives
+            );
         }
         let n = rec.primitives;
         let p = &rec.params;
@@ -105,7 +121,8 @@ impl ReplayCmd {
             rec.scene_name, p.weights.a, p.weights.b, p.weights.c, p.dlimit0, p.glimit0, p.pset
         );
         if rec.complete {
-            let t = tree_of(&rec, &loaded).with_context(|| format!("{name}: the merge events do not form a tree"))?;
+            let t = tree_of(&rec, &loaded)
+                .with_context(|| format!("{name}: the merge events do not form a tree"))?;
             println!(
                 "replayed {} merges in {} rounds: root {}, depth max {} ({} levels), mean {:.2}",
                 rec.merges.len(),
@@ -116,18 +133,30 @@ impl ReplayCmd {
                 t.depth_mean()
             );
         } else {
-            println!("incomplete recording: {} of {} merges, {} rounds started", rec.merges.len(), n.saturating_sub(1), rec.rounds);
+            println!(
+                "incomplete recording: {} of {} merges, {} rounds started",
+                rec.merges.len(),
+                n.saturating_sub(1),
+                rec.rounds
+            );
         }
         if self.verify {
             let log = rerun(&loaded, &rec.params);
             match first_divergence(&rec.merges, &log.merges) {
-                None => println!("verified: the merge sequence is identical ({} merges)", log.merges.len()),
+                None => println!(
+                    "verified: the merge sequence is identical ({} merges)",
+                    log.merges.len()
+                ),
                 Some(i) if !rec.complete && i == rec.merges.len() => println!(
                     "verified: the {} recorded merges match the re-run's first {} (the recording stopped there)",
                     i, i
                 ),
                 Some(i) => {
-                    side_by_side(i, ("recorded", rec.merges.get(i)), ("re-run", log.merges.get(i)));
+                    side_by_side(
+                        i,
+                        ("recorded", rec.merges.get(i)),
+                        ("re-run", log.merges.get(i)),
+                    );
                     return Ok(ExitCode::FAILURE);
                 }
             }
@@ -150,7 +179,10 @@ impl ReplayCmd {
                 bail!("{flag} must be a finite number ≥ 0, got {v}");
             }
         }
-        let params = ResolvedParams { weights, ..rec.params };
+        let params = ResolvedParams {
+            weights,
+            ..rec.params
+        };
         let prefix = match &self.output {
             Some(p) => p.clone(),
             None => {
@@ -158,11 +190,23 @@ impl ReplayCmd {
                     .file_stem()
                     .map(|s| s.to_string_lossy().to_string())
                     .unwrap_or_else(|| "scene".into());
-                std::fs::create_dir_all("recordings").context("recordings: cannot create the default output directory")?;
-                PathBuf::from("recordings").join(format!("{stem}-a{}-b{}-c{}", weights.a, weights.b, weights.c))
+                std::fs::create_dir_all("recordings")
+                    .context("recordings: cannot create the default output directory")?;
+                PathBuf::from("recordings").join(format!(
+                    "{stem}-a{}-b{}-c{}",
+                    weights.a, weights.b, weights.c
+                ))
             }
         };
-        let written = record(&loaded.scene, &loaded.source, &params, self.detail, &prefix, self.force, false)?;
+        let written = record(
+            &loaded.scene,
+            &loaded.source,
+            &params,
+            self.detail,
+            &prefix,
+            self.force,
+            false,
+        )?;
         let Some(g) = &written.grouping else {
             report(&written, &loaded.scene);
             return Ok(ExitCode::from(130));
@@ -170,16 +214,35 @@ impl ReplayCmd {
         let log = rerun(loaded, &params);
         let pairs = |m: &[Merge]| m.iter().map(|x| (x.a, x.b)).collect::<Vec<_>>();
         let (old_pairs, new_pairs) = (pairs(&rec.merges), pairs(&log.merges));
-        match (0..old_pairs.len().max(new_pairs.len())).find(|&i| old_pairs.get(i) != new_pairs.get(i)) {
-            None => println!("the same pairs merge in the same order ({} merges); only costs differ", log.merges.len()),
-            Some(i) => side_by_side(i, ("recorded", rec.merges.get(i)), ("re-weighted", log.merges.get(i))),
+        match (0..old_pairs.len().max(new_pairs.len()))
+            .find(|&i| old_pairs.get(i) != new_pairs.get(i))
+        {
+            None => println!(
+                "the same pairs merge in the same order ({} merges); only costs differ",
+                log.merges.len()
+            ),
+            Some(i) => side_by_side(
+                i,
+                ("recorded", rec.merges.get(i)),
+                ("re-weighted", log.merges.get(i)),
+            ),
         }
         let old = tree_of(rec, loaded)?;
         let (ob, obmax) = balance_stats(&rec.merges);
         let (nb, nbmax) = balance_stats(&log.merges);
         println!("  {:<22} {:>12} {:>12}", "", "recorded", "re-weighted");
-        println!("  {:<22} {:>12} {:>12}", "depth max", old.depth_max(), g.tree.depth_max());
-        println!("  {:<22} {:>12.3} {:>12.3}", "depth mean", old.depth_mean(), g.tree.depth_mean());
+        println!(
+            "  {:<22} {:>12} {:>12}",
+            "depth max",
+            old.depth_max(),
+            g.tree.depth_max()
+        );
+        println!(
+            "  {:<22} {:>12.3} {:>12.3}",
+            "depth mean",
+            old.depth_mean(),
+            g.tree.depth_mean()
+        );
         println!("  {:<22} {:>12.3} {:>12.3}", "Balance mean", ob, nb);
         println!("  {:<22} {:>12.3} {:>12.3}", "Balance max", obmax, nbmax);
         println!("  {:<22} {:>12} {:>12}", "rounds", rec.rounds, g.rounds);
