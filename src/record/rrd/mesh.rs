@@ -1,0 +1,76 @@
+//! The primitives as one shaded triangle mesh, shared by `scene/primitives` and `levels/leaves`.
+//!
+//! Every primitive gets its own copies of its vertices, each with the normalised sum of the
+//! area-weighted normals of the primitive's triangles at that vertex: a planar polygon is shaded
+//! flat and a convex polyhedron smoothly, and neighbouring primitives do not blur into each
+//! other. Degenerate triangles contribute no normal; a vertex with none gets +z.
+
+use crate::geom::{P3, V3};
+use crate::scene::Scene;
+
+/// Vertices, normals and per-primitive triangles of the scene's drawing.
+pub(super) struct PrimMesh {
+    /// Vertex positions relative to the scene origin.
+    pub(super) positions: Vec<[f32; 3]>,
+    /// Unit vertex normals.
+    pub(super) normals: Vec<[f32; 3]>,
+    /// Offsets into `tris`, length N + 1.
+    tri_start: Vec<u32>,
+    /// Triangles as indices into `positions`.
+    tris: Vec<[u32; 3]>,
+}
+
+impl PrimMesh {
+    /// Builds the mesh of `scene` with positions relative to `origin`.
+    pub(super) fn new(scene: &Scene, origin: &P3) -> PrimMesh {
+        let mut m = PrimMesh {
+            positions: Vec::with_capacity(scene.vertex_refs()),
+            normals: Vec::with_capacity(scene.vertex_refs()),
+            tri_start: Vec::with_capacity(scene.len() + 1),
+            tris: Vec::with_capacity(scene.tris.len()),
+        };
+        m.tri_start.push(0);
+        let mut local: Vec<(u32, V3)> = Vec::new();
+        for i in 0..scene.len() {
+            let base = m.positions.len() as u32;
+            local.clear();
+            local.extend(scene.prim(i).iter().map(|&v| (v, V3::zeros())));
+            let slot = |local: &[(u32, V3)], v: u32| local.iter().position(|&(w, _)| w == v);
+            for t in scene.prim_tris(i) {
+                let [a, b, c] = t.map(|v| scene.points[v as usize]);
+                let n = (b - a).cross(&(c - a));
+                let mut idx = [0u32; 3];
+                for (k, &v) in t.iter().enumerate() {
+                    let s = slot(&local, v).unwrap_or_else(|| {
+                        local.push((v, V3::zeros()));
+                        local.len() - 1
+                    });
+                    if n.iter().all(|x| x.is_finite()) {
+                        local[s].1 += n;
+                    }
+                    idx[k] = base + s as u32;
+                }
+                m.tris.push(idx);
+            }
+            for &(v, n) in &local {
+                m.positions
+                    .push(super::rel(&scene.points[v as usize], origin));
+                let len = n.norm();
+                let n = if len > 0.0 { n / len } else { V3::z() };
+                m.normals.push([n.x as f32, n.y as f32, n.z as f32]);
+            }
+            m.tri_start.push(m.tris.len() as u32);
+        }
+        m
+    }
+
+    /// Every triangle.
+    pub(super) fn all_tris(&self) -> &[[u32; 3]] {
+        &self.tris
+    }
+
+    /// Triangles of primitive `i`.
+    pub(super) fn prim_tris(&self, i: u32) -> &[[u32; 3]] {
+        &self.tris[self.tri_start[i as usize] as usize..self.tri_start[i as usize + 1] as usize]
+    }
+}

@@ -1,0 +1,445 @@
+//! The Rerun `.rrd` recorder: the grouping run as a file for the Rerun viewer (SDK 0.36.3).
+//!
+//! [`RrdRecorder`] is an [`Observer`]; it writes with the SDK's RRD encoder through a file sink
+//! that reports write errors (`sink.rs`; no viewer is spawned) and embeds a blueprint
+//! (`blueprint.rs`) so the file opens on a useful layout.
+//!
+//! # Timelines
+//!
+//! | timeline | kind     | one tick per |
+//! |----------|----------|--------------|
+//! | `merge`  | sequence | merge (tick = merge step, 0..N−1) |
+//! | `round`  | sequence | DLimit round (0 = first round) |
+//! | `level`  | sequence | Subset Tree depth d, 0..=depth max |
+//!
+//! The wall-clock `log_time` timeline is switched off with
+//! `RecordingStream::set_log_time_enabled(false)`, and every temporal row is sent with
+//! `send_columns`, which never injects `log_time`/`log_tick`; the file is therefore indexed only
+//! by the three timelines above. (The blueprint, a separate store in the same file, is written by
+//! the SDK's own blueprint stream and carries `log_time`; it holds no recorded data.)
+//!
+//! # Entities
+//!
+//! All 3D positions are `f32` relative to the scene origin (the centre of the scene's AABB); a
+//! static `Transform3D` translation by that origin at `scene`, `grouping` and `levels` puts them
+//! back in scene coordinates, so scenes far from the world origin keep their precision.
+//!
+//! | entity | archetype | time | `--detail` | content |
+//! |--------|-----------|------|------------|---------|
+//! | `/` | `ViewCoordinates` | static | all | right-handed, Z up (the generated scenes' convention) |
+//! | `scene`, `grouping`, `levels` | `Transform3D` | static | all | translation by the scene origin |
+//! | `scene/primitives` | `Mesh3D` | static | all | every input primitive in one shaded mesh, light grey |
+//! | `grouping/merge/pair` | `Boxes3D` (2 boxes) | `merge`, `round` | merges, full | the AABBs of the two merged bodies (orange) |
+//! | `grouping/merge/new` | `Boxes3D` (1 box) | `merge`, `round` | merges, full | the AABB of the new body (green) |
+//! | `grouping/active` | `Boxes3D` | `round`, `merge` | merges, full | at each round start, the AABBs of all active bodies (blue) |
+//! | `series/cost`, `series/diameter`, `series/fill`, `series/balance` | `Scalars` | `merge` | all | Cost, diameter, Fill and Balance of each merge |
+//! | `series/dlimit`, `series/glimit` | `Scalars` | `merge` | all | DLimit and GLimit in force at each merge |
+//! | `series/queue_len` | `Scalars` | `merge` | all | MPairs entries left after each pop |
+//! | `log/doublings` | `TextLog` | `merge`, `round` | all | one line per round start (DLimit, GLimit, active, dormant, pairs), per doubling and at the finish |
+//! | `levels/spheres` | `Ellipsoids3D` | `level` | levels, full | interior nodes of the cut at depth d, as translucent spheres |
+//! | `levels/leaves` | `Mesh3D` | `level` | levels, full | leaves in the cut at depth d, as their polygons (vertices once at d = 0, then only triangle indices) |
+//!
+//! Hull Wrapper Trees, once built, belong at `levels/hulls` (`Mesh3D` per level) beside
+//! `levels/spheres`. Run metadata (scene, hash, parameters) is a recording property
+//! (`__properties/wraptree`) and the recording is named after the scene.
+//!
+//! The per-merge series and boxes are buffered and sent as columns every 4,096 merges
+//! (`columns::BATCH`), so memory stays bounded and most of a long run is already on its way to
+//! the file when it is interrupted; [`RrdRecorder::finish`] (also called after Ctrl-C) sends the
+//! rest and ends the file with its footer.
+//!
+//! The recording id is derived from the scene's SHA-256 and the resolved parameters (not the
+//! detail level), so recordings of the same run share it and the viewer shows them as one.
+
+mod blueprint;
+mod columns;
+mod levels;
+mod mesh;
+mod sink;
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{anyhow, bail};
+use rerun::external::arrow::array::Array as _;
+use rerun::{AsComponents, RecordingStream, SerializedComponentColumn, TimeColumn};
+use sha2::{Digest, Sha256};
+
+use crate::geom::{Aabb, P3};
+use crate::grouping::{Event, Observer};
+use crate::record::{Detail, Outcome, RunInfo};
+use columns::MergeColumns;
+use mesh::PrimMesh;
+use sink::RrdFile;
+
+/// Light grey of the input primitives.
+const SCENE_GREY: u32 = 0xC8C8C8FF;
+/// Blue of the active bodies' boxes.
+const ACTIVE_BLUE: u32 = 0x3C78D8A0;
+
+/// Records a grouping run to a Rerun `.rrd` file; see the [module docs](self) for its layout.
+pub struct RrdRecorder {
+    rec: Option<RecordingStream>,
+    file: RrdFile,
+    path: PathBuf,
+    detail: Detail,
+    origin: P3,
+    /// Box of every body so far, relative to `origin` (only when per-merge geometry is written).
+    boxes: Vec<BoxF32>,
+    columns: MergeColumns,
+    round: u32,
+    dlimit: f64,
+    glimit: f64,
+    /// Merges seen so far: the `merge` tick of the next merge.
+    merges: u32,
+    /// The primitives' mesh, kept for the levels written by `finish`.
+    mesh: Option<PrimMesh>,
+    error: Option<anyhow::Error>,
+}
+
+/// An AABB as (centre, half size) in `f32` relative to the scene origin.
+#[derive(Clone, Copy, Debug)]
+struct BoxF32 {
+    center: [f32; 3],
+    half: [f32; 3],
+}
+
+impl BoxF32 {
+    fn new(b: &Aabb, origin: &P3) -> BoxF32 {
+        let e = b.extents() / 2.0;
+        BoxF32 {
+            center: rel(&b.center(), origin),
+            half: [e.x as f32, e.y as f32, e.z as f32],
+        }
+    }
+}
+
+/// `p` relative to `origin`, as `f32`.
+fn rel(p: &P3, origin: &P3) -> [f32; 3] {
+    let d = p - origin;
+    [d.x as f32, d.y as f32, d.z as f32]
+}
+
+/// The recording id: a UUID-shaped hex digest of the scene hash and the resolved parameters.
+fn recording_id(info: &RunInfo<'_>) -> String {
+    let mut h = Sha256::new();
+    h.update(b"wraptree rrd\0");
+    h.update(info.source.sha256.as_bytes());
+    h.update(b"\0");
+    h.update(
+        serde_json::to_string(info.params)
+            .unwrap_or_default()
+            .as_bytes(),
+    );
+    let hex: String = h.finalize()[..16]
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    format!(
+        "{}-{}-{}-{}-{}",
+        &hex[..8],
+        &hex[8..12],
+        &hex[12..16],
+        &hex[16..20],
+        &hex[20..]
+    )
+}
+
+/// Sends one row of `arch` at the given sequence times, without `log_time`.
+fn send_at(
+    rec: &RecordingStream,
+    entity: &str,
+    times: &[(&'static str, i64)],
+    arch: &dyn AsComponents,
+) -> anyhow::Result<()> {
+    let columns = arch
+        .as_serialized_batches()
+        .into_iter()
+        .map(|batch| {
+            let n = batch.array.len();
+            batch.partitioned([n])
+        })
+        .collect::<Result<Vec<SerializedComponentColumn>, _>>()?;
+    let index = times
+        .iter()
+        .map(|&(name, t)| TimeColumn::new_sequence(name, [t]));
+    rec.send_columns(entity, index, columns)?;
+    Ok(())
+}
+
+impl RrdRecorder {
+    /// Creates `path` (replacing it) and writes the blueprint, run metadata and the static scene.
+    ///
+    /// Fails when the file cannot be created or the first writes fail.
+    pub fn new(path: &Path, info: &RunInfo<'_>) -> anyhow::Result<Self> {
+        let scene = info.scene;
+        let file = RrdFile::create(path)
+            .map_err(|e| file_error(path, "cannot create the Rerun recording", e))?;
+        let rec = rerun::RecordingStreamBuilder::new("wraptree")
+            .recording_id(recording_id(info))
+            .enabled(true)
+            .with_blueprint(blueprint::layout(info.detail))
+            .set_sinks(vec![Box::new(file.clone()) as Box<dyn rerun::sink::LogSink>])
+            .map_err(|e| file_error(path, "cannot create the Rerun recording", e))?;
+        rec.set_log_time_enabled(false);
+        rec.set_log_tick_enabled(false);
+
+        let bbox = scene.aabb();
+        let center = bbox.center();
+        let origin = if center.iter().all(|c| c.is_finite()) {
+            center
+        } else {
+            P3::origin()
+        };
+        let boxes = if info.detail.merges() {
+            let mut b = Vec::with_capacity(2 * scene.len());
+            b.extend((0..scene.len()).map(|i| BoxF32::new(&scene.prim_aabb(i), &origin)));
+            b
+        } else {
+            Vec::new()
+        };
+        let mut recorder = RrdRecorder {
+            rec: Some(rec),
+            file,
+            path: path.to_path_buf(),
+            detail: info.detail,
+            origin,
+            boxes,
+            columns: MergeColumns::default(),
+            round: 0,
+            dlimit: info.params.dlimit0,
+            glimit: info.params.glimit0,
+            merges: 0,
+            mesh: None,
+            error: None,
+        };
+        let mesh = PrimMesh::new(scene, &origin);
+        recorder
+            .write_header(info, &mesh)
+            .map_err(|e| file_error(path, "cannot write the Rerun recording", e))?;
+        if info.detail.levels() {
+            recorder.mesh = Some(mesh);
+        }
+        Ok(recorder)
+    }
+
+    fn rec(&self) -> anyhow::Result<&RecordingStream> {
+        self.rec.as_ref().ok_or_else(closed)
+    }
+
+    /// Metadata, transforms, the scene mesh and static styling.
+    fn write_header(&self, info: &RunInfo<'_>, mesh: &PrimMesh) -> anyhow::Result<()> {
+        let rec = self.rec()?;
+        let scene = info.scene;
+        rec.send_recording_name(format!(
+            "{} ({} primitives)",
+            info.source.file_name,
+            scene.len()
+        ))?;
+        let text = |s: String| [rerun::components::Text::from(s)];
+        rec.send_property(
+            "wraptree",
+            &rerun::AnyValues::default()
+                .with_component::<rerun::components::Text>(
+                    "version",
+                    text(env!("CARGO_PKG_VERSION").into()),
+                )
+                .with_component::<rerun::components::Text>(
+                    "scene",
+                    text(info.source.file_name.clone()),
+                )
+                .with_component::<rerun::components::Text>(
+                    "sha256",
+                    text(info.source.sha256.clone()),
+                )
+                .with_component::<rerun::components::Text>(
+                    "primitives",
+                    text(scene.len().to_string()),
+                )
+                .with_component::<rerun::components::Text>(
+                    "params",
+                    text(serde_json::to_string(info.params)?),
+                )
+                .with_component::<rerun::components::Text>(
+                    "detail",
+                    text(format!("{:?}", info.detail).to_lowercase()),
+                ),
+        )?;
+        let o = self.origin;
+        for root in ["scene", "grouping", "levels"] {
+            rec.log_static(
+                root,
+                &rerun::Transform3D::from_translation([o.x as f32, o.y as f32, o.z as f32]),
+            )?;
+        }
+        rec.log_static("/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
+        rec.log_static(
+            "scene/primitives",
+            &rerun::Mesh3D::new(mesh.positions.iter().copied())
+                .with_vertex_normals(mesh.normals.iter().copied())
+                .with_triangle_indices(mesh.all_tris().iter().copied())
+                .with_albedo_factor(SCENE_GREY),
+        )?;
+        for (path, name) in columns::SERIES {
+            rec.log_static(path, &rerun::SeriesLines::new().with_names([name]))?;
+        }
+        if self.detail.merges() {
+            columns::log_styles(rec)?;
+            rec.log_static(
+                "grouping/active",
+                &rerun::Boxes3D::update_fields()
+                    .with_colors([ACTIVE_BLUE])
+                    .with_radii([rerun::components::Radius::new_ui_points(0.5)])
+                    .with_fill_mode(rerun::components::FillMode::MajorWireframe),
+            )?;
+        }
+        Ok(())
+    }
+
+    fn text(&self, round: u32, line: String) -> anyhow::Result<()> {
+        let times = [("merge", self.merges as i64), ("round", round as i64)];
+        let log = rerun::TextLog::new(line).with_level(rerun::TextLogLevel::INFO);
+        send_at(self.rec()?, "log/doublings", &times, &log)
+    }
+
+    fn handle(&mut self, event: &Event<'_>) -> anyhow::Result<()> {
+        match *event {
+            Event::RoundStart {
+                round,
+                dlimit,
+                glimit,
+                active,
+                dormant,
+                pairs,
+            } => {
+                self.round = round;
+                self.dlimit = dlimit;
+                self.glimit = glimit;
+                let n = active.len();
+                let limits = format!("DLimit {dlimit:.6e}, GLimit {glimit:.6e}");
+                let sets = format!("{n} active, {dormant} dormant, {pairs} pairs");
+                self.text(round, format!("round {round}: {limits}, {sets}"))?;
+                if self.detail.merges() {
+                    let (centers, halves): (Vec<_>, Vec<_>) = active
+                        .iter()
+                        .map(|&b| {
+                            let b = self.body(b)?;
+                            Ok((b.center, b.half))
+                        })
+                        .collect::<anyhow::Result<Vec<_>>>()?
+                        .into_iter()
+                        .unzip();
+                    let times = [("merge", self.merges as i64), ("round", round as i64)];
+                    let boxes = rerun::Boxes3D::update_fields()
+                        .with_centers(centers)
+                        .with_half_sizes(halves);
+                    send_at(self.rec()?, "grouping/active", &times, &boxes)?;
+                }
+            }
+            Event::Merge(m) => {
+                let boxes = if self.detail.merges() {
+                    let new = BoxF32::new(&m.aabb, &self.origin);
+                    let expected = self.boxes.len();
+                    if m.new as usize != expected {
+                        bail!(
+                            "merge {} creates body {}, expected {expected}",
+                            m.step,
+                            m.new
+                        );
+                    }
+                    let pair = [self.body(m.a)?, self.body(m.b)?];
+                    self.boxes.push(new);
+                    Some((pair, new))
+                } else {
+                    None
+                };
+                self.columns.push(&m, self.dlimit, self.glimit, boxes);
+                self.merges = m.step + 1;
+                if self.columns.len() >= columns::BATCH {
+                    let rec = self.rec.as_ref().ok_or_else(closed)?;
+                    self.columns.flush(rec)?;
+                }
+            }
+            Event::Dormant { .. } => {}
+            Event::Doubling {
+                round,
+                merges,
+                dlimit,
+                glimit,
+            } => {
+                let limits = format!("DLimit → {dlimit:.6e}, GLimit → {glimit:.6e}");
+                let line = format!("doubling after round {round} ({merges} merges): {limits}");
+                self.text(round, line)?;
+            }
+            Event::Finish {
+                root,
+                rounds,
+                merges,
+            } => {
+                let line =
+                    format!("finished: root {root} after {rounds} rounds and {merges} merges");
+                self.text(self.round, line)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn body(&self, id: u32) -> anyhow::Result<BoxF32> {
+        self.boxes
+            .get(id as usize)
+            .copied()
+            .ok_or_else(|| anyhow!("event names body {id}, which does not exist yet"))
+    }
+
+    /// Flushes the series, writes the tree levels (when the detail asks for them and the run
+    /// finished), then ends the file with the RRD footer, flushes and syncs it.
+    ///
+    /// Returns the first error met while recording, if any.
+    pub fn finish(mut self, outcome: &Outcome<'_>) -> anyhow::Result<()> {
+        let what = "cannot write the Rerun recording";
+        let path = self.path.clone();
+        let fail = |e: anyhow::Error| file_error(&path, what, e);
+        if let Some(err) = self.error.take() {
+            return Err(fail(err));
+        }
+        self.write_tail(outcome).map_err(fail)?;
+        if let Some(rec) = self.rec.take() {
+            rec.flush_blocking().map_err(|e| fail(e.into()))?;
+            // Dropping the last handle shuts the SDK's pipeline down: nothing more reaches
+            // the file, which `close` then ends with the RRD footer.
+            drop(rec);
+        }
+        self.file.close().map_err(fail)
+    }
+
+    fn write_tail(&mut self, outcome: &Outcome<'_>) -> anyhow::Result<()> {
+        let rec = self.rec.as_ref().ok_or_else(closed)?;
+        self.columns.flush(rec)?;
+        if let (Some(mesh), Some(grouping), Some(spheres)) =
+            (&self.mesh, outcome.grouping, outcome.spheres)
+        {
+            levels::log_levels(rec, mesh, &grouping.tree, spheres, &self.origin)?;
+        }
+        Ok(())
+    }
+}
+
+impl Observer for RrdRecorder {
+    fn on_event(&mut self, event: &Event<'_>) {
+        if self.error.is_none()
+            && let Err(err) = self.handle(event)
+        {
+            self.error = Some(err);
+        }
+    }
+}
+
+fn closed() -> anyhow::Error {
+    anyhow!("the recording is closed")
+}
+
+/// One line `PATH: WHAT: cause`, with only the root cause (the SDK's errors repeat their
+/// sources in their own messages).
+fn file_error(path: &Path, what: &str, err: impl Into<anyhow::Error>) -> anyhow::Error {
+    let err = err.into();
+    anyhow!("{}: {what}: {}", path.display(), err.root_cause())
+}

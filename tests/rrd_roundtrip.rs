@@ -1,0 +1,373 @@
+//! The `.rrd` recorder, read back by independent readers from PyPI's `rerun-sdk==0.36.3`
+//! (installed by `.ci/run`): `rerun rrd verify` must accept each file, and the package's
+//! `rerun.experimental.RrdReader` lists its stores, entities, timelines and time values.
+//! Missing tools make these tests fail, never pass.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+use std::process::Command;
+
+use wraptree::grouping::{EventLog, Grouping, Params, Tee, Weights, group};
+use wraptree::record::rrd::RrdRecorder;
+use wraptree::record::{Detail, Outcome, RunInfo};
+use wraptree::scene::{LoadOptions, Loaded, generate, load_bytes};
+use wraptree::wrap::{SphereMethod, sphere_tree};
+
+/// Prints a JSON summary of the first recording store of the file in `argv[1]`.
+const READER: &str = r#"
+import json, sys
+from rerun.experimental import RrdReader
+r = RrdReader(sys.argv[1])
+out = {"recordings": [[s.application_id, s.recording_id] for s in r.recordings()],
+       "blueprints": len(r.blueprints()), "entities": {}}
+for c in r.stream():
+    e = out["entities"].setdefault(c.entity_path,
+        {"rows": 0, "static": False, "timelines": [], "merge": [], "level": [], "round": []})
+    e["rows"] += c.num_rows
+    e["static"] = e["static"] or c.is_static
+    for t in c.timeline_names:
+        if t not in e["timelines"]:
+            e["timelines"].append(t)
+    rb = c.to_record_batch()
+    for t in ("merge", "level", "round"):
+        if t in rb.schema.names:
+            e[t] += rb.column(t).to_pylist()
+print(json.dumps(out))
+"#;
+
+#[derive(serde::Deserialize)]
+struct Summary {
+    recordings: Vec<(String, String)>,
+    blueprints: usize,
+    entities: BTreeMap<String, Entity>,
+}
+
+#[derive(serde::Deserialize)]
+struct Entity {
+    rows: usize,
+    #[serde(rename = "static")]
+    is_static: bool,
+    timelines: Vec<String>,
+    merge: Vec<i64>,
+    level: Vec<i64>,
+    round: Vec<i64>,
+}
+
+/// An OBJ of 48 right triangles of four sizes on a 1.5-spaced grid: the gaps exceed the first
+/// GLimit, so the run needs several DLimit doublings.
+fn grid_obj() -> Vec<u8> {
+    let mut s = String::new();
+    let mut v = 0;
+    for i in 0..8 {
+        for j in 0..6 {
+            let (x, y, z) = (i as f64 * 1.5, j as f64 * 1.5, ((i + j) % 3) as f64 * 0.1);
+            let size = 0.2 + 0.2 * ((i * 7 + j * 3) % 4) as f64;
+            s += &format!(
+                "v {x} {y} {z}\nv {} {y} {z}\nv {x} {} {z}\n",
+                x + size,
+                y + size
+            );
+            s += &format!("f {} {} {}\n", v + 1, v + 2, v + 3);
+            v += 3;
+        }
+    }
+    s.into_bytes()
+}
+
+struct Run {
+    grouping: Grouping,
+    log: EventLog,
+    summary: Summary,
+}
+
+/// Groups `loaded` while recording it to `path` at `detail`.
+fn write(path: &Path, loaded: &Loaded, detail: Detail, params: &Params) -> (Grouping, EventLog) {
+    let scene = &loaded.scene;
+    let resolved = params.resolve(scene);
+    let info = RunInfo {
+        scene,
+        source: &loaded.source,
+        params: &resolved,
+        detail,
+    };
+    let mut recorder = RrdRecorder::new(path, &info).expect("recorder starts");
+    let mut log = EventLog::default();
+    let grouping = group(scene, params, Tee(&mut recorder, &mut log));
+    let spheres = sphere_tree(&grouping.tree, scene, SphereMethod::default());
+    let outcome = Outcome {
+        grouping: Some(&grouping),
+        spheres: Some(&spheres),
+        merges: log.merges.len() as u32,
+        rounds: grouping.rounds,
+        seconds: 0.0,
+    };
+    recorder.finish(&outcome).expect("recording finishes");
+    (grouping, log)
+}
+
+/// Records the grid scene at `detail`, checks the file with the CLI and summarises it with
+/// the Python reader.
+fn record(dir: &Path, detail: Detail, params: &Params) -> Run {
+    let loaded =
+        load_bytes("grid.obj", grid_obj(), &LoadOptions::default()).expect("grid scene loads");
+    let path = dir.join(format!("grid-{detail:?}.rrd"));
+    let (grouping, log) = write(&path, &loaded, detail, params);
+
+    let verify = Command::new("rerun")
+        .args(["rrd", "verify"])
+        .arg(&path)
+        .output()
+        .expect("the `rerun` CLI (PyPI rerun-sdk==0.36.3, installed by .ci/run) must be on PATH");
+    assert!(
+        verify.status.success(),
+        "rerun rrd verify {} failed:\n{}",
+        path.display(),
+        String::from_utf8_lossy(&verify.stderr)
+    );
+    let out = Command::new("python3")
+        .args(["-c", READER])
+        .arg(&path)
+        .output()
+        .expect("python3 with rerun-sdk==0.36.3 (installed by .ci/run) must be on PATH");
+    assert!(
+        out.status.success(),
+        "the Python reader (needs `pip install rerun-sdk==0.36.3`) failed on {}:\n{}",
+        path.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary = serde_json::from_slice(&out.stdout).expect("reader prints JSON");
+    Run {
+        grouping,
+        log,
+        summary,
+    }
+}
+
+fn range(n: usize) -> Vec<i64> {
+    (0..n as i64).collect()
+}
+
+fn sorted(mut v: Vec<i64>) -> Vec<i64> {
+    v.sort();
+    v
+}
+
+/// Checks one recording's entities, timelines and row counts against its event log.
+fn check(run: &Run, detail: Detail) {
+    let s = &run.summary;
+    let n = run.grouping.tree.leaves();
+    assert_eq!(s.recordings.len(), 1, "one recording store");
+    assert_eq!(s.recordings[0].0, "wraptree");
+    assert!(s.blueprints >= 1, "the file carries a blueprint");
+    assert!(
+        run.log.doublings.len() >= 2,
+        "the scene exercises DLimit doublings"
+    );
+
+    let mut want: BTreeSet<&str> = [
+        "/scene/primitives",
+        "/log/doublings",
+        "/series/cost",
+        "/series/diameter",
+        "/series/fill",
+        "/series/balance",
+        "/series/dlimit",
+        "/series/glimit",
+        "/series/queue_len",
+    ]
+    .into();
+    if detail.merges() {
+        want.extend([
+            "/grouping/merge/pair",
+            "/grouping/merge/new",
+            "/grouping/active",
+        ]);
+    }
+    if detail.levels() {
+        want.extend(["/levels/spheres", "/levels/leaves"]);
+    }
+    let data: BTreeSet<&str> = s
+        .entities
+        .keys()
+        .map(String::as_str)
+        .filter(|e| {
+            !e.starts_with("/__properties") && !["/", "/scene", "/grouping", "/levels"].contains(e)
+        })
+        .collect();
+    assert_eq!(data, want, "entity paths at {detail:?}");
+
+    let timelines: BTreeSet<&str> = s
+        .entities
+        .values()
+        .flat_map(|e| e.timelines.iter().map(String::as_str))
+        .collect();
+    let mut want_tl: BTreeSet<&str> = ["merge", "round"].into();
+    if detail.levels() {
+        want_tl.insert("level");
+    }
+    assert_eq!(
+        timelines, want_tl,
+        "timelines at {detail:?} (no log_time, no log_tick)"
+    );
+
+    assert!(s.entities["/scene/primitives"].is_static);
+    for series in [
+        "cost",
+        "diameter",
+        "fill",
+        "balance",
+        "dlimit",
+        "glimit",
+        "queue_len",
+    ] {
+        let e = &s.entities[&format!("/series/{series}")];
+        let temporal = e.rows - usize::from(e.is_static);
+        assert_eq!(temporal, n - 1, "{series}: one row per merge");
+        assert_eq!(
+            sorted(e.merge.clone()),
+            range(n - 1),
+            "{series}: merge ticks 0..N-1"
+        );
+    }
+    let text = &s.entities["/log/doublings"];
+    assert_eq!(
+        text.rows,
+        run.log.rounds.len() + run.log.doublings.len() + 1
+    );
+    if detail.merges() {
+        for e in ["/grouping/merge/pair", "/grouping/merge/new"] {
+            let e = &s.entities[e];
+            assert_eq!(sorted(e.merge.clone()), range(n - 1));
+            let rounds: Vec<i64> = run.log.merges.iter().map(|m| m.round as i64).collect();
+            assert_eq!(sorted(e.round.clone()), sorted(rounds));
+        }
+        let active = &s.entities["/grouping/active"];
+        assert_eq!(
+            sorted(active.round.clone()),
+            range(run.log.rounds.len()),
+            "one active set per round"
+        );
+    }
+    if detail.levels() {
+        let levels = range(run.grouping.tree.depth_max() as usize + 1);
+        for e in ["/levels/spheres", "/levels/leaves"] {
+            assert_eq!(
+                sorted(s.entities[e].level.clone()),
+                levels,
+                "{e}: one row per level"
+            );
+        }
+    }
+}
+
+#[test]
+fn every_detail_reads_back_with_the_expected_entities_and_timelines() {
+    let dir = tempfile::tempdir().unwrap();
+    let params = Params::default();
+    let mut ids = BTreeSet::new();
+    for detail in [Detail::Levels, Detail::Merges, Detail::Full] {
+        let run = record(dir.path(), detail, &params);
+        check(&run, detail);
+        ids.insert(run.summary.recordings[0].1.clone());
+    }
+    assert_eq!(
+        ids.len(),
+        1,
+        "the same scene and parameters share one recording id"
+    );
+
+    let other = Params {
+        weights: Weights {
+            a: 1.0,
+            b: 1.0,
+            c: 0.5,
+        },
+        ..Params::default()
+    };
+    let run = record(dir.path(), Detail::Levels, &other);
+    assert!(
+        !ids.contains(&run.summary.recordings[0].1),
+        "other parameters, other recording id"
+    );
+}
+
+#[test]
+fn an_unwritable_path_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let loaded = load_bytes("grid.obj", grid_obj(), &LoadOptions::default()).unwrap();
+    let params = Params::default().resolve(&loaded.scene);
+    let info = RunInfo {
+        scene: &loaded.scene,
+        source: &loaded.source,
+        params: &params,
+        detail: Detail::Full,
+    };
+    let path = dir.path().join("missing").join("x.rrd");
+    let err = RrdRecorder::new(&path, &info)
+        .err()
+        .expect("a missing directory fails");
+    let msg = format!("{err:#}");
+    assert!(
+        msg.contains("missing/x.rrd"),
+        "the error names the file: {msg}"
+    );
+}
+
+#[test]
+fn a_full_recording_of_the_12144_polygon_scene_stays_under_20_mb() {
+    let robots = generate::replicate(&generate::robot_base(), 44, 7);
+    let mut obj = Vec::new();
+    robots.write_obj(&mut obj).unwrap();
+    let loaded = load_bytes("robots44.obj", obj, &LoadOptions::default()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("robots44.rrd");
+    let start = std::time::Instant::now();
+    write(&path, &loaded, Detail::Full, &Params::default());
+    let bytes = std::fs::metadata(&path).unwrap().len();
+    eprintln!(
+        "{} primitives: full .rrd {:.2} MB in {:.2} s",
+        loaded.scene.len(),
+        bytes as f64 / 1e6,
+        start.elapsed().as_secs_f64()
+    );
+    assert!(bytes <= 20_000_000, "{bytes} bytes exceed 20 MB");
+}
+
+/// A write error mid-run (`/dev/full` accepts the open and fails every write) is reported by
+/// `new` or `finish` as one line naming the file, and nothing blocks.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_full_disk_is_a_clear_error() {
+    let loaded = load_bytes("grid.obj", grid_obj(), &LoadOptions::default()).unwrap();
+    let params = Params::default();
+    let resolved = params.resolve(&loaded.scene);
+    let info = RunInfo {
+        scene: &loaded.scene,
+        source: &loaded.source,
+        params: &resolved,
+        detail: Detail::Full,
+    };
+    let path = Path::new("/dev/full");
+    let err = match RrdRecorder::new(path, &info) {
+        Err(err) => err,
+        Ok(mut recorder) => {
+            let g = group(&loaded.scene, &params, &mut recorder);
+            let outcome = Outcome {
+                grouping: Some(&g),
+                spheres: None,
+                merges: loaded.scene.len() as u32 - 1,
+                rounds: g.rounds,
+                seconds: 0.0,
+            };
+            recorder
+                .finish(&outcome)
+                .expect_err("writing to /dev/full fails")
+        }
+    };
+    let msg = format!("{err:#}");
+    assert!(
+        msg.starts_with("/dev/full: ") && msg.contains("No space left"),
+        "{msg}"
+    );
+    assert!(!msg.contains('\n'), "one line: {msg}");
+}
