@@ -79,6 +79,16 @@ impl Pending {
     /// interrupted recording aside without touching an existing one).
     pub fn commit_to(self, other: Option<&Path>) -> Result<PathBuf> {
         let dest = other.map(Path::to_path_buf).unwrap_or(self.dest);
+        // Temporary files are private (0600); the finished file gets ordinary permissions.
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let perms = std::fs::Permissions::from_mode(0o644);
+            self.tmp
+                .as_file()
+                .set_permissions(perms)
+                .with_context(|| format!("{}: cannot set permissions", dest.display()))?;
+        }
         self.tmp
             .as_file()
             .sync_all()
