@@ -4,6 +4,8 @@
 //! `foxglove-schemas-protobuf`) decodes every message and checks every level covers the scene.
 //! A missing `python3` or module makes the test fail, never pass.
 
+mod common;
+
 use std::io::{BufWriter, Cursor, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -14,29 +16,13 @@ use wraptree::record::{Detail, Outcome, RunInfo};
 use wraptree::scene::{LoadOptions, Loaded, generate, load_bytes};
 use wraptree::wrap::{SphereMethod, sphere_tree};
 
-/// An OBJ of 60 right triangles of four sizes on a spaced grid (several DLimit doublings).
-fn grid_obj() -> Vec<u8> {
-    let mut s = String::from("# test grid\n");
-    let mut v = 0;
-    for i in 0..10 {
-        for j in 0..6 {
-            let (x, y, z) = (i as f64 * 1.5, j as f64 * 1.7, ((i + j) % 3) as f64 * 0.1);
-            let size = 0.2 + 0.2 * ((i * 7 + j * 3) % 4) as f64;
-            s += &format!(
-                "v {x} {y} {z}\nv {} {y} {z}\nv {x} {} {}\n",
-                x + size,
-                y + size,
-                z + 0.05
-            );
-            s += &format!("f {} {} {}\n", v + 1, v + 2, v + 3);
-            v += 3;
-        }
-    }
-    s.into_bytes()
-}
-
 fn load_grid() -> Loaded {
-    load_bytes("grid.obj", grid_obj(), &LoadOptions::default()).expect("grid loads")
+    load_bytes(
+        "grid.obj",
+        common::grid_obj(10, 6, 1.7, 0.05),
+        &LoadOptions::default(),
+    )
+    .expect("grid loads")
 }
 
 /// Forwards only the first `left` events (an interrupted run).

@@ -3,6 +3,8 @@
 //! `rerun.experimental.RrdReader` lists its stores, entities, timelines and time values.
 //! Missing tools make these tests fail, never pass.
 
+mod common;
+
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 use std::process::Command;
@@ -53,27 +55,6 @@ struct Entity {
     round: Vec<i64>,
 }
 
-/// An OBJ of 48 right triangles of four sizes on a 1.5-spaced grid: the gaps exceed the first
-/// GLimit, so the run needs several DLimit doublings.
-fn grid_obj() -> Vec<u8> {
-    let mut s = String::new();
-    let mut v = 0;
-    for i in 0..8 {
-        for j in 0..6 {
-            let (x, y, z) = (i as f64 * 1.5, j as f64 * 1.5, ((i + j) % 3) as f64 * 0.1);
-            let size = 0.2 + 0.2 * ((i * 7 + j * 3) % 4) as f64;
-            s += &format!(
-                "v {x} {y} {z}\nv {} {y} {z}\nv {x} {} {z}\n",
-                x + size,
-                y + size
-            );
-            s += &format!("f {} {} {}\n", v + 1, v + 2, v + 3);
-            v += 3;
-        }
-    }
-    s.into_bytes()
-}
-
 struct Run {
     grouping: Grouping,
     log: EventLog,
@@ -108,8 +89,12 @@ fn write(path: &Path, loaded: &Loaded, detail: Detail, params: &Params) -> (Grou
 /// Records the grid scene at `detail`, checks the file with the CLI and summarises it with
 /// the Python reader.
 fn record(dir: &Path, detail: Detail, params: &Params) -> Run {
-    let loaded =
-        load_bytes("grid.obj", grid_obj(), &LoadOptions::default()).expect("grid scene loads");
+    let loaded = load_bytes(
+        "grid.obj",
+        common::grid_obj(8, 6, 1.5, 0.0),
+        &LoadOptions::default(),
+    )
+    .expect("grid scene loads");
     let path = dir.join(format!("grid-{detail:?}.rrd"));
     let (grouping, log) = write(&path, &loaded, detail, params);
 
@@ -294,7 +279,12 @@ fn every_detail_reads_back_with_the_expected_entities_and_timelines() {
 #[test]
 fn an_unwritable_path_is_a_clear_error() {
     let dir = tempfile::tempdir().unwrap();
-    let loaded = load_bytes("grid.obj", grid_obj(), &LoadOptions::default()).unwrap();
+    let loaded = load_bytes(
+        "grid.obj",
+        common::grid_obj(8, 6, 1.5, 0.0),
+        &LoadOptions::default(),
+    )
+    .unwrap();
     let params = Params::default().resolve(&loaded.scene);
     let info = RunInfo {
         scene: &loaded.scene,
@@ -338,7 +328,12 @@ fn a_full_recording_of_the_12144_polygon_scene_stays_under_20_mb() {
 #[cfg(target_os = "linux")]
 #[test]
 fn a_full_disk_is_a_clear_error() {
-    let loaded = load_bytes("grid.obj", grid_obj(), &LoadOptions::default()).unwrap();
+    let loaded = load_bytes(
+        "grid.obj",
+        common::grid_obj(8, 6, 1.5, 0.0),
+        &LoadOptions::default(),
+    )
+    .unwrap();
     let params = Params::default();
     let resolved = params.resolve(&loaded.scene);
     let info = RunInfo {

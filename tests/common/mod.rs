@@ -75,3 +75,26 @@ pub fn check_tree(scene: &Scene, g: &Grouping, log: &EventLog) {
         }
     }
 }
+
+/// OBJ text of `nx` × `ny` right triangles of four sizes on a grid spaced 1.5 in x and `dy` in y,
+/// the third vertex of each raised by `lift`: the gaps exceed the first GLimit, so grouping needs
+/// several DLimit doublings.
+pub fn grid_obj(nx: usize, ny: usize, dy: f64, lift: f64) -> Vec<u8> {
+    let mut s = String::from("# test grid\n");
+    let mut v = 0;
+    for i in 0..nx {
+        for j in 0..ny {
+            let (x, y, z) = (i as f64 * 1.5, j as f64 * dy, ((i + j) % 3) as f64 * 0.1);
+            let size = 0.2 + 0.2 * ((i * 7 + j * 3) % 4) as f64;
+            s += &format!(
+                "v {x} {y} {z}\nv {} {y} {z}\nv {x} {} {}\n",
+                x + size,
+                y + size,
+                z + lift
+            );
+            s += &format!("f {} {} {}\n", v + 1, v + 2, v + 3);
+            v += 3;
+        }
+    }
+    s.into_bytes()
+}
