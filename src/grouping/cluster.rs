@@ -1,17 +1,27 @@
 //! The round loop of §2.2 (steps 2–5), generic over the p-set wrapper.
+//!
+//! Partner searches (the voxel scans of steps 3 and 4b) live in [`scan`].
 
 use super::events::{Event, Merge, Observer};
 use super::hull_pset::HullBodies;
-use super::mpairs::{Entry, MPairs};
+use super::mpairs::{Entry, MPairs, Partners, order_bits};
 use super::subset_tree::{NONE, SubsetTree};
-use super::voxel_hash::{Rec, VoxelHash};
+use super::voxel_hash::VoxelHash;
 use super::{Grouping, PSet, ResolvedParams, Stats, Stopped, Weights};
 use crate::geom::Aabb;
 use crate::scene::Scene;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+mod scan;
+
 /// What the round loop needs from a p-set wrapper beyond each body's AABB and diameter.
 pub(super) trait PSetBodies {
+    /// Whether the diameter of a pair is the diagonal of the union of the two boxes (the AABB
+    /// p-set). Its Cost is then a symmetric function of the two records, bounded below by the
+    /// boxes' positions, which lets the searches visit each pair once at round start, keep
+    /// several partners per body and skip voxels that cannot improve a list
+    /// ([`scan`]). Other p-sets search for their single best partner, as in the paper.
+    const AABB: bool = false;
     /// The diameter of the body `x ∪ y` if the pair is eligible (gap ≤ `glimit`), given that
     /// their AABBs are within L∞ gap `glimit` and `merged` is the union of their AABBs.
     fn eligible(&self, x: u32, y: u32, merged: &Aabb, glimit: f64) -> Option<f64>;
@@ -23,6 +33,7 @@ pub(super) trait PSetBodies {
 struct AabbBodies;
 
 impl PSetBodies for AabbBodies {
+    const AABB: bool = true;
     #[inline(always)]
     fn eligible(&self, _: u32, _: u32, merged: &Aabb, _: f64) -> Option<f64> {
         Some(merged.diameter())
@@ -98,6 +109,7 @@ fn spread_bits(v: u64) -> u64 {
     x
 }
 
+/// The state of one grouping run.
 struct Clusterer<'s, P, O> {
     n: usize,
     weights: Weights,
@@ -106,8 +118,8 @@ struct Clusterer<'s, P, O> {
     observer: O,
     aabb: Vec<Aabb>,
     diameter: Vec<f64>,
-    /// Parent-less and not yet merged in this round's MPairs (active) — `in_hash[x]`.
-    in_hash: Vec<bool>,
+    /// Active and not yet merged (stored in the voxel hash) — `live[x]`.
+    live: Vec<bool>,
     parent: Vec<u32>,
     tag: Vec<u64>,
     merges: Vec<(u32, u32, Aabb, f64)>,
@@ -117,6 +129,12 @@ struct Clusterer<'s, P, O> {
     half_ext: [f64; 3],
     morton_scale: [f64; 3],
     mpairs: MPairs,
+    partners: Partners,
+    /// Partner list length: several for the AABB p-set, one (the best partner) otherwise.
+    k: usize,
+    /// Whether Cost lower bounds may skip voxels (AABB p-set, finite non-negative weights,
+    /// scene coordinates far from overflow).
+    prune: bool,
     stats: Stats,
     _scene: std::marker::PhantomData<&'s Scene>,
 }
@@ -144,6 +162,14 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
                 0.0
             }
         });
+        let w = params.weights;
+        let sane = |v: f64| v.is_finite() && v >= 0.0;
+        let small = |v: f64| v.abs() < 1e300;
+        let prune = P::AABB
+            && sane(w.a)
+            && sane(w.b)
+            && sane(w.c)
+            && (0..3).all(|k| small(bounds.min[k]) && small(bounds.max[k]));
         Clusterer {
             n,
             weights: params.weights,
@@ -152,83 +178,21 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
             observer,
             aabb,
             diameter: d,
-            in_hash: vec![false; total],
+            live: vec![false; total],
             parent: vec![NONE; total],
             tag: (0..total as u32).map(|i| tie_tag(params.seed, i)).collect(),
             merges: Vec::with_capacity(n - 1),
-            hash: VoxelHash::new(bounds.min),
+            hash: VoxelHash::default(),
             bounds,
             half_ext: [0.0; 3],
             morton_scale,
             mpairs: MPairs::default(),
+            partners: Partners::default(),
+            k: if P::AABB { super::mpairs::K_MAX } else { 1 },
+            prune,
             stats: Stats::default(),
             _scene: std::marker::PhantomData,
         }
-    }
-
-    /// The cheapest eligible partner of active body `x`, and the number of eligible partners.
-    #[inline]
-    fn best_partner(&mut self, x: u32, glimit: f64) -> (Option<Entry>, u32) {
-        // Specialised on A so that A = 1 and A = 0 never evaluate `powf` (which LLVM would
-        // otherwise compute speculatively for every candidate).
-        if self.weights.a == 1.0 {
-            self.scan::<1>(x, glimit)
-        } else if self.weights.a == 0.0 {
-            self.scan::<0>(x, glimit)
-        } else {
-            self.scan::<2>(x, glimit)
-        }
-    }
-
-    #[inline]
-    fn scan<const A: u8>(&mut self, x: u32, glimit: f64) -> (Option<Entry>, u32) {
-        let xa = self.aabb[x as usize];
-        let dx = self.diameter[x as usize];
-        let tx = self.tag[x as usize];
-        let mut best: Option<Entry> = None;
-        let mut eligible = 0u32;
-        let mut candidates = 0u64;
-        let (weights, tags, pset) = (self.weights, &self.tag, &self.pset);
-        // An eligible partner's box comes within GLimit of x's box, and its centre lies at most
-        // half its extent (≤ `half_ext`, the largest among active bodies) inside that box.
-        let reach = self.half_ext.map(|h| h + glimit);
-        let lo = xa.min - nalgebra::Vector3::from(reach);
-        let hi = xa.max + nalgebra::Vector3::from(reach);
-        self.hash.for_each_in_box(&lo, &hi, |r: &Rec| {
-            candidates += 1;
-            if r.id == x || xa.gap_linf(&r.aabb) > glimit {
-                return;
-            }
-            let merged = xa.merge(&r.aabb);
-            let Some(d) = pset.eligible(x, r.id, &merged, glimit) else {
-                return;
-            };
-            eligible += 1;
-            let (fill, balance) = fill_balance(d, dx, r.diameter);
-            let scale = match A {
-                1 => d,
-                0 => 1.0,
-                _ => d.powf(weights.a),
-            };
-            let cost = weights.cost_scaled(scale, fill, balance);
-            // Tie tags are read only when the cost can win or tie.
-            if best.is_some_and(|b| cost > b.cost) {
-                return;
-            }
-            let ty = tags[r.id as usize];
-            let e = Entry {
-                cost,
-                lo: tx.min(ty),
-                hi: tx.max(ty),
-                owner: x,
-                partner: r.id,
-            };
-            if best.is_none_or(|b| e.before(&b)) {
-                best = Some(e);
-            }
-        });
-        self.stats.candidates += candidates;
-        (best, eligible)
     }
 
     /// Morton (Z-order) code of body `x`'s centre on a 2^21 grid over the scene box.
@@ -243,17 +207,23 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
         key
     }
 
-    fn insert_active(&mut self, x: u32) {
-        self.in_hash[x as usize] = true;
+    fn grow_half_ext(&mut self, x: u32) {
         let e = self.aabb[x as usize].extents();
         for k in 0..3 {
             self.half_ext[k] = self.half_ext[k].max(e[k] / 2.0);
         }
-        self.hash.insert(Rec {
-            id: x,
-            aabb: self.aabb[x as usize],
-            diameter: self.diameter[x as usize],
-        });
+    }
+
+    /// Queues the current entry of `x`'s list, if any.
+    fn queue_current(&mut self, x: u32) {
+        if let Some(c) = self.partners.get(x).current() {
+            let e = Entry {
+                cost: order_bits(c.cost),
+                owner: x,
+                partner: c.partner,
+            };
+            self.mpairs.push(e, &self.tag);
+        }
     }
 
     fn run(mut self, stop: Option<&AtomicBool>) -> Result<Grouping, Stopped> {
@@ -263,6 +233,7 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
         let mut round = 0u32;
         let mut active: Vec<u32> = Vec::new();
         let mut morton: Vec<(u64, u32)> = Vec::new();
+        let mut order: Vec<u32> = Vec::new();
         // Step 2: one parent-less body left is the root.
         while parentless.len() > 1 {
             active.clear();
@@ -274,25 +245,27 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
             );
             let dormant = (parentless.len() - active.len()) as u32;
             // Step 3: voxel hash of active centres, CSize = DLimit + GLimit; queue best pairs.
-            // Bodies are inserted and scanned in Morton order of their centres so consecutive
-            // scans reuse the same cells from cache; the order does not change any result.
-            self.hash.reset(dlimit + glimit);
-            self.half_ext = [0.0; 3];
+            // Bodies are stored and searched in Morton order of their centres so consecutive
+            // searches reuse the same cells from cache; the order does not change any result.
             morton.clear();
             morton.extend(active.iter().map(|&x| (self.morton_key(x), x)));
             morton.sort_unstable();
-            for &(_, x) in &morton {
-                self.insert_active(x);
+            order.clear();
+            order.extend(morton.iter().map(|&(_, x)| x));
+            let ids = 2 * n - 1;
+            self.hash
+                .build(dlimit + glimit, &order, &self.aabb, &self.diameter, ids);
+            self.half_ext = [0.0; 3];
+            self.partners.reset(ids);
+            for &x in &order {
+                self.live[x as usize] = true;
+                self.grow_half_ext(x);
+                self.partners.open(x);
             }
-            let mut pairs = 0u64;
-            for &(_, x) in &morton {
-                let (best, k) = self.best_partner(x, glimit);
-                pairs += k as u64;
-                if let Some(e) = best {
-                    self.mpairs.push(e);
-                }
+            let pairs = self.round_start_search(&order, glimit);
+            for &x in &order {
+                self.queue_current(x);
             }
-            pairs /= 2;
             self.stats.eligible_pairs += pairs;
             self.observer.on_event(&Event::RoundStart {
                 round,
@@ -304,19 +277,38 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
             });
             // Step 4: pop and merge until MPairs is empty.
             let merges_before = self.merges.len();
-            while let Some(e) = self.mpairs.pop() {
+            while let Some(e) = self.mpairs.peek() {
                 self.stats.pops += 1;
-                if !self.in_hash[e.owner as usize] {
+                if !self.live[e.owner as usize] {
                     self.stats.stale_pops += 1;
+                    self.mpairs.pop(&self.tag);
                     continue;
                 }
-                if !self.in_hash[e.partner as usize] {
+                if !self.live[e.partner as usize] {
+                    // The partner merged away: the owner's next live partner, else a new search.
                     self.stats.stale_pops += 1;
-                    if let (Some(again), _) = self.best_partner(e.owner, glimit) {
-                        self.mpairs.push(again);
+                    let live = &self.live;
+                    let mut next = self.partners.get(e.owner).advance(|y| live[y as usize]);
+                    if next.is_none() {
+                        self.search(e.owner, glimit);
+                        next = self.partners.get(e.owner).current();
+                    }
+                    match next {
+                        Some(c) => {
+                            let again = Entry {
+                                cost: order_bits(c.cost),
+                                owner: e.owner,
+                                partner: c.partner,
+                            };
+                            self.mpairs.replace_top(again, &self.tag);
+                        }
+                        None => {
+                            self.mpairs.pop(&self.tag);
+                        }
                     }
                     continue;
                 }
+                self.mpairs.pop(&self.tag);
                 if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
                     return Err(Stopped {
                         merges: self.merges.len() as u32,
@@ -369,10 +361,10 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
         let new = (self.n + self.merges.len()) as u32;
         let merged = self.aabb[a as usize].merge(&self.aabb[b as usize]);
         for x in [a, b] {
-            self.in_hash[x as usize] = false;
+            self.live[x as usize] = false;
             self.parent[x as usize] = new;
-            let bx = self.aabb[x as usize];
-            self.hash.remove(x, &bx);
+            self.hash.remove(x);
+            self.partners.close(x);
         }
         let d = self.pset.merge(a, b, new, &merged);
         let (da, db) = (self.diameter[a as usize], self.diameter[b as usize]);
@@ -384,10 +376,12 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
         let is_active = d <= dlimit;
         if is_active {
             // Step 4(b): the new body joins ABods and queues its best eligible pair.
-            self.insert_active(new);
-            if let (Some(best), _) = self.best_partner(new, glimit) {
-                self.mpairs.push(best);
-            }
+            self.live[new as usize] = true;
+            self.grow_half_ext(new);
+            self.hash.insert(new, &merged, d);
+            self.partners.open(new);
+            self.search(new, glimit);
+            self.queue_current(new);
         }
         self.stats.peak_queue = self.stats.peak_queue.max(self.mpairs.len() as u64);
         self.observer.on_event(&Event::Merge(Merge {

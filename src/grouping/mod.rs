@@ -10,8 +10,9 @@
 //!    diameter ≤ DLimit are active (*ABods*), the rest dormant (*DBods*) — `cluster::run`, top of
 //!    its round loop.
 //! 3. Active body centres go into a voxel hash with cell size CSize = DLimit + GLimit
-//!    ([`voxel_hash::VoxelHash`]); scanning the 27 cells around each centre and filtering by
-//!    GLimit gives the eligible pairs, queued in *MPairs* by Cost ([`mpairs::MPairs`]).
+//!    ([`voxel_hash::VoxelHash`]); scanning the voxels around each body (at round start each
+//!    pair of cells once for the AABB p-set, see `cluster::scan`) and filtering by GLimit gives
+//!    the eligible pairs, queued in *MPairs* by Cost ([`mpairs::MPairs`]).
 //! 4. Until MPairs is empty: (a) pop the cheapest pair, skipping pairs that lost a member, and
 //!    merge it; (b) if the new body obeys DLimit it becomes active, enters the hash and its
 //!    eligible pairs are queued; (c) otherwise it goes dormant — `cluster::run`, inner loop.
@@ -20,11 +21,13 @@
 //! Cost = diameter^A × (B·Fill + C·Balance) ([`Weights::cost`]), Fill = parent diameter / sum of
 //! child diameters, Balance = greater ratio of the child diameters.
 //!
-//! MPairs keeps, for every active body, only its cheapest eligible partner, and searches again
-//! when that partner is merged away. Because pair costs are symmetric and fixed, the pair popped
-//! at every step is the global minimum over all eligible pairs, exactly the pair the literal
-//! queue of every eligible pair would pop, so the tree is the same; the queue is O(N) instead
-//! of O(kN). Ties break by the pair's (smaller id, larger id), or by seeded random tags with
+//! MPairs keeps one entry per active body: the first live entry of its partner list (the AABB
+//! p-set's four cheapest eligible partners at the body's last search; the hull p-set's single
+//! best). When a popped entry's partner has merged away, the next live list entry replaces it;
+//! only a used-up list triggers a new search. Because pair Costs are symmetric and fixed, the
+//! pair popped at every step is the global minimum over all eligible pairs (argument in
+//! [`mpairs`]), exactly the pair the literal queue would pop, so the tree is the same; the
+//! queue is O(N) instead of O(kN). Ties break by the pair's (smaller id, larger id), or by seeded random tags with
 //! `--seed`.
 
 mod cluster;
@@ -149,7 +152,9 @@ pub struct ResolvedParams {
 impl Params {
     /// Fixes the initial limits: DLimit0 = the median primitive diameter (AABB diagonal) and
     /// GLimit0 = DLimit0 / 4. When that median is 0 (point-like primitives) DLimit0 falls back
-    /// to 1e-6 × the scene diagonal, and to 1 for a scene that is a single point.
+    /// to 1e-6 × the scene diagonal, and to 1 for a scene that is a single point. A given
+    /// DLimit ≤ 0 (or not finite) becomes 1; a given GLimit ≤ 0 becomes 1e-9 × DLimit0, since
+    /// the paper's GLimit must be positive for scenes of several connected components.
     pub fn resolve(&self, scene: &Scene) -> ResolvedParams {
         let dlimit0 = match self.dlimit {
             Some(d) => d,
@@ -175,7 +180,17 @@ impl Params {
                 }
             }
         };
-        let glimit0 = self.glimit.unwrap_or(dlimit0 / 4.0);
+        let dlimit0 = if dlimit0.is_finite() && dlimit0 > 0.0 {
+            dlimit0
+        } else {
+            1.0
+        };
+        // GLimit must be positive or disconnected scenes would never finish (doubling 0 stays 0).
+        let glimit0 = match self.glimit {
+            Some(g) if g.is_finite() && g > 0.0 => g,
+            Some(_) => dlimit0 * 1e-9,
+            None => dlimit0 / 4.0,
+        };
         ResolvedParams {
             weights: self.weights,
             dlimit0,

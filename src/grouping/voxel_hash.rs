@@ -1,128 +1,309 @@
-//! Step 3's body-centre occupancy array, stored virtually as a hash of voxel coordinates → the
-//! active bodies whose centre lies in that voxel (§2.3: "the storage for the array only really
-//! need be size O(N)").
+//! Step 3's body-centre occupancy array (§2.3: "the array can be implemented virtually with a
+//! spatial hash table … the storage for the array only really need be size O(N)").
 //!
-//! A cell keeps its bodies as contiguous small records (id, box, diameter) so a scan reads
-//! memory in order; a body is removed from its cell when it merges.
+//! Voxels have edge CSize = DLimit + GLimit. Each round the array is rebuilt over the box of
+//! the active bodies: as a dense grid of cell indices when that grid has at most a few voxels
+//! per active body, otherwise as a hash of voxel coordinates (scenes of far-apart clusters).
+//! A cell keeps its bodies as contiguous records (box, diameter, id) in one shared arena, laid
+//! out in the order the bodies were inserted (Morton order at round start), with slack for the
+//! bodies made during the round; a full cell moves to the end of the arena with twice the room.
+//! Removal swaps the body with its cell's last record (O(1), the arena position of every body is
+//! kept). Each cell also keeps the box of the centres and the largest diameter ever stored in it
+//! this round, so callers can bound the Cost of any pair with a body of that cell.
 
 use crate::geom::{Aabb, P3};
 use std::collections::HashMap;
 
 /// One active body as stored in a voxel.
 #[derive(Clone, Copy, Debug)]
+#[repr(align(64))]
 pub struct Rec {
-    /// Body id.
-    pub id: u32,
     /// Its AABB.
     pub aabb: Aabb,
     /// Its diameter.
     pub diameter: f64,
+    /// Body id.
+    pub id: u32,
 }
 
-/// Voxel coordinates packed 21 bits per axis. Coordinates far apart may share a key; that only
-/// puts more bodies in a cell, which the callers' exact gap test filters, so results never change.
-type Key = u64;
-
-#[inline]
-fn pack(x: i64, y: i64, z: i64) -> Key {
-    const M: i64 = (1 << 21) - 1;
-    ((x & M) as u64) | (((y & M) as u64) << 21) | (((z & M) as u64) << 42)
+/// What a cell knows about every body stored in it during the round (grow-only).
+#[derive(Clone, Copy, Debug)]
+pub struct CellBounds {
+    /// Smallest centre coordinates.
+    pub lo: [f64; 3],
+    /// Largest centre coordinates.
+    pub hi: [f64; 3],
+    /// Largest diameter.
+    pub dmax: f64,
 }
+
+const EMPTY_BOUNDS: CellBounds = CellBounds {
+    lo: [f64::INFINITY; 3],
+    hi: [f64::NEG_INFINITY; 3],
+    dmax: 0.0,
+};
+
+#[derive(Clone, Copy, Debug)]
+struct Cell {
+    start: u32,
+    len: u32,
+    cap: u32,
+}
+
+/// Voxel coordinates are clamped to `0..=MAX_COORD` so keys never alias.
+const MAX_COORD: i64 = (1 << 42) - 1;
+const NO_CELL: u32 = u32::MAX;
+const BLANK: Rec = Rec {
+    aabb: Aabb::EMPTY,
+    diameter: 0.0,
+    id: u32::MAX,
+};
 
 /// Voxel hash with edge length CSize = DLimit + GLimit.
 #[derive(Debug)]
 pub struct VoxelHash {
-    origin: P3,
+    origin: [f64; 3],
     inv_csize: f64,
-    slots: HashMap<Key, u32, foldhash::fast::FixedState>,
-    cells: Vec<Vec<Rec>>,
-    free: Vec<u32>,
+    /// Dense grid dimensions, or `None` when the sparse map is used.
+    dims: Option<[i64; 3]>,
+    dense: Vec<u32>,
+    sparse: HashMap<u128, u32, foldhash::fast::FixedState>,
+    cells: Vec<Cell>,
+    coords: Vec<[i64; 3]>,
+    bounds: Vec<CellBounds>,
+    recs: Vec<Rec>,
+    /// Arena position and cell of every body id (valid while the body is stored).
+    at: Vec<(u32, u32)>,
+}
+
+impl Default for VoxelHash {
+    fn default() -> Self {
+        VoxelHash {
+            origin: [0.0; 3],
+            inv_csize: 1.0,
+            dims: None,
+            dense: Vec::new(),
+            sparse: HashMap::with_hasher(foldhash::fast::FixedState::with_seed(0)),
+            cells: Vec::new(),
+            coords: Vec::new(),
+            bounds: Vec::new(),
+            recs: Vec::new(),
+            at: Vec::new(),
+        }
+    }
 }
 
 impl VoxelHash {
-    /// An empty hash; [`VoxelHash::reset`] sets its cell size.
-    pub fn new(origin: P3) -> VoxelHash {
-        VoxelHash {
-            origin,
-            inv_csize: 1.0,
-            slots: HashMap::with_hasher(foldhash::fast::FixedState::with_seed(0)),
-            cells: Vec::new(),
-            free: Vec::new(),
-        }
-    }
-
-    /// Empties the hash (keeping allocations) and sets the voxel edge to `csize`.
-    pub fn reset(&mut self, csize: f64) {
+    /// Empties the hash (keeping allocations), sets the voxel edge to `csize` and stores
+    /// `bodies` (the round's active bodies, in the order their records should be laid out).
+    /// `boxes` and `diameters` are indexed by body id; `ids` is the number of body ids.
+    pub fn build(
+        &mut self,
+        csize: f64,
+        bodies: &[u32],
+        boxes: &[Aabb],
+        diameters: &[f64],
+        ids: usize,
+    ) {
         self.inv_csize = 1.0 / csize;
-        self.free.clear();
-        for (i, c) in self.cells.iter_mut().enumerate() {
-            c.clear();
-            self.free.push(i as u32);
+        let all = bodies
+            .iter()
+            .fold(Aabb::EMPTY, |b, &x| b.merge(&boxes[x as usize]));
+        // Every body made this round lies inside the union of the active boxes.
+        self.origin = [all.min.x, all.min.y, all.min.z];
+        self.cells.clear();
+        self.coords.clear();
+        self.bounds.clear();
+        self.recs.clear();
+        self.sparse.clear();
+        self.at.resize(ids, (0, NO_CELL));
+        self.dims = None;
+        let max = self.coords_of(&all.max);
+        let dims = max.map(|m| m.max(0) + 1);
+        let voxels = dims.iter().try_fold(1i64, |a, &d| a.checked_mul(d));
+        self.dims = voxels
+            .filter(|&v| v <= 4 * bodies.len() as i64 + 4096)
+            .map(|_| dims);
+        if let Some(v) = voxels.filter(|_| self.dims.is_some()) {
+            self.dense.clear();
+            self.dense.resize(v as usize, NO_CELL);
         }
-        self.slots.clear();
+        // Count per cell, then give each cell its records plus slack for the round's new bodies.
+        let mut cell_of = Vec::with_capacity(bodies.len());
+        for &x in bodies {
+            let c = self.cell_at(&boxes[x as usize].center());
+            self.cells[c as usize].len += 1;
+            cell_of.push(c);
+        }
+        let mut start = 0u32;
+        for cell in &mut self.cells {
+            cell.start = start;
+            cell.cap = cell.len + cell.len / 2 + 2;
+            start += cell.cap;
+            cell.len = 0;
+        }
+        self.recs.resize(start as usize, BLANK);
+        for (&x, &c) in bodies.iter().zip(&cell_of) {
+            self.put(c, x, &boxes[x as usize], diameters[x as usize]);
+        }
     }
 
     #[inline]
-    fn coords(&self, p: &P3) -> [i64; 3] {
-        let f = |k: usize| ((p[k] - self.origin[k]) * self.inv_csize).floor() as i64;
-        [f(0), f(1), f(2)]
+    fn coords_of(&self, p: &P3) -> [i64; 3] {
+        let f = |k: usize| floor((p[k] - self.origin[k]) * self.inv_csize).clamp(0, MAX_COORD);
+        let v = [f(0), f(1), f(2)];
+        match self.dims {
+            Some(d) => [v[0].min(d[0] - 1), v[1].min(d[1] - 1), v[2].min(d[2] - 1)],
+            None => v,
+        }
     }
 
+    /// The voxel coordinates of the voxels holding `lo` and `hi` (a monotone map, so a centre
+    /// inside `[lo, hi]` lies in a voxel of the returned range).
     #[inline]
-    fn key(&self, p: &P3) -> Key {
-        let [x, y, z] = self.coords(p);
-        pack(x, y, z)
+    pub fn range(&self, lo: &P3, hi: &P3) -> ([i64; 3], [i64; 3]) {
+        (self.coords_of(lo), self.coords_of(hi))
     }
 
-    /// Adds a body by the centre of its box.
-    pub fn insert(&mut self, rec: Rec) {
-        let key = self.key(&rec.aabb.center());
-        let slot = match self.slots.get(&key) {
-            Some(&s) => s,
-            None => {
-                let s = match self.free.pop() {
-                    Some(s) => s,
-                    None => {
-                        self.cells.push(Vec::new());
-                        (self.cells.len() - 1) as u32
-                    }
-                };
-                self.slots.insert(key, s);
-                s
-            }
+    /// The cell of voxel `v`, if any body was stored there this round.
+    #[inline]
+    pub fn cell(&self, v: [i64; 3]) -> Option<u32> {
+        let c = match self.dims {
+            Some(d) => self.dense[((v[0] * d[1] + v[1]) * d[2] + v[2]) as usize],
+            None => *self.sparse.get(&key(v))?,
         };
-        self.cells[slot as usize].push(rec);
+        (c != NO_CELL).then_some(c)
     }
 
-    /// Removes body `id` whose box is `aabb` (as inserted).
-    pub fn remove(&mut self, id: u32, aabb: &Aabb) {
-        let key = self.key(&aabb.center());
-        if let Some(&s) = self.slots.get(&key) {
-            let cell = &mut self.cells[s as usize];
-            if let Some(i) = cell.iter().position(|r| r.id == id) {
-                cell.swap_remove(i);
+    /// The cell of the voxel holding `p`, made (empty) if there is none.
+    fn cell_at(&mut self, p: &P3) -> u32 {
+        let v = self.coords_of(p);
+        if let Some(c) = self.cell(v) {
+            return c;
+        }
+        let c = self.cells.len() as u32;
+        match self.dims {
+            Some(d) => self.dense[((v[0] * d[1] + v[1]) * d[2] + v[2]) as usize] = c,
+            None => {
+                self.sparse.insert(key(v), c);
             }
         }
+        self.cells.push(Cell {
+            start: self.recs.len() as u32,
+            len: 0,
+            cap: 0,
+        });
+        self.coords.push(v);
+        self.bounds.push(EMPTY_BOUNDS);
+        c
     }
 
-    /// Calls `f` for every body stored in a voxel that overlaps the box `[lo, hi]`, so every
-    /// body whose centre lies in the box is visited (and some others).
-    ///
-    /// The grouping's query boxes are at most 2·CSize wide, so this visits at most the 27
-    /// voxels around the querying body's centre that step 3 names, and usually far fewer.
+    fn put(&mut self, c: u32, id: u32, aabb: &Aabb, diameter: f64) {
+        let cell = &mut self.cells[c as usize];
+        if cell.len == cell.cap {
+            // Move the cell to the end of the arena with twice the room.
+            let (from, len) = (cell.start as usize, cell.len as usize);
+            let start = self.recs.len();
+            cell.start = start as u32;
+            cell.cap = 2 * cell.cap + 4;
+            self.recs.resize(start + cell.cap as usize, BLANK);
+            self.recs.copy_within(from..from + len, start);
+            for i in start..start + len {
+                self.at[self.recs[i].id as usize].0 = i as u32;
+            }
+        }
+        let cell = &mut self.cells[c as usize];
+        let i = (cell.start + cell.len) as usize;
+        cell.len += 1;
+        self.recs[i] = Rec {
+            aabb: *aabb,
+            diameter,
+            id,
+        };
+        self.at[id as usize] = (i as u32, c);
+        let b = &mut self.bounds[c as usize];
+        let centre = aabb.center();
+        for k in 0..3 {
+            b.lo[k] = b.lo[k].min(centre[k]);
+            b.hi[k] = b.hi[k].max(centre[k]);
+        }
+        b.dmax = b.dmax.max(diameter);
+    }
+
+    /// Adds body `id` by the centre of its box.
+    pub fn insert(&mut self, id: u32, aabb: &Aabb, diameter: f64) {
+        if self.at.len() <= id as usize {
+            self.at.resize(id as usize + 1, (0, NO_CELL));
+        }
+        let c = self.cell_at(&aabb.center());
+        self.put(c, id, aabb, diameter);
+    }
+
+    /// Removes body `id` (which must be stored).
+    pub fn remove(&mut self, id: u32) {
+        let (i, c) = self.at[id as usize];
+        let cell = &mut self.cells[c as usize];
+        cell.len -= 1;
+        let last = (cell.start + cell.len) as usize;
+        self.recs.swap(i as usize, last);
+        let moved = self.recs[i as usize].id;
+        self.at[moved as usize].0 = i;
+        self.at[id as usize].1 = NO_CELL;
+    }
+
+    /// Number of cells (voxels that held a body this round).
+    pub fn cells(&self) -> u32 {
+        self.cells.len() as u32
+    }
+
+    /// The records stored in cell `c`.
     #[inline]
-    pub fn for_each_in_box(&self, lo: &P3, hi: &P3, mut f: impl FnMut(&Rec)) {
-        let (a, b) = (self.coords(lo), self.coords(hi));
+    pub fn recs(&self, c: u32) -> &[Rec] {
+        let cell = self.cells[c as usize];
+        &self.recs[cell.start as usize..(cell.start + cell.len) as usize]
+    }
+
+    /// What cell `c` has held this round.
+    #[inline]
+    pub fn bounds(&self, c: u32) -> &CellBounds {
+        &self.bounds[c as usize]
+    }
+
+    /// Voxel coordinates of cell `c`.
+    #[inline]
+    pub fn coords(&self, c: u32) -> [i64; 3] {
+        self.coords[c as usize]
+    }
+
+    /// Calls `f` with every cell of a voxel that overlaps the box `[lo, hi]`, so every body
+    /// whose centre lies in the box is in one of them (and some others).
+    ///
+    /// The grouping's query boxes are at most 2·CSize wide, so these are at most the 27 voxels
+    /// around the querying body's centre that step 3 names.
+    #[inline]
+    pub fn for_each_cell(&self, lo: &P3, hi: &P3, mut f: impl FnMut(u32, [i64; 3])) {
+        let (a, b) = self.range(lo, hi);
         for x in a[0]..=b[0] {
             for y in a[1]..=b[1] {
                 for z in a[2]..=b[2] {
-                    if let Some(&s) = self.slots.get(&pack(x, y, z)) {
-                        for r in &self.cells[s as usize] {
-                            f(r);
-                        }
+                    if let Some(c) = self.cell([x, y, z]) {
+                        f(c, [x, y, z]);
                     }
                 }
             }
         }
     }
+}
+
+/// `v.floor() as i64` without a libm call (baseline x86-64 has no rounding instruction); NaN
+/// gives 0 and out-of-range values saturate, like the cast.
+#[inline(always)]
+fn floor(v: f64) -> i64 {
+    let t = v as i64;
+    t - ((t as f64) > v) as i64
+}
+
+#[inline]
+fn key(v: [i64; 3]) -> u128 {
+    (v[0] as u128) | ((v[1] as u128) << 42) | ((v[2] as u128) << 84)
 }

@@ -1,0 +1,274 @@
+//! Partner searches over the voxel hash: step 3's round-start scan and step 4(b)'s search for a
+//! new body (also run when a body's partner list is used up).
+//!
+//! A body `x`'s eligible partners have their centres within `x`'s box grown by GLimit plus the
+//! largest half-extent of the round's active bodies, so only the cells of the voxels meeting
+//! that box are visited, and among them only cells whose centres' box meets it.
+//!
+//! For the AABB p-set (whose pair Cost is a symmetric function of the two boxes and diameters):
+//! - the round-start scan visits each pair of cells once — a body's own cell after it, and the
+//!   voxels after its own in (x, y, z) order — counting every eligible pair once and offering
+//!   it to both bodies' partner lists;
+//! - a single body's search visits the cells in increasing order of a lower bound on the Cost
+//!   of any pair with one of their bodies and stops at the first cell whose bound exceeds the
+//!   last Cost the list keeps, so the list is still exactly the first partners in key order.
+//!   The bound takes the merged box to span `x`'s box and the cell's box of centres (every
+//!   body's box holds its centre), Fill over the cell's largest diameter and Balance ≥ 1; it is
+//!   evaluated with the same floating-point operations as the Cost, on smaller operands, so it
+//!   never exceeds a Cost it bounds, and is lowered by 1e-9 relative for `powf`.
+//!
+//! Other p-sets search every candidate for the single best partner, as in the paper.
+
+use super::{Clusterer, PSetBodies, fill_balance};
+use crate::geom::{Aabb, P3, V3};
+use crate::grouping::Weights;
+use crate::grouping::events::Observer;
+use crate::grouping::mpairs::List;
+use crate::grouping::voxel_hash::CellBounds;
+
+/// Cost of a pair of AABB bodies whose merged box has diagonal `d`; `A` = 1 or 0 selects the
+/// exponent without `powf` (any other value uses `w.a`).
+#[inline(always)]
+fn pair_cost<const A: u8>(w: &Weights, d: f64, dx: f64, dy: f64) -> f64 {
+    let (fill, balance) = fill_balance(d, dx, dy);
+    let scale = match A {
+        1 => d,
+        0 => 1.0,
+        _ => d.powf(w.a),
+    };
+    w.cost_scaled(scale, fill, balance)
+}
+
+/// A lower bound on the Cost of pairing the body with box `xa` and diameter `dx` with any body
+/// stored in a cell with bounds `cb`.
+#[inline(always)]
+fn cost_bound<const A: u8>(w: &Weights, xa: &Aabb, dx: f64, cb: &CellBounds) -> f64 {
+    let span = |k: usize| xa.max[k].max(cb.lo[k]) - xa.min[k].min(cb.hi[k]);
+    let d = V3::new(span(0), span(1), span(2)).norm();
+    let scale = match A {
+        1 => d,
+        0 => 1.0,
+        _ => d.powf(w.a),
+    };
+    let sum = dx + cb.dmax;
+    let fill = if sum > 0.0 {
+        let q = d / sum;
+        if dx == 0.0 { q.min(1.0) } else { q }
+    } else {
+        1.0
+    };
+    w.cost_scaled(scale, fill, 1.0) * (1.0 - 1e-9)
+}
+
+/// Whether a cell's box of centres meets the box `[lo, hi]`.
+#[inline(always)]
+fn meets(cb: &CellBounds, lo: &P3, hi: &P3) -> bool {
+    (0..3).all(|k| cb.lo[k] <= hi[k] && cb.hi[k] >= lo[k])
+}
+
+impl<P: PSetBodies, O: Observer> Clusterer<'_, P, O> {
+    /// The box that holds the centre of every eligible partner of a body with box `xa`.
+    #[inline]
+    fn query(&self, xa: &Aabb, glimit: f64) -> (P3, P3) {
+        // A little more than GLimit + half-extent, so rounding never drops a partner.
+        let m = (0..3).fold(0f64, |m, k| m.max(xa.min[k].abs()).max(xa.max[k].abs()));
+        let reach = V3::from(
+            self.half_ext
+                .map(|h| (h + glimit) * (1.0 + 1e-12) + m * 1e-13),
+        );
+        (xa.min - reach, xa.max + reach)
+    }
+
+    /// Step 3 after the active bodies are stored: fills every active body's partner list and
+    /// returns the number of eligible pairs.
+    pub(super) fn round_start_search(&mut self, order: &[u32], glimit: f64) -> u64 {
+        if P::AABB {
+            let a = self.weights.a;
+            if a == 1.0 {
+                self.pairs_once::<1>(glimit)
+            } else if a == 0.0 {
+                self.pairs_once::<0>(glimit)
+            } else {
+                self.pairs_once::<2>(glimit)
+            }
+        } else {
+            order
+                .iter()
+                .map(|&x| self.scan_all(x, glimit) as u64)
+                .sum::<u64>()
+                / 2
+        }
+    }
+
+    /// Step 4(b) (and a used-up list): refills `x`'s partner list.
+    pub(super) fn search(&mut self, x: u32, glimit: f64) {
+        if P::AABB {
+            let a = self.weights.a;
+            if a == 1.0 {
+                self.scan_pruned::<1>(x, glimit)
+            } else if a == 0.0 {
+                self.scan_pruned::<0>(x, glimit)
+            } else {
+                self.scan_pruned::<2>(x, glimit)
+            }
+        } else {
+            self.scan_all(x, glimit);
+        }
+    }
+
+    /// Every eligible pair once (AABB p-set); returns their number.
+    fn pairs_once<const A: u8>(&mut self, glimit: f64) -> u64 {
+        let (k, w) = (self.k, self.weights);
+        let mut pairs = 0u64;
+        let mut candidates = 0u64;
+        let mut near: Vec<u32> = Vec::with_capacity(27);
+        let mut fwd: Vec<u32> = Vec::with_capacity(27);
+        for c in 0..self.hash.cells() {
+            let vc = self.hash.coords(c);
+            // The later cells any body of this cell may pair with, found once per cell.
+            let (mut clo, mut chi) = (
+                P3::new(f64::MAX, f64::MAX, f64::MAX),
+                P3::new(f64::MIN, f64::MIN, f64::MIN),
+            );
+            for r in self.hash.recs(c) {
+                let (lo, hi) = self.query(&r.aabb, glimit);
+                clo = clo.inf(&lo);
+                chi = chi.sup(&hi);
+            }
+            let hash = &self.hash;
+            near.clear();
+            hash.for_each_cell(&clo, &chi, |cell, v| {
+                if v > vc && meets(hash.bounds(cell), &clo, &chi) {
+                    near.push(cell);
+                }
+            });
+            for i in 0..hash.recs(c).len() {
+                let xr = hash.recs(c)[i];
+                let (x, xa, dx) = (xr.id, xr.aabb, xr.diameter);
+                let (lo, hi) = self.query(&xa, glimit);
+                fwd.clear();
+                fwd.extend(
+                    near.iter()
+                        .copied()
+                        .filter(|&cell| meets(hash.bounds(cell), &lo, &hi)),
+                );
+                let (tags, partners) = (&self.tag, &mut self.partners);
+                let sx = partners.slot(x);
+                let own = &hash.recs(c)[i + 1..];
+                for seg in std::iter::once(own).chain(fwd.iter().map(|&cell| hash.recs(cell))) {
+                    for yr in seg {
+                        candidates += 1;
+                        if xa.gap_linf(&yr.aabb) > glimit {
+                            continue;
+                        }
+                        pairs += 1;
+                        let d = xa.merge(&yr.aabb).diameter();
+                        let cost = pair_cost::<A>(&w, d, dx, yr.diameter);
+                        let sy = partners.slot(yr.id);
+                        let lists = partners.lists_mut();
+                        lists[sx].offer(k, cost, yr.id, tags);
+                        lists[sy].offer(k, cost, x, tags);
+                    }
+                }
+            }
+        }
+        self.stats.candidates += candidates;
+        pairs
+    }
+
+    /// The first partners of `x` in key order (AABB p-set), visiting cells cheapest bound first.
+    fn scan_pruned<const A: u8>(&mut self, x: u32, glimit: f64) {
+        let (k, w) = (self.k, self.weights);
+        let xa = self.aabb[x as usize];
+        let dx = self.diameter[x as usize];
+        let (lo, hi) = self.query(&xa, glimit);
+        let hash = &self.hash;
+        let prune = self.prune;
+        let mut cells: [(f64, u32); 64] = [(0.0, 0); 64];
+        let mut n = 0;
+        let mut overflow: Vec<(f64, u32)> = Vec::new();
+        hash.for_each_cell(&lo, &hi, |cell, _| {
+            let cb = hash.bounds(cell);
+            if meets(cb, &lo, &hi) {
+                let bound = if prune {
+                    cost_bound::<A>(&w, &xa, dx, cb)
+                } else {
+                    f64::NEG_INFINITY
+                };
+                if n < cells.len() {
+                    cells[n] = (bound, cell);
+                    n += 1;
+                } else {
+                    overflow.push((bound, cell));
+                }
+            }
+        });
+        let mut list = List::EMPTY;
+        let mut candidates = 0u64;
+        let tags = &self.tag;
+        let cells: &mut [(f64, u32)] = if overflow.is_empty() {
+            let cells = &mut cells[..n];
+            // Insertion sort: at most 27 cells.
+            for i in 1..cells.len() {
+                let mut j = i;
+                while j > 0 && cells[j].0 < cells[j - 1].0 {
+                    cells.swap(j, j - 1);
+                    j -= 1;
+                }
+            }
+            cells
+        } else {
+            // Only reachable through rounding at voxel boundaries: visit everything, unsorted.
+            overflow.extend_from_slice(&cells);
+            overflow.iter_mut().for_each(|c| c.0 = f64::NEG_INFINITY);
+            &mut overflow
+        };
+        for &(bound, cell) in cells.iter() {
+            if bound > list.bar(k) {
+                break;
+            }
+            for r in hash.recs(cell) {
+                candidates += 1;
+                if r.id == x || xa.gap_linf(&r.aabb) > glimit {
+                    continue;
+                }
+                let d = xa.merge(&r.aabb).diameter();
+                let cost = pair_cost::<A>(&w, d, dx, r.diameter);
+                list.offer(k, cost, r.id, tags);
+            }
+        }
+        self.stats.candidates += candidates;
+        *self.partners.get(x) = list;
+    }
+
+    /// The best partner of `x` over every candidate (any p-set); returns the number of
+    /// eligible partners.
+    fn scan_all(&mut self, x: u32, glimit: f64) -> u32 {
+        let k = self.k;
+        let xa = self.aabb[x as usize];
+        let dx = self.diameter[x as usize];
+        let (lo, hi) = self.query(&xa, glimit);
+        let (hash, pset, tags, w) = (&self.hash, &self.pset, &self.tag, self.weights);
+        let mut list = List::EMPTY;
+        let mut eligible = 0u32;
+        let mut candidates = 0u64;
+        hash.for_each_cell(&lo, &hi, |cell, _| {
+            for r in hash.recs(cell) {
+                candidates += 1;
+                if r.id == x || xa.gap_linf(&r.aabb) > glimit {
+                    continue;
+                }
+                let merged = xa.merge(&r.aabb);
+                let Some(d) = pset.eligible(x, r.id, &merged, glimit) else {
+                    continue;
+                };
+                eligible += 1;
+                let (fill, balance) = fill_balance(d, dx, r.diameter);
+                list.offer(k, w.cost(d, fill, balance), r.id, tags);
+            }
+        });
+        self.stats.candidates += candidates;
+        *self.partners.get(x) = list;
+        eligible
+    }
+}
