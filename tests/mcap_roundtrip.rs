@@ -76,6 +76,7 @@ fn record(
     let outcome = Outcome {
         grouping: cut.is_none().then_some(&g),
         spheres: Some(&spheres),
+        wrappers: None,
         merges: log.merges.len() as u32,
         rounds: log.rounds.len() as u32,
         seconds: 0.25,
@@ -360,6 +361,7 @@ fn record_into<W: Write + Seek>(loaded: &Loaded, sink: W) -> anyhow::Result<W> {
     let outcome = Outcome {
         grouping: Some(&g),
         spheres: Some(&spheres),
+        wrappers: None,
         merges: loaded.scene.len() as u32 - 1,
         rounds: g.rounds,
         seconds: 0.0,

@@ -78,6 +78,7 @@ fn write(path: &Path, loaded: &Loaded, detail: Detail, params: &Params) -> (Grou
     let outcome = Outcome {
         grouping: Some(&grouping),
         spheres: Some(&spheres),
+        wrappers: None,
         merges: log.merges.len() as u32,
         rounds: grouping.rounds,
         seconds: 0.0,
@@ -350,6 +351,7 @@ fn a_full_disk_is_a_clear_error() {
             let outcome = Outcome {
                 grouping: Some(&g),
                 spheres: None,
+                wrappers: None,
                 merges: loaded.scene.len() as u32 - 1,
                 rounds: g.rounds,
                 seconds: 0.0,

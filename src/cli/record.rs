@@ -15,7 +15,7 @@ use wraptree::record::output::Pending;
 use wraptree::record::rrd::RrdRecorder;
 use wraptree::record::{Detail, Outcome, RunInfo};
 use wraptree::scene::{Scene, SceneSource};
-use wraptree::wrap::{SphereMethod, sphere_tree};
+use wraptree::wrap::{SphereMethod, WrapperKind, Wrappers};
 
 /// Arguments of `wraptree record`.
 #[derive(Args, Debug)]
@@ -36,6 +36,9 @@ pub struct RecordCmd {
     /// Leave wall-clock timing out of the .mcap so identical runs give identical bytes.
     #[arg(long)]
     reproducible: bool,
+    /// Wrapper Trees logged with the levels, comma-separated: sphere, hull, box (aabb), obb.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "sphere")]
+    wrapper: Vec<WrapperKind>,
 }
 
 /// Where a pair of recordings goes, and the outcome of writing it.
@@ -65,9 +68,7 @@ fn with_ext(prefix: &Path, ext: &str) -> PathBuf {
     PathBuf::from(s)
 }
 
-/// Groups `scene` while both recorders listen; commits the files when complete, or sets them
-/// aside as `PREFIX.incomplete.*` when stopped by Ctrl-C/SIGTERM (an existing recording is never
-/// replaced by a partial one).
+/// [`record_with`] logging sphere Wrapper Trees.
 pub fn record(
     scene: &Scene,
     source: &SceneSource,
@@ -76,6 +77,31 @@ pub fn record(
     prefix: &Path,
     force: bool,
     reproducible: bool,
+) -> Result<Written> {
+    let kinds = [WrapperKind::Sphere];
+    record_with(
+        scene,
+        source,
+        params,
+        detail,
+        prefix,
+        (force, reproducible),
+        &kinds,
+    )
+}
+
+/// Groups `scene` while both recorders listen, logging the levels with the Wrapper Trees of
+/// `kinds`; commits the files when complete, or sets them aside as `PREFIX.incomplete.*` when
+/// stopped by Ctrl-C/SIGTERM (an existing recording is never replaced by a partial one).
+/// `flags` is (force, reproducible).
+pub fn record_with(
+    scene: &Scene,
+    source: &SceneSource,
+    params: &ResolvedParams,
+    detail: Detail,
+    prefix: &Path,
+    (force, reproducible): (bool, bool),
+    kinds: &[WrapperKind],
 ) -> Result<Written> {
     let (rrd_path, mcap_path) = (with_ext(prefix, ".rrd"), with_ext(prefix, ".mcap"));
     let rrd_file = Pending::create(&rrd_path, force)?;
@@ -110,13 +136,23 @@ pub fn record(
         }
         Err(s) => (None, s.merges, s.rounds),
     };
-    let spheres = match (&grouping, detail.levels()) {
-        (Some(g), true) => Some(sphere_tree(&g.tree, scene, SphereMethod::AabbCenter)),
+    let mut wrappers = match (&grouping, detail.levels()) {
+        (Some(g), true) => Some(Wrappers::build(
+            &g.tree,
+            scene,
+            kinds,
+            SphereMethod::AabbCenter,
+        )),
         _ => None,
     };
+    // Spheres travel in `Outcome::spheres`; empty = levels without spheres.
+    let spheres = wrappers
+        .as_mut()
+        .map(|w| w.spheres.take().unwrap_or_default());
     let outcome = Outcome {
         grouping: grouping.as_ref(),
         spheres: spheres.as_deref(),
+        wrappers: wrappers.as_ref(),
         merges,
         rounds,
         seconds,
@@ -194,14 +230,14 @@ impl RecordCmd {
                 p
             }
         };
-        let w = record(
+        let w = record_with(
             &loaded.scene,
             &loaded.source,
             &params,
             self.detail,
             &prefix,
-            self.force,
-            self.reproducible,
+            (self.force, self.reproducible),
+            &self.wrapper,
         )?;
         report(&w, &loaded.scene);
         Ok(if w.grouping.is_some() {

@@ -8,7 +8,7 @@ pub mod rrd;
 
 use crate::grouping::{Grouping, ResolvedParams};
 use crate::scene::{Scene, SceneSource};
-use crate::wrap::Sphere;
+use crate::wrap::{Sphere, Wrappers};
 
 /// What a recording holds (`--detail`).
 #[derive(
@@ -64,8 +64,12 @@ pub struct RunInfo<'a> {
 pub struct Outcome<'a> {
     /// The finished grouping; `None` when the run was interrupted.
     pub grouping: Option<&'a Grouping>,
-    /// Sphere Wrapper Tree (one per node) when levels are written.
+    /// Sphere Wrapper Tree (one per node) when levels are written; empty when levels are
+    /// written without spheres.
     pub spheres: Option<&'a [Sphere]>,
+    /// Further Wrapper Trees (hulls, boxes, oriented boxes) logged with the levels; its
+    /// `spheres` are ignored (see `spheres`).
+    pub wrappers: Option<&'a Wrappers>,
     /// Merges made.
     pub merges: u32,
     /// Rounds started.

@@ -3,6 +3,7 @@
 use crate::geom::P3;
 use crate::grouping::SubsetTree;
 use crate::scene::Scene;
+use crate::wrap::{LeafOrder, welzl};
 
 /// A sphere; radius 0 is allowed (a point-like leaf).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,6 +28,11 @@ impl Sphere {
         let radius = (dist + self.radius + o.radius) / 2.0;
         let center = self.center + d * ((radius - self.radius) / dist);
         Sphere { center, radius }
+    }
+
+    /// Volume (0 for radius 0).
+    pub fn volume(&self) -> f64 {
+        4.0 / 3.0 * std::f64::consts::PI * self.radius.powi(3)
     }
 
     /// Whether `p` lies inside, with `tol` of slack.
@@ -54,10 +60,31 @@ pub enum SphereMethod {
     /// Centre at the node's AABB centre, radius to the farthest leaf vertex (the paper's choice).
     #[default]
     AabbCenter,
+    /// Ritter's approximation over the leaves' vertices (O(n) per node).
+    Ritter,
+    /// The exact minimum enclosing sphere of the leaves' vertices (Welzl, O(n) expected per
+    /// node).
+    #[value(alias = "welzl")]
+    Minimum,
 }
 
 /// One sphere per Subset Tree node (index = node id), each holding every vertex below it.
+///
+/// `Merged` is O(N); the others visit every leaf vertex once per ancestor, O(N log N) for a
+/// tree of depth O(log N) (§2.4). All are `f64`; every radius is at least the distance from
+/// the centre to the farthest vertex below, so containment is exact up to rounding.
 pub fn sphere_tree(tree: &SubsetTree, scene: &Scene, method: SphereMethod) -> Vec<Sphere> {
+    let per_node = |f: fn(&[P3]) -> Sphere| {
+        let order = LeafOrder::new(tree, scene);
+        (0..tree.len() as u32)
+            .map(|x| f(order.node_points(x)))
+            .collect()
+    };
+    match method {
+        SphereMethod::Ritter => return per_node(welzl::ritter_sphere),
+        SphereMethod::Minimum => return per_node(welzl::min_sphere),
+        SphereMethod::Merged | SphereMethod::AabbCenter => {}
+    }
     let n = tree.leaves();
     let mut out: Vec<Sphere> = (0..tree.len())
         .map(|x| Sphere {
@@ -93,6 +120,7 @@ pub fn sphere_tree(tree: &SubsetTree, scene: &Scene, method: SphereMethod) -> Ve
                 }
             }
         }
+        SphereMethod::Ritter | SphereMethod::Minimum => {}
     }
     out
 }

@@ -16,7 +16,7 @@
 //! | `/grouping/active` | `foxglove.SceneUpdate` | entity `active`: one translucent green box per active body at each round start | `--detail merges` or `full` |
 //! | `/grouping/bodies` | `foxglove.SceneUpdate` | entity `merge`: the merged pair (red) and the new body (yellow) as boxes, per merge | `--detail merges` or `full` |
 //! | `/grouping/dormant` | `dormantevent.DormantEvent` | round, body, diameter of each body going dormant | `--detail merges` or `full` |
-//! | `/levels/<d>` | `foxglove.SceneUpdate` | one snapshot of the cut at depth d (d = 0..=depth max): entity `spheres` (interior nodes as `SpherePrimitive`s, size = diameter) and entity `leaves` (the cut's leaves as one orange `TriangleListPrimitive`) | `--detail levels` or `full`, finished runs |
+//! | `/levels/<d>` | `foxglove.SceneUpdate` | one snapshot of the cut at depth d (d = 0..=depth max), one entity per wrapper kind chosen with `--wrapper` for the cut's interior nodes: `spheres` (`SpherePrimitive`s, size = diameter), `hulls` (one indexed `TriangleListPrimitive`), `boxes` (axis-aligned `CubePrimitive`s), `obbs` (`CubePrimitive`s with orientation); and entity `leaves` (the cut's leaves as one orange `TriangleListPrimitive`) | `--detail levels` or `full`, finished runs |
 //!
 //! The input scene file is attached (name = its file name, media type `model/obj`, log time 0),
 //! and two metadata records describe the run ([`metadata`]): `wraptree` (version, git commit,
@@ -320,8 +320,19 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             return Ok(());
         };
         let tree = &grouping.tree;
-        if spheres.len() != tree.len() {
+        if !spheres.is_empty() && spheres.len() != tree.len() {
             bail!("{} spheres for {} tree nodes", spheres.len(), tree.len());
+        }
+        let none = crate::wrap::Wrappers::default();
+        let extra = outcome.wrappers.unwrap_or(&none);
+        for (what, len) in [
+            ("hulls", extra.hulls.as_ref().map(Vec::len)),
+            ("boxes", extra.boxes.as_ref().map(Vec::len)),
+            ("oriented boxes", extra.obbs.as_ref().map(Vec::len)),
+        ] {
+            if let Some(len) = len.filter(|&l| l != tree.len()) {
+                bail!("{len} {what} for {} tree nodes", tree.len());
+            }
         }
         let scene = self.info.scene;
         for d in 0..=tree.depth_max() {
@@ -329,12 +340,44 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             let mut topic =
                 add_topic(&mut self.writer, self.scene_update, &format!("/levels/{d}"))?;
             let cut = tree.level(d);
-            let mut balls = scene_msgs::entity("spheres", t);
-            balls.spheres = cut
+            let interior: Vec<usize> = cut
                 .iter()
                 .filter(|&&x| !tree.is_leaf(x))
-                .map(|&x| scene_msgs::sphere(&spheres[x as usize], scene_msgs::SPHERE_COLOR))
+                .map(|&x| x as usize)
                 .collect();
+            let mut entities = Vec::with_capacity(5);
+            if !spheres.is_empty() {
+                let mut e = scene_msgs::entity("spheres", t);
+                e.spheres = interior
+                    .iter()
+                    .map(|&x| scene_msgs::sphere(&spheres[x], scene_msgs::SPHERE_COLOR))
+                    .collect();
+                entities.push(e);
+            }
+            if let Some(h) = &extra.hulls {
+                let mut e = scene_msgs::entity("hulls", t);
+                e.triangles.push(scene_msgs::hull_triangles(
+                    interior.iter().map(|&x| &h[x]),
+                    scene_msgs::HULL_COLOR,
+                ));
+                entities.push(e);
+            }
+            if let Some(b) = &extra.boxes {
+                let mut e = scene_msgs::entity("boxes", t);
+                e.cubes = interior
+                    .iter()
+                    .map(|&x| scene_msgs::cube(&b[x], scene_msgs::BOX_COLOR))
+                    .collect();
+                entities.push(e);
+            }
+            if let Some(b) = &extra.obbs {
+                let mut e = scene_msgs::entity("obbs", t);
+                e.cubes = interior
+                    .iter()
+                    .map(|&x| scene_msgs::obb_cube(&b[x], scene_msgs::OBB_COLOR))
+                    .collect();
+                entities.push(e);
+            }
             let mut leaves = scene_msgs::entity("leaves", t);
             let leaf_ids = cut
                 .iter()
@@ -346,7 +389,8 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
                 scene_msgs::LEAF_COLOR,
                 &mut self.remap,
             ));
-            let msg = scene_msgs::update(vec![balls, leaves]);
+            entities.push(leaves);
+            let msg = scene_msgs::update(entities);
             emit(&mut self.writer, &mut self.buf, &mut topic, t, &msg)
                 .with_context(|| format!("writing level {d}"))?;
         }

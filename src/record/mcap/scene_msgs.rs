@@ -4,7 +4,7 @@
 
 use crate::geom::{Aabb, P3};
 use crate::scene::Scene;
-use crate::wrap::Sphere;
+use crate::wrap::{Hull, Obb, Sphere};
 use foxglove::messages::{
     Color, CubePrimitive, Point3, Pose, Quaternion, SceneEntity, SceneUpdate, SpherePrimitive,
     Timestamp, TriangleListPrimitive, Vector3,
@@ -22,6 +22,12 @@ pub const PAIR_COLOR: [f64; 4] = [0.95, 0.25, 0.2, 0.45];
 pub const NEW_COLOR: [f64; 4] = [1.0, 0.85, 0.1, 0.25];
 /// Interior nodes' spheres on `/levels/<d>`: translucent blue.
 pub const SPHERE_COLOR: [f64; 4] = [0.25, 0.55, 1.0, 0.3];
+/// Interior nodes' convex hulls on `/levels/<d>`: translucent green.
+pub const HULL_COLOR: [f64; 4] = [0.3, 0.8, 0.45, 0.3];
+/// Interior nodes' axis-aligned boxes on `/levels/<d>`: translucent purple.
+pub const BOX_COLOR: [f64; 4] = [0.6, 0.4, 0.9, 0.25];
+/// Interior nodes' oriented boxes on `/levels/<d>`: translucent teal.
+pub const OBB_COLOR: [f64; 4] = [0.1, 0.7, 0.75, 0.25];
 /// Leaves drawn on `/levels/<d>`: orange.
 pub const LEAF_COLOR: [f64; 4] = [1.0, 0.55, 0.15, 1.0];
 
@@ -73,6 +79,54 @@ pub fn cube(b: &Aabb, rgba: [f64; 4]) -> CubePrimitive {
         pose: pose_at(&b.center()),
         size: vector(e.x, e.y, e.z),
         color: color(rgba),
+    }
+}
+
+/// An oriented box: pose at its centre rotated to its axes, size = twice its half extents.
+pub fn obb_cube(b: &Obb, rgba: [f64; 4]) -> CubePrimitive {
+    let q = b.rotation();
+    let h = b.half * 2.0;
+    CubePrimitive {
+        pose: Some(Pose {
+            position: vector(b.center.x, b.center.y, b.center.z),
+            orientation: Some(Quaternion {
+                x: q.i,
+                y: q.j,
+                z: q.k,
+                w: q.w,
+            }),
+        }),
+        size: vector(h.x, h.y, h.z),
+        color: color(rgba),
+    }
+}
+
+/// One indexed triangle list drawing the hulls `hulls` (segment and point hulls draw
+/// nothing); each hull's vertices appear once.
+pub fn hull_triangles<'h>(
+    hulls: impl IntoIterator<Item = &'h Hull>,
+    rgba: [f64; 4],
+) -> TriangleListPrimitive {
+    let mut points = Vec::new();
+    let mut indices = Vec::new();
+    for h in hulls {
+        if h.triangles.is_empty() {
+            continue;
+        }
+        let base = points.len() as u32;
+        points.extend(h.vertices.iter().map(|p| Point3 {
+            x: p.x,
+            y: p.y,
+            z: p.z,
+        }));
+        indices.extend(h.triangles.iter().flatten().map(|&i| base + i));
+    }
+    TriangleListPrimitive {
+        pose: pose_at(&P3::origin()),
+        points,
+        color: color(rgba),
+        colors: Vec::new(),
+        indices,
     }
 }
 

@@ -21,7 +21,7 @@ const SPHERE_BLUE: u32 = 0x1E90FF40;
 const LEAF_ORANGE: u32 = 0xE07020FF;
 
 /// Logs every level of `tree` with the leaves drawn from `mesh`; `spheres` holds one sphere
-/// per node.
+/// per node, or none (levels without spheres: `levels/spheres` stays empty).
 pub(super) fn log_levels(
     rec: &RecordingStream,
     mesh: &PrimMesh,
@@ -29,7 +29,7 @@ pub(super) fn log_levels(
     spheres: &[Sphere],
     origin: &P3,
 ) -> anyhow::Result<()> {
-    if spheres.len() != tree.len() {
+    if !spheres.is_empty() && spheres.len() != tree.len() {
         anyhow::bail!("{} spheres for {} tree nodes", spheres.len(), tree.len());
     }
     for d in 0..=tree.depth_max() {
@@ -39,7 +39,7 @@ pub(super) fn log_levels(
         for node in tree.level(d) {
             if tree.is_leaf(node) {
                 tris.extend_from_slice(mesh.prim_tris(node));
-            } else {
+            } else if !spheres.is_empty() {
                 let s = &spheres[node as usize];
                 centers.push(rel(&s.center, origin));
                 radii.push(s.radius as f32);
