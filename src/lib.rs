@@ -8,5 +8,6 @@
 pub mod geom;
 pub mod grouping;
 pub mod record;
+pub mod render;
 pub mod scene;
 pub mod wrap;

@@ -5,6 +5,7 @@ mod group;
 mod record;
 mod replay;
 mod scene_cmd;
+mod snapshot;
 
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
@@ -34,6 +35,8 @@ enum Command {
     Scene(scene_cmd::SceneCmd),
     /// Time the grouping phase on the standard scenes (12,144-polygon robot bases, soups).
     Bench(bench::BenchCmd),
+    /// Render the input and chosen tree levels as PNG/SVG frames and a figure sheet.
+    Snapshot(snapshot::SnapshotCmd),
 }
 
 /// How to read a scene file.
@@ -127,6 +130,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Replay(c) => c.run(),
         Command::Scene(c) => c.run(),
         Command::Bench(c) => c.run(),
+        Command::Snapshot(c) => c.run(),
     }
 }
 

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Regenerates the README's figure sheets (docs/figures/*.png) like the paper's Figures 1–3:
+#   bash docs/figures/make.sh
+# Builds the release binary, renders each scene into a temporary directory with
+# `wraptree snapshot` and keeps only the sheet (figure.png). Deterministic: same bytes each run.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+cargo build --release --quiet
+bin=target/release/wraptree
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+snap() { # NAME SCENE ARGS...
+  local name=$1 scene=$2
+  shift 2
+  "$bin" snapshot "scenes/$scene" -o "$tmp/$name" "$@" >/dev/null
+  cp "$tmp/$name/figure.png" "docs/figures/$name.png"
+  echo "docs/figures/$name.png ($(stat -c %s "docs/figures/$name.png") bytes)"
+}
+
+# Figure 1: the robot base at the levels nearest 251, 104 and 8 nodes.
+snap robot-base robot-base.obj --nodes 251,104,8 --size 480x360
+# Figure 2: the lamp, the levels nearest 167 and 4 nodes as spheres, then as convex hulls.
+snap lamp lamp.obj --nodes 167,4 --wrapper sphere,hull --size 400x320
+# Figure 3: five lamps, the 8-node level as spheres and as convex hulls.
+snap lamps5 lamps5.obj --nodes 8 --wrapper sphere,hull --size 480x400
