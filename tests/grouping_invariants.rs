@@ -181,3 +181,24 @@ fn paper_like_scenes_are_shallow() {
         );
     }
 }
+
+/// The precision contract: f64 throughout, so a scene moved 1e7 away from the origin groups
+/// into the same tree with diameters equal up to the rounding of the moved coordinates
+/// themselves (a few ulps of 1e7, ulp = 1.86e-9). A random soup has no exact cost
+/// ties (a symmetric mesh would: rounding at 1e7 may then break a tie the other way).
+#[test]
+fn far_offset_gives_the_same_tree() {
+    let near = generate::soup(3000, 5);
+    let mut far = near.clone();
+    for p in &mut far.points {
+        *p += nalgebra::Vector3::new(1e7, -1e7, 1e7);
+    }
+    let (g0, log0) = run(&near, &Params::default());
+    let (g1, log1) = run(&far, &Params::default());
+    check_tree(&far, &g1, &log1);
+    assert_eq!(g0.tree.parent, g1.tree.parent);
+    for (a, b) in log0.merges.iter().zip(&log1.merges) {
+        let ulp = 1e7f64.next_up() - 1e7;
+        assert!((a.diameter - b.diameter).abs() <= 8.0 * ulp, "{a:?} vs {b:?}");
+    }
+}
