@@ -157,7 +157,15 @@ pub fn hull_of(mut points: Vec<P3>) -> (Hull, Option<Vec<P3>>) {
     if ext[small].partial_cmp(&(FLAT_REL * ext[big])) != Some(Greater) {
         return (flat_hull(&points, &frame, big, mid), None);
     }
-    match solid_hull(&points, &frame, lo, hi) {
+    // parry's f32 quickhull can return a non-convex mesh on near-degenerate input (seen on the
+    // 12,144-polygon scene); every result is checked in f64 against all the node's points, then
+    // retried with uniform scaling, and the principal-axes box is the always-valid last resort.
+    let tol = HULL_TOL_REL * ext.norm();
+    let valid = |h: Hull| points.iter().all(|p| h.excess(p) <= tol).then_some(h);
+    let solid = solid_hull(&points, &frame, lo, hi, false)
+        .and_then(valid)
+        .or_else(|| solid_hull(&points, &frame, lo, hi, true).and_then(valid));
+    match solid {
         Some(h) => (h, None),
         None => (box_hull(&frame, lo, hi), Some(points)),
     }
@@ -218,10 +226,15 @@ fn flat_hull(points: &[P3], frame: &Frame, u: usize, v: usize) -> Hull {
     }
 }
 
-/// The solid hull by parry in the scaled principal frame; `None` if parry fails or panics.
-fn solid_hull(points: &[P3], frame: &Frame, lo: V3, hi: V3) -> Option<Hull> {
+/// The solid hull by parry in the principal frame, each axis scaled to [-1, 1] (or all by the
+/// largest extent when `uniform`); `None` if parry fails or panics.
+fn solid_hull(points: &[P3], frame: &Frame, lo: V3, hi: V3, uniform: bool) -> Option<Hull> {
     let mid = (lo + hi) / 2.0;
-    let half = (hi - lo) / 2.0;
+    let half = if uniform {
+        V3::repeat((hi - lo).max() / 2.0)
+    } else {
+        (hi - lo) / 2.0
+    };
     let local: Vec<parry3d::math::Vector> = points
         .iter()
         .map(|p| {
