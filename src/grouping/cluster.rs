@@ -135,6 +135,9 @@ struct Clusterer<'s, P, O> {
     /// Whether Cost lower bounds may skip voxels (AABB p-set, finite non-negative weights,
     /// scene coordinates far from overflow).
     prune: bool,
+    /// Whether every box coordinate is finite, so the round-start scan may stop early in a
+    /// cell's records (sorted by smallest x).
+    finite: bool,
     stats: Stats,
     _scene: std::marker::PhantomData<&'s Scene>,
 }
@@ -154,6 +157,9 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
         let mut d = diameter;
         d.reserve(total - n);
         let bounds = aabb.iter().fold(Aabb::EMPTY, |b, x| b.merge(x));
+        let finite = aabb
+            .iter()
+            .all(|b| (0..3).all(|k| b.min[k].is_finite() && b.max[k].is_finite()));
         let ext = bounds.extents();
         let morton_scale = [0, 1, 2].map(|k| {
             if ext[k] > 0.0 {
@@ -190,6 +196,7 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
             partners: Partners::default(),
             k: if P::AABB { super::mpairs::K_MAX } else { 1 },
             prune,
+            finite,
             stats: Stats::default(),
             _scene: std::marker::PhantomData,
         }

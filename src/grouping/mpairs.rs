@@ -199,11 +199,11 @@ impl List {
         if len == k && cost > self.e[k - 1].cost {
             return;
         }
-        let tp = tags[partner as usize];
+        // Tie tags are read only for equal Costs (rare), sparing a random memory access.
         let goes_before = |c: &Cand| match cost.total_cmp(&c.cost) {
             Ordering::Less => true,
             Ordering::Greater => false,
-            Ordering::Equal => tp < tags[c.partner as usize],
+            Ordering::Equal => tags[partner as usize] < tags[c.partner as usize],
         };
         let mut i = len;
         if i == k {

@@ -8,8 +8,10 @@
 //! out in the order the bodies were inserted (Morton order at round start), with slack for the
 //! bodies made during the round; a full cell moves to the end of the arena with twice the room.
 //! Removal swaps the body with its cell's last record (O(1), the arena position of every body is
-//! kept). Each cell also keeps the box of the centres and the largest diameter ever stored in it
-//! this round, so callers can bound the Cost of any pair with a body of that cell.
+//! kept). At build each cell's records are sorted by their boxes' smallest x, so the round-start
+//! scan can stop early in a cell; later insertions and removals do not keep that order. Each
+//! cell also keeps the box of the centres and the largest diameter ever stored in it this
+//! round, so callers can bound the Cost of any pair with a body of that cell.
 
 use crate::geom::{Aabb, P3};
 use std::collections::HashMap;
@@ -145,6 +147,14 @@ impl VoxelHash {
         self.recs.resize(start as usize, BLANK);
         for (&x, &c) in bodies.iter().zip(&cell_of) {
             self.put(c, x, &boxes[x as usize], diameters[x as usize]);
+        }
+        for cell in &self.cells {
+            let (s, e) = (cell.start as usize, (cell.start + cell.len) as usize);
+            let recs = &mut self.recs[s..e];
+            recs.sort_unstable_by(|a, b| a.aabb.min.x.total_cmp(&b.aabb.min.x));
+            for (i, r) in recs.iter().enumerate() {
+                self.at[r.id as usize].0 = (s + i) as u32;
+            }
         }
     }
 

@@ -8,7 +8,9 @@
 //! For the AABB p-set (whose pair Cost is a symmetric function of the two boxes and diameters):
 //! - the round-start scan visits each pair of cells once — a body's own cell after it, and the
 //!   voxels after its own in (x, y, z) order — counting every eligible pair once and offering
-//!   it to both bodies' partner lists;
+//!   it to both bodies' partner lists; as the freshly built cells are sorted by their boxes'
+//!   smallest x, a body's scan of a cell stops at the first record starting more than GLimit
+//!   beyond the body's largest x (finite scenes);
 //! - a single body's search visits the cells in increasing order of a lower bound on the Cost
 //!   of any pair with one of their bodies and stops at the first cell whose bound exceeds the
 //!   last Cost the list keeps, so the list is still exactly the first partners in key order.
@@ -17,7 +19,8 @@
 //!   evaluated with the same floating-point operations as the Cost, on smaller operands, so it
 //!   never exceeds a Cost it bounds, and is lowered by 1e-9 relative for `powf`.
 //!
-//! Other p-sets search every candidate for the single best partner, as in the paper.
+//! With C = 0 and B > 0 the pair Cost skips Balance (then weighted by zero), bit for bit the
+//! same value. Other p-sets search every candidate for the single best partner, as in the paper.
 
 use super::{Clusterer, PSetBodies, fill_balance};
 use crate::geom::{Aabb, P3, V3};
@@ -30,12 +33,19 @@ use crate::grouping::voxel_hash::CellBounds;
 /// exponent without `powf` (any other value uses `w.a`).
 #[inline(always)]
 fn pair_cost<const A: u8>(w: &Weights, d: f64, dx: f64, dy: f64) -> f64 {
-    let (fill, balance) = fill_balance(d, dx, dy);
     let scale = match A {
         1 => d,
         0 => 1.0,
         _ => d.powf(w.a),
     };
+    if w.c == 0.0 && w.b > 0.0 && dx < f64::INFINITY && dy < f64::INFINITY {
+        // Balance is then finite, so C·Balance = ±0 and B·Fill + C·Balance = B·Fill bit for
+        // bit (B·Fill is +0, positive or NaN): skip Balance's division.
+        let sum = dx + dy;
+        let fill = if sum > 0.0 { d / sum } else { 1.0 };
+        return scale * (w.b * fill);
+    }
+    let (fill, balance) = fill_balance(d, dx, dy);
     w.cost_scaled(scale, fill, balance)
 }
 
@@ -118,7 +128,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<'_, P, O> {
 
     /// Every eligible pair once (AABB p-set); returns their number.
     fn pairs_once<const A: u8>(&mut self, glimit: f64) -> u64 {
-        let (k, w) = (self.k, self.weights);
+        let (k, w, finite) = (self.k, self.weights, self.finite);
         let mut pairs = 0u64;
         let mut candidates = 0u64;
         let mut near: Vec<u32> = Vec::with_capacity(27);
@@ -157,6 +167,10 @@ impl<P: PSetBodies, O: Observer> Clusterer<'_, P, O> {
                 let own = &hash.recs(c)[i + 1..];
                 for seg in std::iter::once(own).chain(fwd.iter().map(|&cell| hash.recs(cell))) {
                     for yr in seg {
+                        // Fresh cells are sorted by smallest x: the rest are farther still.
+                        if finite && yr.aabb.min.x - xa.max.x > glimit {
+                            break;
+                        }
                         candidates += 1;
                         if xa.gap_linf(&yr.aabb) > glimit {
                             continue;
