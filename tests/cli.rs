@@ -232,3 +232,51 @@ fn interrupted_recording_keeps_what_was_recorded() {
         String::from_utf8_lossy(&verify.stderr)
     );
 }
+
+#[test]
+fn wrap_json_reports_every_kind_with_levels_and_containment() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "wrap",
+        &scene("robot-base.obj"),
+        "--json",
+        "--samples",
+        "16",
+    ];
+    let out = wraptree(&args, dir.path());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["primitives"].as_u64(), Some(276));
+    assert_eq!(v["sphere_method"].as_str(), Some("aabb-center"));
+    let depth = v["depth_max"].as_u64().unwrap() as usize;
+    let kinds: Vec<&str> = v["wrappers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w["kind"].as_str().unwrap())
+        .collect();
+    assert_eq!(kinds, ["sphere", "hull", "box", "obb"]);
+    for w in v["wrappers"].as_array().unwrap() {
+        let c = &w["containment"];
+        assert_eq!(c["holds"].as_bool(), Some(true), "{w}");
+        assert!(w["build_seconds"].as_f64().unwrap() >= 0.0);
+        let levels = w["levels"].as_array().unwrap();
+        assert_eq!(levels.len(), depth + 1, "one row per level");
+        assert_eq!(levels[0]["nodes"].as_u64(), Some(1), "the root alone");
+        assert_eq!(levels[depth]["nodes"].as_u64(), Some(276), "every leaf");
+        for l in levels {
+            for k in ["volume", "error_max", "error_mean"] {
+                assert!(l[k].as_f64().unwrap() >= 0.0, "{k}: {l}");
+            }
+        }
+    }
+    let bad = wraptree(
+        &["wrap", &scene("robot-base.obj"), "--wrapper", "cone"],
+        dir.path(),
+    );
+    assert_one_line_error(&bad, "valid: sphere, hull, box");
+}

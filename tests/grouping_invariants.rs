@@ -199,6 +199,9 @@ fn far_offset_gives_the_same_tree() {
     assert_eq!(g0.tree.parent, g1.tree.parent);
     for (a, b) in log0.merges.iter().zip(&log1.merges) {
         let ulp = 1e7f64.next_up() - 1e7;
-        assert!((a.diameter - b.diameter).abs() <= 8.0 * ulp, "{a:?} vs {b:?}");
+        assert!(
+            (a.diameter - b.diameter).abs() <= 8.0 * ulp,
+            "{a:?} vs {b:?}"
+        );
     }
 }

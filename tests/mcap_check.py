@@ -9,8 +9,16 @@ SceneUpdate again with the official schema). Checks:
   - every message on every channel decodes; the wraptree metadata and scene attachment exist;
   - /grouping/merge holds N-1 messages with steps 0..N-2 and log times increase;
   - for a finished run recorded with levels, /levels/0 .. /levels/<depth_max> each hold one
-    SceneUpdate, and every input vertex (the /scene triangle points) lies in some sphere of the
-    level (tolerance 1e-6 x scene diagonal) or is a vertex of a drawn leaf triangle.
+    SceneUpdate; its wrapper entities (`spheres`, `hulls`, `boxes`, `obbs`, whichever were
+    recorded) hold the same number of wrappers (one per interior node of the cut), and for each
+    of them every input vertex (the /scene triangle points) lies in some wrapper of that entity
+    or is a vertex of the `leaves` entity's triangles. Spheres and boxes (axis-aligned or
+    oriented, rotated by their pose's quaternion) allow 1e-6 x the scene diagonal. Hulls (one
+    TriangleListPrimitive each) allow 1e-5 x the scene diagonal (hulls are decided in f32): a
+    closed hull mesh is a solid, tested against the planes of its well-shaped faces (twice the
+    area >= 1e-3 x the longest edge squared, as in the Rust `Hull::excess`), each oriented away
+    from the mean of the hull's points; an open one (a flat polygon, or a degenerate triangle
+    standing for a segment or a point) by the point's distance to its triangles.
 Exits 0 and prints one summary line on success; prints `mcap_check: FAIL ...` and exits 1
 otherwise (2 when a required module is missing).
 """
@@ -45,35 +53,166 @@ def triangle_points(tri):
     return pts
 
 
-def check_level(d, update, vertices, tol):
-    spheres = []
-    drawn = set()
-    for ent in update.entities:
-        for s in ent.spheres:
-            sx, sy, sz = s.size.x, s.size.y, s.size.z
-            if not (sx == sy == sz) or sx < 0:
-                fail(f"/levels/{d}: sphere with size {sx}, {sy}, {sz}")
-            p = s.pose.position
-            spheres.append((p.x, p.y, p.z, sx / 2))
-        for tri in ent.triangles:
-            drawn.update(triangle_points(tri))
-    # Uniform grid with cell = the largest sphere diameter: each sphere touches <= 8 cells.
-    cell = max([2 * r for *_, r in spheres] + [tol, 1e-300])
+def sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def point_segment(p, a, b):
+    ab = sub(b, a)
+    den = dot(ab, ab)
+    t = 0.0 if den == 0 else min(1.0, max(0.0, dot(sub(p, a), ab) / den))
+    return math.dist(p, (a[0] + t * ab[0], a[1] + t * ab[1], a[2] + t * ab[2]))
+
+
+def point_triangle(p, a, b, c):
+    """Distance from p to the triangle abc (to its edges when it is degenerate)."""
+    ab, ac, ap = sub(b, a), sub(c, a), sub(p, a)
+    n = cross(ab, ac)
+    nn = dot(n, n)
+    if nn > 0:
+        # Barycentric coordinates of p's projection onto the plane.
+        v = dot(cross(ap, ac), n) / nn
+        w = dot(cross(ab, ap), n) / nn
+        if v >= 0 and w >= 0 and v + w <= 1:
+            return abs(dot(ap, n)) / math.sqrt(nn)
+    return min(point_segment(p, a, b), point_segment(p, b, c), point_segment(p, c, a))
+
+
+def rotate(q, v):
+    """v rotated by the unit quaternion q = (x, y, z, w)."""
+    u = q[:3]
+    t = cross(u, v)
+    t = (2 * t[0], 2 * t[1], 2 * t[2])
+    s = cross(u, t)
+    return (v[0] + q[3] * t[0] + s[0], v[1] + q[3] * t[1] + s[1], v[2] + q[3] * t[2] + s[2])
+
+
+def quat(pose):
+    o = pose.orientation
+    q = (o.x, o.y, o.z, o.w)
+    norm = math.sqrt(sum(c * c for c in q))
+    if not norm > 0:
+        fail("box with a zero quaternion")
+    return tuple(c / norm for c in q)
+
+
+def sphere_wrapper(s, tol):
+    sx, sy, sz = s.size.x, s.size.y, s.size.z
+    if not (sx == sy == sz) or sx < 0:
+        fail(f"sphere with size {sx}, {sy}, {sz}")
+    c = (s.pose.position.x, s.pose.position.y, s.pose.position.z)
+    r = sx / 2
+    return ([x - r for x in c], [x + r for x in c], lambda v: math.dist(v, c) <= r + tol)
+
+
+def cube_wrapper(b, tol):
+    half = (b.size.x / 2, b.size.y / 2, b.size.z / 2)
+    if min(half) < 0:
+        fail(f"box with size {b.size}")
+    c = (b.pose.position.x, b.pose.position.y, b.pose.position.z)
+    q = quat(b.pose)
+    inv = (-q[0], -q[1], -q[2], q[3])
+    # Bounding box of the rotated box: the extent along each world axis.
+    axes = [rotate(q, e) for e in ((1, 0, 0), (0, 1, 0), (0, 0, 1))]
+    ext = [sum(abs(axes[a][k]) * half[a] for a in range(3)) for k in range(3)]
+
+    def inside(v):
+        local = rotate(inv, sub(v, c))
+        return all(abs(local[k]) <= half[k] + tol for k in range(3))
+
+    return ([c[k] - ext[k] for k in range(3)], [c[k] + ext[k] for k in range(3)], inside)
+
+
+def hull_wrapper(tri, tol):
+    pts = [(p.x, p.y, p.z) for p in tri.points]
+    idx = list(tri.indices)
+    if not pts or not idx or len(idx) % 3 or max(idx) >= len(pts):
+        fail("hull triangle list without points or with bad indices")
+    tris = [(pts[idx[k]], pts[idx[k + 1]], pts[idx[k + 2]]) for k in range(0, len(idx), 3)]
+    edges = {}
+    for k in range(0, len(idx), 3):
+        for a, b in ((idx[k], idx[k + 1]), (idx[k + 1], idx[k + 2]), (idx[k + 2], idx[k])):
+            key = (min(a, b), max(a, b))
+            edges[key] = edges.get(key, 0) + 1
+    closed = len(tris) >= 4 and all(n == 2 for n in edges.values())
+    lo = [min(p[k] for p in pts) for k in range(3)]
+    hi = [max(p[k] for p in pts) for k in range(3)]
+    if not closed:
+        return (lo, hi, lambda v: min(point_triangle(v, *t) for t in tris) <= tol)
+    mean = tuple(sum(p[k] for p in pts) / len(pts) for k in range(3))
+    planes = []
+    for a, b, c in tris:
+        n = cross(sub(b, a), sub(c, a))
+        e = [math.dist(a, b), math.dist(b, c), math.dist(c, a)]
+        norm = math.sqrt(dot(n, n))
+        if norm >= 1e-3 * max(e) ** 2 and min(e) > 0:
+            n = tuple(x / norm for x in n)
+            if dot(n, sub(a, mean)) < 0:
+                n = tuple(-x for x in n)
+            planes.append((n, a))
+    if not planes:
+        fail("a closed hull without a well-shaped face")
+
+    def inside(v):
+        if any(v[k] < lo[k] - tol or v[k] > hi[k] + tol for k in range(3)):
+            return False
+        return all(dot(n, sub(v, a)) <= tol for n, a in planes)
+
+    return (lo, hi, inside)
+
+
+def covered(d, kind, wrappers, vertices, drawn, tol):
+    """Fails unless every vertex is in one of `wrappers` ((lo, hi, inside) triples) or drawn."""
+    # Uniform grid with cell = the largest wrapper extent: each wrapper touches <= 8 cells.
+    cell = max([max(h - l for l, h in zip(lo, hi)) for lo, hi, _ in wrappers] + [tol, 1e-300])
     grid = {}
-    for i, (x, y, z, r) in enumerate(spheres):
-        lo = [math.floor((c - r - tol) / cell) for c in (x, y, z)]
-        hi = [math.floor((c + r + tol) / cell) for c in (x, y, z)]
-        for gx in range(lo[0], hi[0] + 1):
-            for gy in range(lo[1], hi[1] + 1):
-                for gz in range(lo[2], hi[2] + 1):
+    for i, (lo, hi, _) in enumerate(wrappers):
+        a = [math.floor((c - tol) / cell) for c in lo]
+        b = [math.floor((c + tol) / cell) for c in hi]
+        for gx in range(a[0], b[0] + 1):
+            for gy in range(a[1], b[1] + 1):
+                for gz in range(a[2], b[2] + 1):
                     grid.setdefault((gx, gy, gz), []).append(i)
     for v in vertices:
         if v in drawn:
             continue
         key = tuple(math.floor(c / cell) for c in v)
-        if not any(math.dist(v, spheres[i][:3]) <= spheres[i][3] + tol for i in grid.get(key, ())):
-            fail(f"/levels/{d}: input vertex {v} is in no sphere and on no drawn leaf")
-    return len(spheres)
+        if not any(wrappers[i][2](v) for i in grid.get(key, ())):
+            fail(f"/levels/{d}: input vertex {v} is in no {kind} and on no drawn leaf")
+
+
+def check_level(d, update, vertices, tol, hull_tol):
+    """Checks one level; returns the number of wrappers per recorded kind."""
+    wrappers = {}
+    drawn = set()
+    for ent in update.entities:
+        if ent.id == "leaves":
+            for tri in ent.triangles:
+                drawn.update(triangle_points(tri))
+        elif ent.id == "spheres":
+            wrappers[ent.id] = [sphere_wrapper(s, tol) for s in ent.spheres]
+        elif ent.id == "hulls":
+            wrappers[ent.id] = [hull_wrapper(t, hull_tol) for t in ent.triangles]
+        elif ent.id in ("boxes", "obbs"):
+            wrappers[ent.id] = [cube_wrapper(b, tol) for b in ent.cubes]
+        else:
+            fail(f"/levels/{d}: unexpected entity {ent.id!r}")
+    if not wrappers:
+        fail(f"/levels/{d}: no wrapper entity")
+    counts = {k: len(w) for k, w in wrappers.items()}
+    if len(set(counts.values())) != 1:
+        fail(f"/levels/{d}: wrapper entities disagree on the cut's interior nodes: {counts}")
+    for kind, ws in sorted(wrappers.items()):
+        covered(d, kind, ws, vertices, drawn, tol)
+    return counts
 
 
 def main():
@@ -129,9 +268,10 @@ def main():
             vertices.update(triangle_points(tri))
     lo = [min(v[k] for v in vertices) for k in range(3)]
     hi = [max(v[k] for v in vertices) for k in range(3)]
-    tol = 1e-6 * max(math.dist(lo, hi), 1e-300)
+    diagonal = max(math.dist(lo, hi), 1e-300)
+    tol, hull_tol = 1e-6 * diagonal, 1e-5 * diagonal
 
-    spheres = 0
+    wrappers = {}
     if run["detail"] in ("levels", "full") and run["complete"] == "true":
         depth_max = int(run["depth_max"])
         if sorted(levels) != list(range(depth_max + 1)):
@@ -139,11 +279,14 @@ def main():
         for d, updates in sorted(levels.items()):
             if len(updates) != 1:
                 fail(f"/levels/{d} holds {len(updates)} messages, expected 1")
-            spheres += check_level(d, updates[0], vertices, tol)
+            for kind, n_kind in check_level(d, updates[0], vertices, tol, hull_tol).items():
+                wrappers[kind] = wrappers.get(kind, 0) + n_kind
     elif levels:
         fail(f"levels written with detail {run['detail']} / complete {run['complete']}")
     print(f"mcap_check: ok {path}: {sum(counts.values())} messages on {len(counts)} topics, "
-          f"{len(merges)} merges, {len(levels)} levels, {spheres} spheres, {len(vertices)} vertices")
+          f"{len(merges)} merges, {len(levels)} levels, "
+          f"{', '.join(f'{n} {k}' for k, n in sorted(wrappers.items())) or 'no wrappers'}, "
+          f"{len(vertices)} vertices")
 
 
 if __name__ == "__main__":

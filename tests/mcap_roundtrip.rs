@@ -10,11 +10,12 @@ use std::io::{BufWriter, Cursor, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use wraptree::geom::V3;
 use wraptree::grouping::{Event, EventLog, Grouping, Observer, Params, Tee, group};
 use wraptree::record::mcap::{McapRecorder, metadata, read_recording};
 use wraptree::record::{Detail, Outcome, RunInfo};
 use wraptree::scene::{LoadOptions, Loaded, generate, load_bytes};
-use wraptree::wrap::{SphereMethod, sphere_tree};
+use wraptree::wrap::{SphereMethod, WrapperKind, Wrappers, sphere_tree};
 
 fn load_grid() -> Loaded {
     load_bytes(
@@ -423,4 +424,61 @@ fn paper_scene_recordings_are_small() {
         assert_eq!(read_recording(&path).unwrap().merges, log.merges);
         assert!(size <= 20_000_000, "{kind}: {size} bytes");
     }
+}
+
+/// Records `loaded` at full detail with `wrappers` (spheres from them) to `path`.
+fn record_wrappers(loaded: &Loaded, path: &Path, g: &Grouping, wrappers: &Wrappers) {
+    let resolved = Params::default().resolve(&loaded.scene);
+    let info = RunInfo {
+        scene: &loaded.scene,
+        source: &loaded.source,
+        params: &resolved,
+        detail: Detail::Levels,
+    };
+    let file = std::fs::File::create(path).unwrap();
+    let mut rec = McapRecorder::new(BufWriter::new(file), &info).unwrap();
+    let mut log = EventLog::default();
+    group(&loaded.scene, &Params::default(), Tee(&mut rec, &mut log));
+    let outcome = Outcome {
+        grouping: Some(g),
+        spheres: wrappers.spheres.as_deref(),
+        wrappers: Some(wrappers),
+        merges: log.merges.len() as u32,
+        rounds: log.rounds.len() as u32,
+        seconds: 0.0,
+    };
+    rec.finish(&outcome).unwrap().flush().unwrap();
+}
+
+/// Every wrapper kind's levels cover the scene in the Python checker (hulls by their face
+/// planes, boxes and oriented boxes by their poses), and hulls shrunk by 20 % fail it.
+#[test]
+fn every_wrapper_kind_passes_the_python_checker() {
+    let scene = generate::by_name("robot-base", None, None, 1).unwrap();
+    let mut obj = Vec::new();
+    scene.write_obj(&mut obj).unwrap();
+    let loaded = load_bytes("robot-base.obj", obj, &LoadOptions::default()).unwrap();
+    let n = loaded.scene.len();
+    let g = group(&loaded.scene, &Params::default(), ());
+    let kinds = WrapperKind::ALL;
+    let mut wrappers = Wrappers::build(&g.tree, &loaded.scene, &kinds, SphereMethod::default());
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("all.mcap");
+    record_wrappers(&loaded, &path, &g, &wrappers);
+    let (ok, text) = python_check(&path, n);
+    assert!(ok, "{text}");
+    for kind in ["spheres", "hulls", "boxes", "obbs"] {
+        assert!(text.contains(&format!(" {kind}")), "{kind} checked: {text}");
+    }
+
+    for h in wrappers.hulls.as_mut().unwrap().iter_mut().skip(n) {
+        let c = h.vertices.iter().map(|p| p.coords).sum::<V3>() / h.vertices.len() as f64;
+        for p in &mut h.vertices {
+            p.coords = c + (p.coords - c) * 0.8;
+        }
+    }
+    let path = dir.path().join("shrunk.mcap");
+    record_wrappers(&loaded, &path, &g, &wrappers);
+    let (ok, text) = python_check(&path, n);
+    assert!(!ok && text.contains("in no hulls"), "{text}");
 }

@@ -13,7 +13,7 @@ use wraptree::grouping::{EventLog, Grouping, Params, Tee, Weights, group};
 use wraptree::record::rrd::RrdRecorder;
 use wraptree::record::{Detail, Outcome, RunInfo};
 use wraptree::scene::{LoadOptions, Loaded, generate, load_bytes};
-use wraptree::wrap::{SphereMethod, sphere_tree};
+use wraptree::wrap::{SphereMethod, WrapperKind, Wrappers};
 
 /// Prints a JSON summary of the first recording store of the file in `argv[1]`.
 const READER: &str = r#"
@@ -61,8 +61,14 @@ struct Run {
     summary: Summary,
 }
 
-/// Groups `loaded` while recording it to `path` at `detail`.
-fn write(path: &Path, loaded: &Loaded, detail: Detail, params: &Params) -> (Grouping, EventLog) {
+/// Groups `loaded` while recording it to `path` at `detail`, with the Wrapper Trees of `kinds`.
+fn write(
+    path: &Path,
+    loaded: &Loaded,
+    detail: Detail,
+    params: &Params,
+    kinds: &[WrapperKind],
+) -> (Grouping, EventLog) {
     let scene = &loaded.scene;
     let resolved = params.resolve(scene);
     let info = RunInfo {
@@ -74,11 +80,12 @@ fn write(path: &Path, loaded: &Loaded, detail: Detail, params: &Params) -> (Grou
     let mut recorder = RrdRecorder::new(path, &info).expect("recorder starts");
     let mut log = EventLog::default();
     let grouping = group(scene, params, Tee(&mut recorder, &mut log));
-    let spheres = sphere_tree(&grouping.tree, scene, SphereMethod::default());
+    let mut wrappers = Wrappers::build(&grouping.tree, scene, kinds, SphereMethod::default());
+    let spheres = wrappers.spheres.take().unwrap_or_default();
     let outcome = Outcome {
         grouping: Some(&grouping),
         spheres: Some(&spheres),
-        wrappers: None,
+        wrappers: Some(&wrappers),
         merges: log.merges.len() as u32,
         rounds: grouping.rounds,
         seconds: 0.0,
@@ -87,9 +94,9 @@ fn write(path: &Path, loaded: &Loaded, detail: Detail, params: &Params) -> (Grou
     (grouping, log)
 }
 
-/// Records the grid scene at `detail`, checks the file with the CLI and summarises it with
-/// the Python reader.
-fn record(dir: &Path, detail: Detail, params: &Params) -> Run {
+/// Records the grid scene at `detail` with the Wrapper Trees of `kinds`, checks the file with
+/// the CLI and summarises it with the Python reader.
+fn record(dir: &Path, detail: Detail, params: &Params, kinds: &[WrapperKind]) -> Run {
     let loaded = load_bytes(
         "grid.obj",
         common::grid_obj(8, 6, 1.5, 0.0),
@@ -97,7 +104,7 @@ fn record(dir: &Path, detail: Detail, params: &Params) -> Run {
     )
     .expect("grid scene loads");
     let path = dir.join(format!("grid-{detail:?}.rrd"));
-    let (grouping, log) = write(&path, &loaded, detail, params);
+    let (grouping, log) = write(&path, &loaded, detail, params, kinds);
 
     let verify = Command::new("rerun")
         .args(["rrd", "verify"])
@@ -138,8 +145,22 @@ fn sorted(mut v: Vec<i64>) -> Vec<i64> {
     v
 }
 
-/// Checks one recording's entities, timelines and row counts against its event log.
-fn check(run: &Run, detail: Detail) {
+/// The `levels/*` wrapper entities of the Wrapper Tree `kinds`.
+fn wrapper_entities(kinds: &[WrapperKind]) -> Vec<&'static str> {
+    kinds
+        .iter()
+        .map(|k| match k {
+            WrapperKind::Sphere => "/levels/spheres",
+            WrapperKind::Hull => "/levels/hulls",
+            WrapperKind::Box => "/levels/boxes",
+            WrapperKind::Obb => "/levels/obbs",
+        })
+        .collect()
+}
+
+/// Checks one recording's entities, timelines and row counts against its event log; `kinds`
+/// are the Wrapper Trees it was recorded with.
+fn check(run: &Run, detail: Detail, kinds: &[WrapperKind]) {
     let s = &run.summary;
     let n = run.grouping.tree.leaves();
     assert_eq!(s.recordings.len(), 1, "one recording store");
@@ -170,7 +191,8 @@ fn check(run: &Run, detail: Detail) {
         ]);
     }
     if detail.levels() {
-        want.extend(["/levels/spheres", "/levels/leaves"]);
+        want.insert("/levels/leaves");
+        want.extend(wrapper_entities(kinds));
     }
     let data: BTreeSet<&str> = s
         .entities
@@ -236,7 +258,10 @@ fn check(run: &Run, detail: Detail) {
     }
     if detail.levels() {
         let levels = range(run.grouping.tree.depth_max() as usize + 1);
-        for e in ["/levels/spheres", "/levels/leaves"] {
+        for e in wrapper_entities(kinds)
+            .into_iter()
+            .chain(["/levels/leaves"])
+        {
             assert_eq!(
                 sorted(s.entities[e].level.clone()),
                 levels,
@@ -251,9 +276,15 @@ fn every_detail_reads_back_with_the_expected_entities_and_timelines() {
     let dir = tempfile::tempdir().unwrap();
     let params = Params::default();
     let mut ids = BTreeSet::new();
-    for detail in [Detail::Levels, Detail::Merges, Detail::Full] {
-        let run = record(dir.path(), detail, &params);
-        check(&run, detail);
+    let sphere = [WrapperKind::Sphere];
+    // Levels with every wrapper kind: `levels/hulls`, `levels/boxes` and `levels/obbs` too.
+    for (detail, kinds) in [
+        (Detail::Levels, &WrapperKind::ALL[..]),
+        (Detail::Merges, &sphere[..]),
+        (Detail::Full, &sphere[..]),
+    ] {
+        let run = record(dir.path(), detail, &params, kinds);
+        check(&run, detail, kinds);
         ids.insert(run.summary.recordings[0].1.clone());
     }
     assert_eq!(
@@ -270,7 +301,7 @@ fn every_detail_reads_back_with_the_expected_entities_and_timelines() {
         },
         ..Params::default()
     };
-    let run = record(dir.path(), Detail::Levels, &other);
+    let run = record(dir.path(), Detail::Levels, &other, &sphere);
     assert!(
         !ids.contains(&run.summary.recordings[0].1),
         "other parameters, other recording id"
@@ -313,10 +344,11 @@ fn a_full_recording_of_the_12144_polygon_scene_stays_under_20_mb() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("robots44.rrd");
     let start = std::time::Instant::now();
-    write(&path, &loaded, Detail::Full, &Params::default());
+    let kinds = [WrapperKind::Sphere, WrapperKind::Hull];
+    write(&path, &loaded, Detail::Full, &Params::default(), &kinds);
     let bytes = std::fs::metadata(&path).unwrap().len();
     eprintln!(
-        "{} primitives: full .rrd {:.2} MB in {:.2} s",
+        "{} primitives: full .rrd with spheres and hulls {:.2} MB in {:.2} s",
         loaded.scene.len(),
         bytes as f64 / 1e6,
         start.elapsed().as_secs_f64()

@@ -1,11 +1,13 @@
 //! Argument definitions and dispatch for every subcommand.
 
 mod bench;
+mod cover;
 mod group;
 mod record;
 mod replay;
 mod scene_cmd;
 mod snapshot;
+mod wrap_cmd;
 
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
@@ -37,6 +39,10 @@ enum Command {
     Bench(bench::BenchCmd),
     /// Render the input and chosen tree levels as PNG/SVG frames and a figure sheet.
     Snapshot(snapshot::SnapshotCmd),
+    /// Build Wrapper Trees and print their per-level tightness and containment check.
+    Wrap(wrap_cmd::WrapCmd),
+    /// The fewest wrappers that model a scene within --tolerance, or the best --budget of them.
+    Cover(cover::CoverCmd),
 }
 
 /// How to read a scene file.
@@ -131,6 +137,8 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Scene(c) => c.run(),
         Command::Bench(c) => c.run(),
         Command::Snapshot(c) => c.run(),
+        Command::Wrap(c) => c.run(),
+        Command::Cover(c) => c.run(),
     }
 }
 

@@ -28,6 +28,7 @@
 //! # }
 //! ```
 
+pub mod cover;
 pub mod distance;
 pub mod hull;
 pub mod kind;

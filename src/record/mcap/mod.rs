@@ -16,7 +16,7 @@
 //! | `/grouping/active` | `foxglove.SceneUpdate` | entity `active`: one translucent green box per active body at each round start | `--detail merges` or `full` |
 //! | `/grouping/bodies` | `foxglove.SceneUpdate` | entity `merge`: the merged pair (red) and the new body (yellow) as boxes, per merge | `--detail merges` or `full` |
 //! | `/grouping/dormant` | `dormantevent.DormantEvent` | round, body, diameter of each body going dormant | `--detail merges` or `full` |
-//! | `/levels/<d>` | `foxglove.SceneUpdate` | one snapshot of the cut at depth d (d = 0..=depth max), one entity per wrapper kind chosen with `--wrapper` for the cut's interior nodes: `spheres` (`SpherePrimitive`s, size = diameter), `hulls` (one indexed `TriangleListPrimitive`), `boxes` (axis-aligned `CubePrimitive`s), `obbs` (`CubePrimitive`s with orientation); and entity `leaves` (the cut's leaves as one orange `TriangleListPrimitive`) | `--detail levels` or `full`, finished runs |
+//! | `/levels/<d>` | `foxglove.SceneUpdate` | one snapshot of the cut at depth d (d = 0..=depth max), one entity per wrapper kind chosen with `--wrapper` for the cut's interior nodes: `spheres` (`SpherePrimitive`s, size = diameter), `hulls` (one indexed `TriangleListPrimitive` per hull; a segment hull is one degenerate triangle `[a, b, b]`, a point hull `[a, a, a]`), `boxes` (axis-aligned `CubePrimitive`s), `obbs` (`CubePrimitive`s with orientation); and entity `leaves` (the cut's leaves as one orange `TriangleListPrimitive`) | `--detail levels` or `full`, finished runs |
 //!
 //! The input scene file is attached (name = its file name, media type `model/obj`, log time 0),
 //! and two metadata records describe the run ([`metadata`]): `wraptree` (version, git commit,
@@ -356,10 +356,10 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             }
             if let Some(h) = &extra.hulls {
                 let mut e = scene_msgs::entity("hulls", t);
-                e.triangles.push(scene_msgs::hull_triangles(
-                    interior.iter().map(|&x| &h[x]),
-                    scene_msgs::HULL_COLOR,
-                ));
+                e.triangles = interior
+                    .iter()
+                    .map(|&x| scene_msgs::hull_triangles(&h[x], scene_msgs::HULL_COLOR))
+                    .collect();
                 entities.push(e);
             }
             if let Some(b) = &extra.boxes {

@@ -101,26 +101,25 @@ pub fn obb_cube(b: &Obb, rgba: [f64; 4]) -> CubePrimitive {
     }
 }
 
-/// One indexed triangle list drawing the hulls `hulls` (segment and point hulls draw
-/// nothing); each hull's vertices appear once.
-pub fn hull_triangles<'h>(
-    hulls: impl IntoIterator<Item = &'h Hull>,
-    rgba: [f64; 4],
-) -> TriangleListPrimitive {
-    let mut points = Vec::new();
-    let mut indices = Vec::new();
-    for h in hulls {
-        if h.triangles.is_empty() {
-            continue;
-        }
-        let base = points.len() as u32;
-        points.extend(h.vertices.iter().map(|p| Point3 {
+/// One indexed triangle list drawing the hull `h`, its vertices once. A segment hull is one
+/// degenerate triangle `[a, b, b]` and a point hull `[a, a, a]` (they draw nothing but keep
+/// their geometry), so readers get exactly one primitive per hull.
+pub fn hull_triangles(h: &Hull, rgba: [f64; 4]) -> TriangleListPrimitive {
+    let points = h
+        .vertices
+        .iter()
+        .map(|p| Point3 {
             x: p.x,
             y: p.y,
             z: p.z,
-        }));
-        indices.extend(h.triangles.iter().flatten().map(|&i| base + i));
-    }
+        })
+        .collect();
+    let indices = match (h.triangles.is_empty(), h.vertices.len()) {
+        (false, _) => h.triangles.iter().flatten().copied().collect(),
+        (true, 0) => Vec::new(),
+        (true, 1) => vec![0, 0, 0],
+        (true, _) => vec![0, 1, 1],
+    };
     TriangleListPrimitive {
         pose: pose_at(&P3::origin()),
         points,

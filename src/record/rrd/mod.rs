@@ -36,11 +36,14 @@
 //! | `series/dlimit`, `series/glimit` | `Scalars` | `merge` | all | DLimit and GLimit in force at each merge |
 //! | `series/queue_len` | `Scalars` | `merge` | all | MPairs entries left after each pop |
 //! | `log/doublings` | `TextLog` | `merge`, `round` | all | one line per round start (DLimit, GLimit, active, dormant, pairs), per doubling and at the finish |
-//! | `levels/spheres` | `Ellipsoids3D` | `level` | levels, full | interior nodes of the cut at depth d, as translucent spheres |
+//! | `levels/spheres` | `Ellipsoids3D` | `level` | levels, full | interior nodes of the cut at depth d, as translucent blue spheres (`--wrapper sphere`) |
+//! | `levels/hulls` | `Mesh3D` | `level` | levels, full | interior nodes' convex hulls, translucent green (`--wrapper hull`; every distinct hull vertex once at d = 0, then only the triangle indices of the cut's hulls) |
+//! | `levels/boxes` | `Boxes3D` | `level` | levels, full | interior nodes' axis-aligned boxes, translucent violet (`--wrapper box`) |
+//! | `levels/obbs` | `Boxes3D` | `level` | levels, full | interior nodes' oriented boxes (rotations as quaternions), translucent dark violet (`--wrapper obb`) |
 //! | `levels/leaves` | `Mesh3D` | `level` | levels, full | leaves in the cut at depth d, as their polygons (vertices once at d = 0, then only triangle indices) |
 //!
-//! Hull Wrapper Trees, once built, belong at `levels/hulls` (`Mesh3D` per level) beside
-//! `levels/spheres`. Run metadata (scene, hash, parameters) is a recording property
+//! Each `levels/*` wrapper entity exists only for the kinds chosen with `record --wrapper`, and
+//! then has one row per level. Run metadata (scene, hash, parameters) is a recording property
 //! (`__properties/wraptree`) and the recording is named after the scene.
 //!
 //! The per-merge series and boxes are buffered and sent as columns every 4,096 merges
@@ -417,7 +420,8 @@ impl RrdRecorder {
         if let (Some(mesh), Some(grouping), Some(spheres)) =
             (&self.mesh, outcome.grouping, outcome.spheres)
         {
-            levels::log_levels(rec, mesh, &grouping.tree, spheres, &self.origin)?;
+            let tree = &grouping.tree;
+            levels::log_levels(rec, mesh, tree, spheres, outcome.wrappers, &self.origin)?;
         }
         Ok(())
     }
