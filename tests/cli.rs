@@ -1,5 +1,7 @@
 //! The `wraptree` binary end to end: outputs, error lines, exit codes, nothing clobbered.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -17,20 +19,6 @@ fn scene(name: &str) -> String {
         .join(name)
         .display()
         .to_string()
-}
-
-/// Asserts a failure with exactly one `error:` line on stderr mentioning `needle`, and no panic.
-fn assert_one_line_error(out: &Output, needle: &str) {
-    assert!(!out.status.success(), "must fail");
-    let err = String::from_utf8_lossy(&out.stderr);
-    let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
-    assert_eq!(errors.len(), 1, "one error line, got: {err}");
-    assert!(
-        errors[0].contains(needle),
-        "{:?} should mention {needle}",
-        errors[0]
-    );
-    assert!(!err.contains("panicked"), "no panic: {err}");
 }
 
 #[test]
@@ -58,17 +46,17 @@ fn group_json_has_the_tree() {
 fn bad_scene_inputs_give_one_error_line() {
     let dir = tempfile::tempdir().unwrap();
     let missing = wraptree(&["group", "no-such-file.obj"], dir.path());
-    assert_one_line_error(&missing, "no-such-file.obj");
+    common::assert_one_line_error(&missing, "no-such-file.obj");
     let bad = dir.path().join("nan.obj");
     std::fs::write(&bad, "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     let out = wraptree(&["record", "nan.obj", "-o", "rec"], dir.path());
-    assert_one_line_error(&out, "nan.obj");
+    common::assert_one_line_error(&out, "nan.obj");
     assert!(!dir.path().join("rec.rrd").exists() && !dir.path().join("rec.mcap").exists());
     let out = wraptree(
         &["group", &scene("robot-base.obj"), "--a", "-1"],
         dir.path(),
     );
-    assert_one_line_error(&out, "--a");
+    common::assert_one_line_error(&out, "--a");
 }
 
 fn record(dir: &Path, prefix: &str, extra: &[&str]) -> Output {
@@ -90,7 +78,7 @@ fn record_never_clobbers_without_force() {
     let mcap = dir.path().join("rb.mcap");
     let before = std::fs::read(&mcap).unwrap();
     let again = record(dir.path(), "rb", &[]);
-    assert_one_line_error(&again, "already exists");
+    common::assert_one_line_error(&again, "already exists");
     assert_eq!(std::fs::read(&mcap).unwrap(), before, "untouched");
     let forced = record(dir.path(), "rb", &["--force"]);
     assert!(forced.status.success());
@@ -109,7 +97,7 @@ fn record_never_clobbers_without_force() {
         "no temporary files left: {leftovers:?}"
     );
     let missing_dir = record(dir.path(), "nowhere/rb", &[]);
-    assert_one_line_error(&missing_dir, "does not exist");
+    common::assert_one_line_error(&missing_dir, "does not exist");
 }
 
 #[test]
@@ -174,7 +162,7 @@ fn replay_rejects_broken_and_foreign_files() {
         "absent.mcap",
     ] {
         let out = wraptree(&["replay", f, "--verify"], dir.path());
-        assert_one_line_error(&out, f);
+        common::assert_one_line_error(&out, f);
     }
 }
 
@@ -278,5 +266,5 @@ fn wrap_json_reports_every_kind_with_levels_and_containment() {
         &["wrap", &scene("robot-base.obj"), "--wrapper", "cone"],
         dir.path(),
     );
-    assert_one_line_error(&bad, "valid: sphere, hull, box");
+    common::assert_one_line_error(&bad, "valid: sphere, hull, box");
 }

@@ -1,5 +1,7 @@
 //! `wraptree snapshot` end to end on a tiny scene, and the renderer's ordering and framing.
 
+mod common;
+
 use resvg::{tiny_skia::Pixmap, usvg};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -148,20 +150,7 @@ fn a_recording_gives_the_same_images_as_its_scene() {
         &["snapshot", mcap.to_str().unwrap(), "--a", "2", "-o", "x"],
         dir.path(),
     );
-    one_error_line(&out, "do not apply to a recording");
-}
-
-fn one_error_line(out: &Output, needle: &str) {
-    assert!(!out.status.success(), "must fail");
-    let err = String::from_utf8_lossy(&out.stderr);
-    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
-    assert_eq!(lines.len(), 1, "one error line: {err}");
-    assert!(
-        lines[0].contains(needle),
-        "{:?} should mention {needle}",
-        lines[0]
-    );
-    assert!(!err.contains("panicked"), "{err}");
+    common::assert_one_line_error(&out, "do not apply to a recording");
 }
 
 #[test]
@@ -174,14 +163,14 @@ fn bad_values_give_one_error_line_and_nothing_is_clobbered() {
         args.extend_from_slice(extra);
         wraptree(&args, dir.path())
     };
-    one_error_line(&run(&["--wrapper", "cone"]), "valid: sphere, hull, box");
-    one_error_line(&run(&["--view", "diag"]), "valid: iso, front, side, top");
-    one_error_line(&run(&["--levels", "9"]), "max depth 2");
-    one_error_line(&run(&["--size", "10x10"]), "WxH");
-    one_error_line(&run(&["--elevation", "95"]), "--elevation");
+    common::assert_one_line_error(&run(&["--wrapper", "cone"]), "valid: sphere, hull, box");
+    common::assert_one_line_error(&run(&["--view", "diag"]), "valid: iso, front, side, top");
+    common::assert_one_line_error(&run(&["--levels", "9"]), "max depth 2");
+    common::assert_one_line_error(&run(&["--size", "10x10"]), "WxH");
+    common::assert_one_line_error(&run(&["--elevation", "95"]), "--elevation");
     ok(&run(&["--levels", "1"]));
     let before = read(&dir.path().join("out"), "figure.png");
-    one_error_line(&run(&["--levels", "2"]), "already exists");
+    common::assert_one_line_error(&run(&["--levels", "2"]), "already exists");
     assert_eq!(read(&dir.path().join("out"), "figure.png"), before);
     assert!(!dir.path().join("out/frame-01-level-2.png").exists());
     ok(&run(&[

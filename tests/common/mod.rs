@@ -98,3 +98,17 @@ pub fn grid_obj(nx: usize, ny: usize, dy: f64, lift: f64) -> Vec<u8> {
     }
     s.into_bytes()
 }
+
+/// Asserts a failed run with exactly one `error:` line on stderr mentioning `needle`, no panic.
+pub fn assert_one_line_error(out: &std::process::Output, needle: &str) {
+    assert!(!out.status.success(), "must fail");
+    let err = String::from_utf8_lossy(&out.stderr);
+    let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
+    assert_eq!(errors.len(), 1, "one error line, got: {err}");
+    assert!(
+        errors[0].contains(needle),
+        "{:?} should mention {needle}",
+        errors[0]
+    );
+    assert!(!err.contains("panicked"), "no panic: {err}");
+}
