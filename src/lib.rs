@@ -1,6 +1,6 @@
 //! wraptree: build, record and inspect bounding-volume hierarchies with the bottom-up grouping
 //! phase of Xavier, "A Generic Algorithm for Constructing Hierarchical Representations of
-//! Geometric Objects" (ICRA 1996).
+//! Geometric Objects".
 //!
 //! Data flows `scene` → `grouping` (Subset Tree, §2.2) → `wrap` (Wrapper Trees, §2.4) →
 //! `record` (`.rrd`, `.mcap`).

@@ -17,7 +17,8 @@ use wraptree::grouping::{PSet, Params, Weights};
 use wraptree::scene::{LoadOptions, Loaded};
 
 /// Build, record and inspect bounding-volume hierarchies with the bottom-up grouping phase of
-/// Xavier (ICRA 1996).
+/// Xavier's "A Generic Algorithm for Constructing Hierarchical Representations of Geometric
+/// Objects".
 #[derive(Parser, Debug)]
 #[command(name = "wraptree", version, about, long_about = None)]
 pub struct Cli {
