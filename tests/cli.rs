@@ -268,3 +268,24 @@ fn wrap_json_reports_every_kind_with_levels_and_containment() {
     );
     common::assert_one_line_error(&bad, "valid: sphere, hull, box");
 }
+
+#[test]
+fn bad_cover_values_give_one_error_line() {
+    let dir = tempfile::tempdir().unwrap();
+    for (extra, what) in [
+        (&["--cover-tolerance", "-1"][..], "-1"),
+        (
+            &["--cover-tolerance", "1", "--cover-budget", "3"][..],
+            "--cover-budget",
+        ),
+        (&["--cover-budget", "0"][..], "--cover-budget"),
+        (
+            &["--cover-budget", "3", "--detail", "merges"][..],
+            "--detail",
+        ),
+    ] {
+        let out = record(dir.path(), "c", extra);
+        common::assert_one_line_error(&out, what);
+        assert!(!dir.path().join("c.rrd").exists() && !dir.path().join("c.mcap").exists());
+    }
+}

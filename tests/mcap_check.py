@@ -19,6 +19,9 @@ SceneUpdate again with the official schema). Checks:
     area >= 1e-3 x the longest edge squared, as in the Rust `Hull::excess`), each oriented away
     from the mean of the hull's points; an open one (a flat polygon, or a degenerate triangle
     standing for a segment or a point) by the point's distance to its triangles.
+  - when /cover exists (one SceneUpdate, entities `spheres`, `boxes`, `hulls`, `leaves`): every
+    input vertex lies in some cover wrapper (same tolerances) or is a vertex of a cover leaf, and
+    the metadata's cover_size counts its wrappers and cover_max_error <= cover_tolerance.
 Exits 0 and prints one summary line on success; prints `mcap_check: FAIL ...` and exits 1
 otherwise (2 when a required module is missing).
 """
@@ -169,7 +172,7 @@ def hull_wrapper(tri, tol):
     return (lo, hi, inside)
 
 
-def covered(d, kind, wrappers, vertices, drawn, tol):
+def covered(where, kind, wrappers, vertices, drawn, tol):
     """Fails unless every vertex is in one of `wrappers` ((lo, hi, inside) triples) or drawn."""
     # Uniform grid with cell = the largest wrapper extent: each wrapper touches <= 8 cells.
     cell = max([max(h - l for l, h in zip(lo, hi)) for lo, hi, _ in wrappers] + [tol, 1e-300])
@@ -186,7 +189,7 @@ def covered(d, kind, wrappers, vertices, drawn, tol):
             continue
         key = tuple(math.floor(c / cell) for c in v)
         if not any(wrappers[i][2](v) for i in grid.get(key, ())):
-            fail(f"/levels/{d}: input vertex {v} is in no {kind} and on no drawn leaf")
+            fail(f"{where}: input vertex {v} is in no {kind} and on no drawn leaf")
 
 
 def check_level(d, update, vertices, tol, hull_tol):
@@ -211,8 +214,41 @@ def check_level(d, update, vertices, tol, hull_tol):
     if len(set(counts.values())) != 1:
         fail(f"/levels/{d}: wrapper entities disagree on the cut's interior nodes: {counts}")
     for kind, ws in sorted(wrappers.items()):
-        covered(d, kind, ws, vertices, drawn, tol)
+        covered(f"/levels/{d}", kind, ws, vertices, drawn, tol)
     return counts
+
+
+def check_cover(updates, run, vertices, tol, hull_tol):
+    """Checks the /cover level; returns its number of wrappers (leaves drawn count one each)."""
+    if len(updates) != 1:
+        fail(f"/cover holds {len(updates)} messages, expected 1")
+    wrappers, drawn, size = [], set(), 0
+    for ent in updates[0].entities:
+        if ent.id == "leaves":
+            for tri in ent.triangles:
+                drawn.update(triangle_points(tri))
+            size += len(ent.triangles)
+        elif ent.id == "spheres":
+            wrappers += [sphere_wrapper(s, tol) for s in ent.spheres]
+            size += len(ent.spheres)
+        elif ent.id == "hulls":
+            wrappers += [hull_wrapper(t, hull_tol) for t in ent.triangles]
+            size += len(ent.triangles)
+        elif ent.id == "boxes":
+            wrappers += [cube_wrapper(b, tol) for b in ent.cubes]
+            size += len(ent.cubes)
+        else:
+            fail(f"/cover: unexpected entity {ent.id!r}")
+    covered("/cover", "cover wrapper", wrappers, vertices, drawn, tol)
+    for key in ("cover_tolerance", "cover_size", "cover_max_error"):
+        if key not in run:
+            fail(f"/cover written without metadata key {key}")
+    if int(run["cover_size"]) != size:
+        fail(f"metadata cover_size {run['cover_size']}, /cover draws {size}")
+    if not 0 <= float(run["cover_max_error"]) <= float(run["cover_tolerance"]):
+        fail(f"cover_max_error {run['cover_max_error']} above cover_tolerance "
+             f"{run['cover_tolerance']}")
+    return size
 
 
 def main():
@@ -221,6 +257,7 @@ def main():
     path, n = sys.argv[1], int(sys.argv[2])
     merges = []
     levels = {}
+    cover = []
     scene = None
     counts = {}
     last_time = {}
@@ -245,6 +282,8 @@ def main():
                     scene = decoded
                 elif topic.startswith("/levels/"):
                     levels.setdefault(int(topic.split("/")[2]), []).append(decoded)
+                elif topic == "/cover":
+                    cover.append(decoded)
         except Exception as e:  # any decode error fails the check
             fail(f"decoding messages: {type(e).__name__}: {e}")
 
@@ -283,6 +322,12 @@ def main():
                 wrappers[kind] = wrappers.get(kind, 0) + n_kind
     elif levels:
         fail(f"levels written with detail {run['detail']} / complete {run['complete']}")
+    if cover:
+        if not levels:
+            fail("/cover written without levels")
+        wrappers["cover wrappers"] = check_cover(cover, run, vertices, tol, hull_tol)
+    elif any(k.startswith("cover_") for k in run):
+        fail("cover metadata without a /cover topic")
     print(f"mcap_check: ok {path}: {sum(counts.values())} messages on {len(counts)} topics, "
           f"{len(merges)} merges, {len(levels)} levels, "
           f"{', '.join(f'{n} {k}' for k, n in sorted(wrappers.items())) or 'no wrappers'}, "

@@ -78,6 +78,7 @@ fn record(
         grouping: cut.is_none().then_some(&g),
         spheres: Some(&spheres),
         wrappers: None,
+        cover: None,
         merges: log.merges.len() as u32,
         rounds: log.rounds.len() as u32,
         seconds: 0.25,
@@ -363,6 +364,7 @@ fn record_into<W: Write + Seek>(loaded: &Loaded, sink: W) -> anyhow::Result<W> {
         grouping: Some(&g),
         spheres: Some(&spheres),
         wrappers: None,
+        cover: None,
         merges: loaded.scene.len() as u32 - 1,
         rounds: g.rounds,
         seconds: 0.0,
@@ -443,6 +445,7 @@ fn record_wrappers(loaded: &Loaded, path: &Path, g: &Grouping, wrappers: &Wrappe
         grouping: Some(g),
         spheres: wrappers.spheres.as_deref(),
         wrappers: Some(wrappers),
+        cover: None,
         merges: log.merges.len() as u32,
         rounds: log.rounds.len() as u32,
         seconds: 0.0,
@@ -481,4 +484,34 @@ fn every_wrapper_kind_passes_the_python_checker() {
     record_wrappers(&loaded, &path, &g, &wrappers);
     let (ok, text) = python_check(&path, n);
     assert!(!ok && text.contains("in no hulls"), "{text}");
+}
+
+#[test]
+fn record_cli_cover_level_passes_the_python_checker() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/robot-base.obj");
+    let out = Command::new(env!("CARGO_BIN_EXE_wraptree"))
+        .arg("record")
+        .arg(&scene)
+        .arg("-o")
+        .arg(dir.path().join("rb"))
+        .args(["--cover-tolerance", "2%", "--detail", "levels"])
+        .output()
+        .expect("the binary runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let path = dir.path().join("rb.mcap");
+    let (ok, text) = python_check(&path, 276);
+    assert!(ok && text.contains("cover wrappers"), "{text}");
+    let m = read_recording(&path).expect("reads").metadata;
+    let num = |k: &str| {
+        m[k].parse::<f64>()
+            .unwrap_or_else(|_| panic!("{k} = {}", m[k]))
+    };
+    assert!(num("cover_max_error") <= num("cover_tolerance") && num("cover_tolerance") > 0.0);
+    assert!((1.0..276.0).contains(&num("cover_size")), "{m:?}");
+    assert!(!m.contains_key("cover_budget"));
 }

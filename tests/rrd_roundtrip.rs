@@ -86,6 +86,7 @@ fn write(
         grouping: Some(&grouping),
         spheres: Some(&spheres),
         wrappers: Some(&wrappers),
+        cover: None,
         merges: log.merges.len() as u32,
         rounds: grouping.rounds,
         seconds: 0.0,
@@ -106,9 +107,19 @@ fn record(dir: &Path, detail: Detail, params: &Params, kinds: &[WrapperKind]) ->
     let path = dir.join(format!("grid-{detail:?}.rrd"));
     let (grouping, log) = write(&path, &loaded, detail, params, kinds);
 
+    let summary = summarize(&path);
+    Run {
+        grouping,
+        log,
+        summary,
+    }
+}
+
+/// Checks `path` with `rerun rrd verify` and summarises it with the Python reader.
+fn summarize(path: &Path) -> Summary {
     let verify = Command::new("rerun")
         .args(["rrd", "verify"])
-        .arg(&path)
+        .arg(path)
         .output()
         .expect("the `rerun` CLI (PyPI rerun-sdk==0.36.3, installed by .ci/run) must be on PATH");
     assert!(
@@ -119,7 +130,7 @@ fn record(dir: &Path, detail: Detail, params: &Params, kinds: &[WrapperKind]) ->
     );
     let out = Command::new("python3")
         .args(["-c", READER])
-        .arg(&path)
+        .arg(path)
         .output()
         .expect("python3 with rerun-sdk==0.36.3 (installed by .ci/run) must be on PATH");
     assert!(
@@ -128,12 +139,7 @@ fn record(dir: &Path, detail: Detail, params: &Params, kinds: &[WrapperKind]) ->
         path.display(),
         String::from_utf8_lossy(&out.stderr)
     );
-    let summary = serde_json::from_slice(&out.stdout).expect("reader prints JSON");
-    Run {
-        grouping,
-        log,
-        summary,
-    }
+    serde_json::from_slice(&out.stdout).expect("reader prints JSON")
 }
 
 fn range(n: usize) -> Vec<i64> {
@@ -384,6 +390,7 @@ fn a_full_disk_is_a_clear_error() {
                 grouping: Some(&g),
                 spheres: None,
                 wrappers: None,
+                cover: None,
                 merges: loaded.scene.len() as u32 - 1,
                 rounds: g.rounds,
                 seconds: 0.0,
@@ -399,4 +406,61 @@ fn a_full_disk_is_a_clear_error() {
         "{msg}"
     );
     assert!(!msg.contains('\n'), "one line: {msg}");
+}
+
+#[test]
+fn record_cli_logs_the_cover_as_one_more_level() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/robot-base.obj");
+    let prefix = dir.path().join("rb");
+    let out = Command::new(env!("CARGO_BIN_EXE_wraptree"))
+        .arg("record")
+        .arg(&scene)
+        .arg("-o")
+        .arg(&prefix)
+        .args([
+            "--cover-tolerance",
+            "2%",
+            "--cover-kinds",
+            "sphere,box,obb,hull",
+        ])
+        .output()
+        .expect("the binary runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s = summarize(&dir.path().join("rb.rrd"));
+    let last = *s.entities["/levels/leaves"].level.iter().max().unwrap();
+    let cover: Vec<&str> = s
+        .entities
+        .keys()
+        .map(String::as_str)
+        .filter(|e| e.starts_with("/cover/") && *e != "/cover/summary")
+        .collect();
+    assert!(!cover.is_empty(), "cover entities: {:?}", s.entities.keys());
+    for e in &cover {
+        assert!(
+            [
+                "/cover/spheres",
+                "/cover/boxes",
+                "/cover/hulls",
+                "/cover/leaves"
+            ]
+            .contains(e),
+            "unexpected cover entity {e}"
+        );
+        assert_eq!(
+            s.entities[*e].level,
+            vec![last + 1],
+            "{e}: one row at depth max + 1"
+        );
+    }
+    assert!(s.entities["/cover/summary"].is_static);
+    assert_eq!(
+        s.entities["/levels"].level,
+        vec![last + 1],
+        "levels cleared under the cover"
+    );
 }

@@ -14,12 +14,25 @@ use wraptree::wrap::{DEFAULT_SAMPLES, SphereMethod, WrapperKind, Wrappers};
 
 /// A tolerance: a length in scene units, or `P%` of the scene diagonal.
 #[derive(Clone, Copy, Debug)]
-enum Tolerance {
+pub enum Tolerance {
+    /// A length in scene units.
     Abs(f64),
+    /// A fraction of the scene diagonal.
     Rel(f64),
 }
 
-fn parse_tolerance(s: &str) -> Result<Tolerance, String> {
+impl Tolerance {
+    /// The length for a scene of diagonal `diagonal`.
+    pub fn length(self, diagonal: f64) -> f64 {
+        match self {
+            Tolerance::Abs(t) => t,
+            Tolerance::Rel(r) => r * diagonal,
+        }
+    }
+}
+
+/// Parses `--tolerance`: a length ≥ 0, or `P%` of the scene diagonal.
+pub(super) fn parse_tolerance(s: &str) -> Result<Tolerance, String> {
     let bad = || format!("invalid tolerance '{s}' (want a length ≥ 0, or P% of the diagonal)");
     let t = s.trim();
     let (num, rel) = match t.strip_suffix('%') {
@@ -142,8 +155,7 @@ impl CoverCmd {
         let fits = Fits::measure(tree, scene, &wrappers, hulls.as_deref(), DEFAULT_SAMPLES);
         let diagonal = scene.aabb().diameter();
         let c = match (self.tolerance, self.budget) {
-            (Some(Tolerance::Abs(t)), _) => fits.cover_tolerance(tree, t),
-            (Some(Tolerance::Rel(r)), _) => fits.cover_tolerance(tree, r * diagonal),
+            (Some(t), _) => fits.cover_tolerance(tree, t.length(diagonal)),
             (None, Some(k)) => fits.cover_budget(tree, k).map_err(anyhow::Error::msg)?,
             (None, None) => bail!("give --tolerance or --budget"),
         };

@@ -1,21 +1,25 @@
 //! `wraptree record`: group a scene step by step and write `PREFIX.rrd` and `PREFIX.mcap`.
 
+use super::cover::{Tolerance, parse_tolerance};
 use super::group::Progress;
 use super::{GroupArgs, SceneArgs};
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
+use wraptree::grouping::SubsetTree;
 use wraptree::grouping::{self, Grouping, ResolvedParams, Tee};
 use wraptree::record::mcap::McapRecorder;
 use wraptree::record::output::Pending;
 use wraptree::record::rrd::RrdRecorder;
-use wraptree::record::{Detail, Outcome, RunInfo};
+use wraptree::record::{CoverLevel, Detail, Outcome, RunInfo};
 use wraptree::scene::{Scene, SceneSource};
-use wraptree::wrap::{SphereMethod, WrapperKind, Wrappers};
+use wraptree::wrap::cover::export::{self, WrapperRecord};
+use wraptree::wrap::cover::{Cover, Fits};
+use wraptree::wrap::{DEFAULT_SAMPLES, SphereMethod, WrapperKind, Wrappers};
 
 /// Arguments of `wraptree record`.
 #[derive(Args, Debug)]
@@ -39,6 +43,61 @@ pub struct RecordCmd {
     /// Wrapper Trees logged with the levels, comma-separated: sphere, hull, box (aabb), obb.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "sphere")]
     wrapper: Vec<WrapperKind>,
+    /// Also log the cover within this error (as `cover --tolerance`: a length, or P% of the
+    /// scene diagonal) as one more level.
+    #[arg(long, value_parser = parse_tolerance, allow_negative_numbers = true, conflicts_with = "cover_budget")]
+    cover_tolerance: Option<Tolerance>,
+    /// Also log the best cover with at most K wrappers as one more level.
+    #[arg(long, value_name = "K")]
+    cover_budget: Option<usize>,
+    /// Wrapper kinds the cover chooses from, comma-separated: sphere, box (or aabb), obb, hull.
+    #[arg(long, default_value = "sphere,box,hull", value_delimiter = ',', value_parser = WrapperKind::parse)]
+    cover_kinds: Vec<WrapperKind>,
+}
+
+/// How the logged cover is bounded.
+#[derive(Clone, Copy, Debug)]
+pub enum CoverLimit {
+    /// Largest error per wrapper.
+    Tolerance(Tolerance),
+    /// Largest number of wrappers.
+    Budget(usize),
+}
+
+/// What is logged with the levels besides the scene and the grouping.
+#[derive(Clone, Copy, Debug)]
+pub struct Logged<'a> {
+    /// Wrapper Trees drawn at every level.
+    pub kinds: &'a [WrapperKind],
+    /// The cover logged as one more level, from these kinds, when asked for.
+    pub cover: Option<(CoverLimit, &'a [WrapperKind])>,
+}
+
+/// The cover of `tree` within `limit` from `kinds` (as `wraptree cover` computes it), with its
+/// wrappers' geometry.
+fn compute_cover(
+    tree: &SubsetTree,
+    scene: &Scene,
+    limit: CoverLimit,
+    kinds: &[WrapperKind],
+) -> Result<(Cover, Vec<WrapperRecord>)> {
+    let mut build = kinds.to_vec();
+    if !build.contains(&WrapperKind::Hull) {
+        build.push(WrapperKind::Hull);
+    }
+    let mut wrappers = Wrappers::build(tree, scene, &build, SphereMethod::Minimum);
+    let hulls = if kinds.contains(&WrapperKind::Hull) {
+        None
+    } else {
+        wrappers.hulls.take()
+    };
+    let fits = Fits::measure(tree, scene, &wrappers, hulls.as_deref(), DEFAULT_SAMPLES);
+    let cover = match limit {
+        CoverLimit::Tolerance(t) => fits.cover_tolerance(tree, t.length(scene.aabb().diameter())),
+        CoverLimit::Budget(k) => fits.cover_budget(tree, k).map_err(anyhow::Error::msg)?,
+    };
+    let records = export::records(&cover, tree, scene, &wrappers);
+    Ok((cover, records))
 }
 
 /// Where a pair of recordings goes, and the outcome of writing it.
@@ -86,14 +145,18 @@ pub fn record(
         detail,
         prefix,
         (force, reproducible),
-        &kinds,
+        Logged {
+            kinds: &kinds,
+            cover: None,
+        },
     )
 }
 
 /// Groups `scene` while both recorders listen, logging the levels with the Wrapper Trees of
 /// `kinds`; commits the files when complete, or sets them aside as `PREFIX.incomplete.*` when
 /// stopped by Ctrl-C/SIGTERM (an existing recording is never replaced by a partial one).
-/// `flags` is (force, reproducible).
+/// `flags` is (force, reproducible). A cover in `logged` is computed after a finished grouping
+/// and logged as one more level (it needs `detail` with levels).
 pub fn record_with(
     scene: &Scene,
     source: &SceneSource,
@@ -101,8 +164,14 @@ pub fn record_with(
     detail: Detail,
     prefix: &Path,
     (force, reproducible): (bool, bool),
-    kinds: &[WrapperKind],
+    logged: Logged<'_>,
 ) -> Result<Written> {
+    if logged.cover.is_some() && !detail.levels() {
+        bail!(
+            "--cover-tolerance/--cover-budget need --detail levels or full (the cover is a level)"
+        );
+    }
+    let kinds = logged.kinds;
     let (rrd_path, mcap_path) = (with_ext(prefix, ".rrd"), with_ext(prefix, ".mcap"));
     let rrd_file = Pending::create(&rrd_path, force)?;
     let mcap_file = Pending::create(&mcap_path, force)?;
@@ -149,10 +218,25 @@ pub fn record_with(
     let spheres = wrappers
         .as_mut()
         .map(|w| w.spheres.take().unwrap_or_default());
+    let cover = match (&grouping, logged.cover) {
+        (Some(g), Some((limit, cover_kinds))) => {
+            Some(compute_cover(&g.tree, scene, limit, cover_kinds)?)
+        }
+        _ => None,
+    };
+    let budget = match logged.cover {
+        Some((CoverLimit::Budget(k), _)) => Some(k),
+        _ => None,
+    };
     let outcome = Outcome {
         grouping: grouping.as_ref(),
         spheres: spheres.as_deref(),
         wrappers: wrappers.as_ref(),
+        cover: cover.as_ref().map(|(cover, wrappers)| CoverLevel {
+            cover,
+            wrappers,
+            budget,
+        }),
         merges,
         rounds,
         seconds,
@@ -219,6 +303,19 @@ impl RecordCmd {
     pub fn run(self) -> Result<ExitCode> {
         // Installed before loading so an early Ctrl-C still ends in readable, incomplete files.
         stop_flag();
+        if self.cover_budget == Some(0) {
+            bail!("--cover-budget must be ≥ 1 (a cover needs at least one wrapper)");
+        }
+        let limit = match (self.cover_tolerance, self.cover_budget) {
+            (Some(t), _) => Some(CoverLimit::Tolerance(t)),
+            (None, Some(k)) => Some(CoverLimit::Budget(k)),
+            (None, None) => None,
+        };
+        if limit.is_some() && !self.detail.levels() {
+            bail!(
+                "--cover-tolerance/--cover-budget need --detail levels or full (the cover is a level)"
+            );
+        }
         let loaded = self.scene.load()?;
         let params = self.group.params()?.resolve(&loaded.scene);
         let prefix = match self.output {
@@ -237,7 +334,10 @@ impl RecordCmd {
             self.detail,
             &prefix,
             (self.force, self.reproducible),
-            &self.wrapper,
+            Logged {
+                kinds: &self.wrapper,
+                cover: limit.map(|l| (l, self.cover_kinds.as_slice())),
+            },
         )?;
         report(&w, &loaded.scene);
         Ok(if w.grouping.is_some() {

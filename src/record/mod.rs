@@ -8,6 +8,8 @@ pub mod rrd;
 
 use crate::grouping::{Grouping, ResolvedParams};
 use crate::scene::{Scene, SceneSource};
+use crate::wrap::cover::Cover;
+use crate::wrap::cover::export::WrapperRecord;
 use crate::wrap::{Sphere, Wrappers};
 
 /// What a recording holds (`--detail`).
@@ -70,10 +72,25 @@ pub struct Outcome<'a> {
     /// Further Wrapper Trees (hulls, boxes, oriented boxes) logged with the levels; its
     /// `spheres` are ignored (see `spheres`).
     pub wrappers: Option<&'a Wrappers>,
+    /// A cover logged as one extra level after the last (`record --cover-tolerance` or
+    /// `--cover-budget`); `None` when not requested.
+    pub cover: Option<CoverLevel<'a>>,
     /// Merges made.
     pub merges: u32,
     /// Rounds started.
     pub rounds: u32,
     /// Grouping wall time in seconds.
     pub seconds: f64,
+}
+
+/// A cover of the finished tree (see [`crate::wrap::cover`]) with its wrappers' geometry, logged
+/// as one extra level after the tree levels.
+#[derive(Clone, Copy, Debug)]
+pub struct CoverLevel<'a> {
+    /// The chosen nodes, kinds and errors; `tolerance` is the absolute error bound used.
+    pub cover: &'a Cover,
+    /// One record per cover node, in the cover's order, with its geometry.
+    pub wrappers: &'a [WrapperRecord],
+    /// The wrapper budget K when the cover was asked for by budget rather than by tolerance.
+    pub budget: Option<usize>,
 }

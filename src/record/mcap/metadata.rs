@@ -41,9 +41,18 @@ pub const KEYS: &[&str] = &[
     "log_time",
 ];
 
+/// Keys the `wraptree` record adds when a cover is logged (`cover_budget` only for a cover
+/// asked for by budget).
+pub const COVER_KEYS: &[&str] = &[
+    "cover_tolerance",
+    "cover_budget",
+    "cover_size",
+    "cover_max_error",
+];
+
 /// How log times map to grouping steps (also stored under `log_time`).
 pub const LOG_TIME: &str = "scene and attachment at 0 ms; the k-th grouping event (k = 1, 2, ...) at k ms; \
-     /levels/<d> at (events + 1 + d) ms";
+     /levels/<d> at (events + 1 + d) ms; /cover at (events + 2 + depth_max) ms";
 
 fn value_name<T: ValueEnum>(v: &T) -> String {
     v.to_possible_value()
@@ -52,7 +61,9 @@ fn value_name<T: ValueEnum>(v: &T) -> String {
 }
 
 /// The `wraptree` record of a run. `depth_max`/`depth_mean` are present only for a finished
-/// grouping, and `complete` is `"false"` when it is missing (an interrupted run).
+/// grouping, and `complete` is `"false"` when it is missing (an interrupted run). With a cover:
+/// `cover_tolerance` (absolute), `cover_budget` (when asked by budget), `cover_size` and
+/// `cover_max_error`.
 pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String, String> {
     let p = info.params;
     let mut m = BTreeMap::new();
@@ -85,6 +96,14 @@ pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String,
     if let Some(g) = outcome.grouping {
         put("depth_max", g.tree.depth_max().to_string());
         put("depth_mean", g.tree.depth_mean().to_string());
+    }
+    if let Some(c) = &outcome.cover {
+        put("cover_tolerance", c.cover.tolerance.to_string());
+        if let Some(k) = c.budget {
+            put("cover_budget", k.to_string());
+        }
+        put("cover_size", c.cover.nodes.len().to_string());
+        put("cover_max_error", c.cover.max_error().to_string());
     }
     put("complete", outcome.grouping.is_some().to_string());
     put("log_time", LOG_TIME.to_string());

@@ -17,6 +17,7 @@
 //! | `/grouping/bodies` | `foxglove.SceneUpdate` | entity `merge`: the merged pair (red) and the new body (yellow) as boxes, per merge | `--detail merges` or `full` |
 //! | `/grouping/dormant` | `dormantevent.DormantEvent` | round, body, diameter of each body going dormant | `--detail merges` or `full` |
 //! | `/levels/<d>` | `foxglove.SceneUpdate` | one snapshot of the cut at depth d (d = 0..=depth max), one entity per wrapper kind chosen with `--wrapper` for the cut's interior nodes: `spheres` (`SpherePrimitive`s, size = diameter), `hulls` (one indexed `TriangleListPrimitive` per hull; a segment hull is one degenerate triangle `[a, b, b]`, a point hull `[a, a, a]`), `boxes` (axis-aligned `CubePrimitive`s), `obbs` (`CubePrimitive`s with orientation); and entity `leaves` (the cut's leaves as one orange `TriangleListPrimitive`) | `--detail levels` or `full`, finished runs |
+//! | `/cover` | `foxglove.SceneUpdate` | the cover (`--cover-tolerance` or `--cover-budget`) as one more level: entities `spheres`, `boxes` (oriented ones with orientation), `hulls` (one indexed `TriangleListPrimitive` per hull) and `leaves` (one `TriangleListPrimitive` per leaf drawn as itself), only those used | with a cover, `--detail levels` or `full`, finished runs |
 //!
 //! The input scene file is attached (name = its file name, media type `model/obj`, log time 0),
 //! and two metadata records describe the run ([`metadata`]): `wraptree` (version, git commit,
@@ -27,7 +28,7 @@
 //! **Log times** are synthetic and monotonic, never wall-clock: the scene at 0; the k-th grouping
 //! event (k = 1, 2, …, counting every event, written at this detail or not: round starts,
 //! merges, dormant bodies, doublings, the finish) at k ms; the level snapshots after the last event at consecutive milliseconds,
-//! `/levels/<d>` at (events + 1 + d) ms. Sequence numbers count up from 0 on each channel.
+//! `/levels/<d>` at (events + 1 + d) ms, then `/cover` at (events + 2 + depth max) ms. Sequence numbers count up from 0 on each channel.
 
 pub mod messages;
 pub mod metadata;
@@ -393,6 +394,13 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             let msg = scene_msgs::update(entities);
             emit(&mut self.writer, &mut self.buf, &mut topic, t, &msg)
                 .with_context(|| format!("writing level {d}"))?;
+        }
+        if let Some(cover) = &outcome.cover {
+            let t = (self.events + 2 + u64::from(tree.depth_max())) * MS;
+            let mut topic = add_topic(&mut self.writer, self.scene_update, "/cover")?;
+            let msg = scene_msgs::cover_update(cover.wrappers, t);
+            emit(&mut self.writer, &mut self.buf, &mut topic, t, &msg)
+                .context("writing the cover")?;
         }
         Ok(())
     }

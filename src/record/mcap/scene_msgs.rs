@@ -1,9 +1,10 @@
-//! Builders for the `foxglove.SceneUpdate` messages: the input scene, boxes of bodies and the
-//! level snapshots. Many shapes share one primitive list (one entity, one `TriangleListPrimitive`
+//! Builders for the `foxglove.SceneUpdate` messages: the input scene, boxes of bodies, the
+//! level snapshots and the cover. Many shapes share one primitive list (one entity, one `TriangleListPrimitive`
 //! with indexed vertices) to keep messages small.
 
-use crate::geom::{Aabb, P3};
+use crate::geom::{Aabb, P3, V3};
 use crate::scene::Scene;
+use crate::wrap::cover::export::{self, Geometry, WrapperRecord};
 use crate::wrap::{Hull, Obb, Sphere};
 use foxglove::messages::{
     Color, CubePrimitive, Point3, Pose, Quaternion, SceneEntity, SceneUpdate, SpherePrimitive,
@@ -185,4 +186,80 @@ pub fn triangles(
         colors: Vec::new(),
         indices,
     }
+}
+
+/// An indexed triangle list of one cover mesh ([`export::mesh`]).
+fn mesh_triangles(g: &Geometry, rgba: [f64; 4]) -> TriangleListPrimitive {
+    let (v, t) = export::mesh(g);
+    TriangleListPrimitive {
+        pose: pose_at(&P3::origin()),
+        points: v
+            .iter()
+            .map(|p| Point3 {
+                x: p.x,
+                y: p.y,
+                z: p.z,
+            })
+            .collect(),
+        color: color(rgba),
+        colors: Vec::new(),
+        indices: t.iter().flatten().copied().collect(),
+    }
+}
+
+/// The `/cover` update at `t_ns`: entities `spheres` (`SpherePrimitive`s), `boxes`
+/// (`CubePrimitive`s, oriented ones with their rotation), `hulls` (one indexed
+/// `TriangleListPrimitive` per hull, degenerate hulls as in [`export::mesh`]) and `leaves`
+/// (one `TriangleListPrimitive` per leaf drawn as itself), each only when used.
+pub fn cover_update(wrappers: &[WrapperRecord], t_ns: u64) -> SceneUpdate {
+    let mut spheres = entity("spheres", t_ns);
+    let mut boxes = entity("boxes", t_ns);
+    let mut hulls = entity("hulls", t_ns);
+    let mut leaves = entity("leaves", t_ns);
+    let f = |a: &[f64; 3]| P3::new(a[0], a[1], a[2]);
+    for w in wrappers {
+        match &w.geometry {
+            Geometry::Sphere { center, radius } => spheres.spheres.push(sphere(
+                &Sphere {
+                    center: f(center),
+                    radius: *radius,
+                },
+                SPHERE_COLOR,
+            )),
+            Geometry::Box { min, max } => boxes.cubes.push(cube(
+                &Aabb {
+                    min: f(min),
+                    max: f(max),
+                },
+                BOX_COLOR,
+            )),
+            Geometry::Obb {
+                center,
+                axes,
+                half_extents,
+            } => {
+                let col = |k: usize| V3::new(axes[k][0], axes[k][1], axes[k][2]);
+                let b = Obb {
+                    center: f(center),
+                    axes: nalgebra::Matrix3::from_columns(&[col(0), col(1), col(2)]),
+                    half: V3::new(half_extents[0], half_extents[1], half_extents[2]),
+                };
+                boxes.cubes.push(obb_cube(&b, OBB_COLOR));
+            }
+            Geometry::Hull { .. } => hulls
+                .triangles
+                .push(mesh_triangles(&w.geometry, HULL_COLOR)),
+            Geometry::Primitive { .. } => leaves
+                .triangles
+                .push(mesh_triangles(&w.geometry, LEAF_COLOR)),
+        }
+    }
+    let used =
+        |e: &SceneEntity| !(e.spheres.is_empty() && e.cubes.is_empty() && e.triangles.is_empty());
+    update(
+        [spheres, boxes, hulls, leaves]
+            .into_iter()
+            .filter(used)
+            .collect(),
+    )
 }

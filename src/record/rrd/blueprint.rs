@@ -1,7 +1,8 @@
 //! The layout the `.rrd` file opens on (a Rerun blueprint, sent with `with_blueprint`).
 //!
 //! Left: a 3D view of the scene and the grouping boxes (scrub the `merge` or `round`
-//! timeline); beside it, when levels are written, a 3D view of the tree levels (scrub `level`).
+//! timeline); beside it, when levels are written, a 3D view of the tree levels and the cover,
+//! if any (scrub `level`).
 //! Right: four plots of the merge series above the text log of rounds and doublings. The time
 //! panel opens expanded on the `merge` timeline.
 
@@ -25,7 +26,7 @@ pub(super) fn layout(detail: Detail) -> Blueprint {
         views.push(
             Spatial3DView::new("Levels (timeline level)")
                 .with_origin("/")
-                .with_contents(["+ /levels/**"])
+                .with_contents(["+ /levels/**", "+ /cover/**"])
                 .into(),
         );
     }

@@ -10,6 +10,9 @@
 //! input points, shared by a node's hull and its ancestors' hulls, so each distinct point is
 //! logged once and without normals (the hulls are drawn translucent and unshaded). Each level
 //! costs 12 bytes per drawn triangle, 16 bytes per sphere, 24 per box and 40 per oriented box.
+//!
+//! A cover (`record --cover-tolerance`/`--cover-budget`) is one more level at tick
+//! `depth_max + 1` under `cover/*` ([`log_cover`]); its meshes are sent whole.
 
 use std::collections::HashMap;
 
@@ -18,8 +21,10 @@ use rerun::components::FillMode;
 
 use super::mesh::PrimMesh;
 use super::{rel, send_at};
-use crate::geom::P3;
+use crate::geom::{P3, V3};
 use crate::grouping::SubsetTree;
+use crate::record::CoverLevel;
+use crate::wrap::cover::export::{self, Geometry};
 use crate::wrap::{Hull, Sphere, Wrappers};
 
 /// Translucent blue of the level spheres.
@@ -197,4 +202,122 @@ pub(super) fn log_levels(
         send_at(rec, "levels/leaves", &times, &leaves)?;
     }
     Ok(())
+}
+
+/// Logs `cover` as one more level, at tick `depth_max + 1` of the `level` timeline: its spheres
+/// (`cover/spheres`), boxes (`cover/boxes`, axis-aligned and oriented together, with rotations
+/// when any is oriented), hulls (`cover/hulls`, one mesh) and leaves drawn as themselves
+/// (`cover/leaves`, one mesh), only the entities used; a recursive `Clear` of `levels` at the
+/// same tick so the cover is seen alone; and a static `TextLog` `cover/summary` with the
+/// tolerance, size and largest error.
+pub(super) fn log_cover(
+    rec: &RecordingStream,
+    tree: &SubsetTree,
+    cover: &CoverLevel<'_>,
+    origin: &P3,
+) -> anyhow::Result<()> {
+    let times = [("level", i64::from(tree.depth_max()) + 1)];
+    rec.log_static(
+        "cover",
+        &rerun::Transform3D::from_translation([origin.x as f32, origin.y as f32, origin.z as f32]),
+    )?;
+    send_at(rec, "levels", &times, &rerun::Clear::recursive())?;
+    let (mut centers, mut radii) = (Vec::new(), Vec::new());
+    let mut boxes: Vec<([f32; 3], [f32; 3], [f32; 4])> = Vec::new();
+    let mut oriented = false;
+    let mut hulls = (Vec::new(), Vec::new());
+    let mut leaves = (Vec::new(), Vec::new());
+    let f = |a: &[f64; 3]| P3::new(a[0], a[1], a[2]);
+    for w in cover.wrappers {
+        match &w.geometry {
+            Geometry::Sphere { center, radius } => {
+                centers.push(rel(&f(center), origin));
+                radii.push(*radius as f32);
+            }
+            Geometry::Box { min, max } => {
+                let (lo, hi) = (f(min), f(max));
+                let h = (hi - lo) / 2.0;
+                let c = rel(&nalgebra::center(&lo, &hi), origin);
+                boxes.push((
+                    c,
+                    [h.x as f32, h.y as f32, h.z as f32],
+                    [0.0, 0.0, 0.0, 1.0],
+                ));
+            }
+            Geometry::Obb {
+                center,
+                axes,
+                half_extents,
+            } => {
+                oriented = true;
+                let col = |k: usize| V3::new(axes[k][0], axes[k][1], axes[k][2]);
+                let m = nalgebra::Matrix3::from_columns(&[col(0), col(1), col(2)]);
+                let q = nalgebra::UnitQuaternion::from_matrix(&m)
+                    .coords
+                    .map(|c| c as f32);
+                boxes.push((
+                    rel(&f(center), origin),
+                    half_extents.map(|h| h as f32),
+                    [q.x, q.y, q.z, q.w],
+                ));
+            }
+            Geometry::Hull { .. } => append_mesh(&mut hulls, &w.geometry, origin),
+            Geometry::Primitive { .. } => append_mesh(&mut leaves, &w.geometry, origin),
+        }
+    }
+    if !centers.is_empty() {
+        let arch = rerun::Ellipsoids3D::from_centers_and_radii(centers, radii)
+            .with_colors([SPHERE_BLUE])
+            .with_fill_mode(FillMode::TransparentFillMajorWireframe);
+        send_at(rec, "cover/spheres", &times, &arch)?;
+    }
+    if !boxes.is_empty() {
+        let mut arch = rerun::Boxes3D::from_centers_and_half_sizes(
+            boxes.iter().map(|b| b.0),
+            boxes.iter().map(|b| b.1),
+        );
+        if oriented {
+            arch = arch.with_quaternions(
+                boxes
+                    .iter()
+                    .map(|b| rerun::datatypes::Quaternion::from_xyzw(b.2)),
+            );
+        }
+        let arch = arch
+            .with_colors([BOX_VIOLET])
+            .with_fill_mode(FillMode::TransparentFillMajorWireframe);
+        send_at(rec, "cover/boxes", &times, &arch)?;
+    }
+    for (path, (positions, tris), rgba) in [
+        ("cover/hulls", hulls, HULL_GREEN),
+        ("cover/leaves", leaves, LEAF_ORANGE),
+    ] {
+        if !positions.is_empty() {
+            let arch = rerun::Mesh3D::new(positions)
+                .with_triangle_indices(nonempty(tris))
+                .with_albedo_factor(rgba);
+            send_at(rec, path, &times, &arch)?;
+        }
+    }
+    let c = cover.cover;
+    let limit = match cover.budget {
+        Some(k) => format!("budget {k}, tolerance {:.4e}", c.tolerance),
+        None => format!("tolerance {:.4e}", c.tolerance),
+    };
+    let line = format!(
+        "cover at level tick {}: {limit}, {} wrappers, max error {:.4e}",
+        times[0].1,
+        c.nodes.len(),
+        c.max_error()
+    );
+    rec.log_static("cover/summary", &rerun::TextLog::new(line))?;
+    Ok(())
+}
+
+/// Appends the mesh of `g` ([`export::mesh`]) to (positions, triangles), relative to `origin`.
+fn append_mesh((positions, tris): &mut (Vec<[f32; 3]>, Vec<[u32; 3]>), g: &Geometry, origin: &P3) {
+    let (v, t) = export::mesh(g);
+    let base = positions.len() as u32;
+    positions.extend(v.iter().map(|p| rel(p, origin)));
+    tris.extend(t.iter().map(|t| t.map(|i| i + base)));
 }

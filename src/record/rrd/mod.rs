@@ -10,7 +10,7 @@
 //! |----------|----------|--------------|
 //! | `merge`  | sequence | merge (tick = merge step, 0..N−1) |
 //! | `round`  | sequence | DLimit round (0 = first round) |
-//! | `level`  | sequence | Subset Tree depth d, 0..=depth max |
+//! | `level`  | sequence | Subset Tree depth d, 0..=depth max; then the cover, if any, at depth max + 1 |
 //!
 //! The wall-clock `log_time` timeline is switched off with
 //! `RecordingStream::set_log_time_enabled(false)`, and every temporal row is sent with
@@ -41,6 +41,13 @@
 //! | `levels/boxes` | `Boxes3D` | `level` | levels, full | interior nodes' axis-aligned boxes, translucent violet (`--wrapper box`) |
 //! | `levels/obbs` | `Boxes3D` | `level` | levels, full | interior nodes' oriented boxes (rotations as quaternions), translucent dark violet (`--wrapper obb`) |
 //! | `levels/leaves` | `Mesh3D` | `level` | levels, full | leaves in the cut at depth d, as their polygons (vertices once at d = 0, then only triangle indices) |
+//! | `cover/spheres`, `cover/boxes` | `Ellipsoids3D`, `Boxes3D` | `level` (depth max + 1) | levels, full | the cover's spheres and boxes (oriented ones with rotations), colours as in `levels/*` (`--cover-tolerance`/`--cover-budget`) |
+//! | `cover/hulls`, `cover/leaves` | `Mesh3D` | `level` (depth max + 1) | levels, full | the cover's hulls, and its leaves drawn as themselves, each one mesh |
+//! | `cover/summary` | `TextLog` | static | levels, full | tolerance (and budget), size and largest error of the cover |
+//! | `levels` | `Clear` (recursive) | `level` (depth max + 1) | with a cover | hides the last level under the cover |
+//!
+//! Each `cover/*` geometry entity exists only when the cover uses that kind; `cover` carries the
+//! same static origin translation as `levels`.
 //!
 //! Each `levels/*` wrapper entity exists only for the kinds chosen with `record --wrapper`, and
 //! then has one row per level. Run metadata (scene, hash, parameters) is a recording property
@@ -422,6 +429,9 @@ impl RrdRecorder {
         {
             let tree = &grouping.tree;
             levels::log_levels(rec, mesh, tree, spheres, outcome.wrappers, &self.origin)?;
+            if let Some(cover) = &outcome.cover {
+                levels::log_cover(rec, tree, cover, &self.origin)?;
+            }
         }
         Ok(())
     }
