@@ -7,7 +7,7 @@ use super::hull_pset::HullBodies;
 use super::mpairs::{Entry, MPairs, Partners, order_bits};
 use super::subset_tree::{NONE, SubsetTree};
 use super::voxel_hash::VoxelHash;
-use super::{Grouping, PSet, ResolvedParams, Stats, Stopped, Weights};
+use super::{Grouping, PSet, ResolvedParams, Stats, Stopped};
 use crate::geom::Aabb;
 use crate::scene::Scene;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -110,9 +110,8 @@ fn spread_bits(v: u64) -> u64 {
 }
 
 /// The state of one grouping run.
-struct Clusterer<'s, P, O> {
+struct Clusterer<P, O> {
     n: usize,
-    weights: Weights,
     params: ResolvedParams,
     pset: P,
     observer: O,
@@ -122,7 +121,8 @@ struct Clusterer<'s, P, O> {
     live: Vec<bool>,
     parent: Vec<u32>,
     tag: Vec<u64>,
-    merges: Vec<(u32, u32, Aabb, f64)>,
+    /// Children of each interior node made so far, in merge order.
+    children: Vec<[u32; 2]>,
     hash: VoxelHash,
     bounds: Aabb,
     /// Largest half-extent per axis of the bodies in the hash this round.
@@ -139,12 +139,11 @@ struct Clusterer<'s, P, O> {
     /// cell's records (sorted by smallest x).
     finite: bool,
     stats: Stats,
-    _scene: std::marker::PhantomData<&'s Scene>,
 }
 
-impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
+impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
     fn new(
-        scene: &'s Scene,
+        scene: &Scene,
         params: &ResolvedParams,
         pset: P,
         diameter: Vec<f64>,
@@ -178,7 +177,6 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
             && (0..3).all(|k| small(bounds.min[k]) && small(bounds.max[k]));
         Clusterer {
             n,
-            weights: params.weights,
             params: *params,
             pset,
             observer,
@@ -187,7 +185,7 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
             live: vec![false; total],
             parent: vec![NONE; total],
             tag: (0..total as u32).map(|i| tie_tag(params.seed, i)).collect(),
-            merges: Vec::with_capacity(n - 1),
+            children: Vec::with_capacity(n - 1),
             hash: VoxelHash::default(),
             bounds,
             half_ext: [0.0; 3],
@@ -198,7 +196,6 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
             prune,
             finite,
             stats: Stats::default(),
-            _scene: std::marker::PhantomData,
         }
     }
 
@@ -283,7 +280,7 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
                 pairs,
             });
             // Step 4: pop and merge until MPairs is empty.
-            let merges_before = self.merges.len();
+            let merges_before = self.children.len();
             while let Some(e) = self.mpairs.peek() {
                 self.stats.pops += 1;
                 if !self.live[e.owner as usize] {
@@ -318,16 +315,16 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
                 self.mpairs.pop(&self.tag);
                 if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
                     return Err(Stopped {
-                        merges: self.merges.len() as u32,
+                        merges: self.children.len() as u32,
                         rounds: round + 1,
                     });
                 }
                 self.merge_pair(e, round, dlimit, glimit);
             }
-            let made = (self.merges.len() - merges_before) as u32;
+            let made = (self.children.len() - merges_before) as u32;
             parentless.retain(|&x| self.parent[x as usize] == NONE);
             parentless.extend(
-                ((n + merges_before) as u32..(n + self.merges.len()) as u32)
+                ((n + merges_before) as u32..(n + self.children.len()) as u32)
                     .filter(|&x| self.parent[x as usize] == NONE),
             );
             round += 1;
@@ -343,16 +340,13 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
                 });
             }
         }
-        let tree = SubsetTree::from_merges(
-            self.aabb[..n].to_vec(),
-            self.diameter[..n].to_vec(),
-            &self.merges,
-        )
-        .expect("the round loop makes exactly N - 1 valid merges");
+        let merges = self.children.len() as u32;
+        let tree = SubsetTree::new(self.aabb, self.diameter, self.children)
+            .expect("the round loop makes exactly N - 1 valid merges");
         self.observer.on_event(&Event::Finish {
             root: tree.root(),
             rounds: round,
-            merges: self.merges.len() as u32,
+            merges,
         });
         Ok(Grouping {
             tree,
@@ -365,7 +359,7 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
     /// Step 4(a)–(c) for one popped pair.
     fn merge_pair(&mut self, e: Entry, round: u32, dlimit: f64, glimit: f64) {
         let (a, b) = (e.owner.min(e.partner), e.owner.max(e.partner));
-        let new = (self.n + self.merges.len()) as u32;
+        let new = (self.n + self.children.len()) as u32;
         let merged = self.aabb[a as usize].merge(&self.aabb[b as usize]);
         for x in [a, b] {
             self.live[x as usize] = false;
@@ -376,10 +370,10 @@ impl<'s, P: PSetBodies, O: Observer> Clusterer<'s, P, O> {
         let d = self.pset.merge(a, b, new, &merged);
         let (da, db) = (self.diameter[a as usize], self.diameter[b as usize]);
         let (fill, balance) = fill_balance(d, da, db);
-        let cost = self.weights.cost(d, fill, balance);
+        let cost = self.params.weights.cost(d, fill, balance);
         self.aabb.push(merged);
         self.diameter.push(d);
-        self.merges.push((a, b, merged, d));
+        self.children.push([a, b]);
         let is_active = d <= dlimit;
         if is_active {
             // Step 4(b): the new body joins ABods and queues its best eligible pair.

@@ -23,30 +23,40 @@ pub struct SubsetTree {
 }
 
 impl SubsetTree {
-    /// Builds a tree from the leaves' boxes and diameters and the merges `(a, b)` in order;
-    /// merge `i` creates node `N + i`. Fails unless the merges form one binary tree.
+    /// Builds a tree from the leaves' boxes and diameters and the merges `(a, b, box, diameter)`
+    /// in order; merge `i` creates node `N + i`. Fails unless the merges form one binary tree.
     pub fn from_merges(
         leaf_aabb: Vec<Aabb>,
         leaf_diameter: Vec<f64>,
         merges: &[(u32, u32, Aabb, f64)],
     ) -> Result<SubsetTree, String> {
-        let n = leaf_aabb.len();
-        if n == 0 {
-            return Err("a Subset Tree needs at least one leaf".into());
-        }
-        if merges.len() != n - 1 {
+        let (mut aabb, mut diameter) = (leaf_aabb, leaf_diameter);
+        aabb.extend(merges.iter().map(|m| m.2));
+        diameter.extend(merges.iter().map(|m| m.3));
+        let children = merges.iter().map(|&(a, b, _, _)| [a, b]).collect();
+        SubsetTree::new(aabb, diameter, children)
+    }
+
+    /// Builds a tree from every node's box and diameter (2N − 1 each: leaves, then interior
+    /// nodes in merge order) and the children of each interior node. Fails unless the children
+    /// form one binary tree whose children precede their parents.
+    pub fn new(
+        aabb: Vec<Aabb>,
+        diameter: Vec<f64>,
+        children: Vec<[u32; 2]>,
+    ) -> Result<SubsetTree, String> {
+        let n = children.len() + 1;
+        let total = 2 * n - 1;
+        if aabb.len() != total || diameter.len() != total {
             return Err(format!(
-                "{} merges for {n} leaves (want {})",
-                merges.len(),
-                n - 1
+                "{} merges need {total} node boxes and diameters, got {} and {}",
+                n - 1,
+                aabb.len(),
+                diameter.len()
             ));
         }
-        let total = 2 * n - 1;
         let mut parent = vec![NONE; total];
-        let mut aabb = leaf_aabb;
-        let mut diameter = leaf_diameter;
-        let mut children = Vec::with_capacity(n - 1);
-        for (i, &(a, b, bx, d)) in merges.iter().enumerate() {
+        for (i, &[a, b]) in children.iter().enumerate() {
             let new = (n + i) as u32;
             for c in [a, b] {
                 if c >= new || parent[c as usize] != NONE || a == b {
@@ -56,9 +66,6 @@ impl SubsetTree {
                 }
                 parent[c as usize] = new;
             }
-            children.push([a, b]);
-            aabb.push(bx);
-            diameter.push(d);
         }
         let mut depth = vec![0u32; total];
         for node in (0..total - 1).rev() {

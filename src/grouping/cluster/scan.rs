@@ -76,7 +76,7 @@ fn meets(cb: &CellBounds, lo: &P3, hi: &P3) -> bool {
     (0..3).all(|k| cb.lo[k] <= hi[k] && cb.hi[k] >= lo[k])
 }
 
-impl<P: PSetBodies, O: Observer> Clusterer<'_, P, O> {
+impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
     /// The box that holds the centre of every eligible partner of a body with box `xa`.
     #[inline]
     fn query(&self, xa: &Aabb, glimit: f64) -> (P3, P3) {
@@ -93,7 +93,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<'_, P, O> {
     /// returns the number of eligible pairs.
     pub(super) fn round_start_search(&mut self, order: &[u32], glimit: f64) -> u64 {
         if P::AABB {
-            let a = self.weights.a;
+            let a = self.params.weights.a;
             if a == 1.0 {
                 self.pairs_once::<1>(glimit)
             } else if a == 0.0 {
@@ -113,7 +113,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<'_, P, O> {
     /// Step 4(b) (and a used-up list): refills `x`'s partner list.
     pub(super) fn search(&mut self, x: u32, glimit: f64) {
         if P::AABB {
-            let a = self.weights.a;
+            let a = self.params.weights.a;
             if a == 1.0 {
                 self.scan_pruned::<1>(x, glimit)
             } else if a == 0.0 {
@@ -128,7 +128,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<'_, P, O> {
 
     /// Every eligible pair once (AABB p-set); returns their number.
     fn pairs_once<const A: u8>(&mut self, glimit: f64) -> u64 {
-        let (k, w, finite) = (self.k, self.weights, self.finite);
+        let (k, w, finite) = (self.k, self.params.weights, self.finite);
         let mut pairs = 0u64;
         let mut candidates = 0u64;
         let mut near: Vec<u32> = Vec::with_capacity(27);
@@ -192,7 +192,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<'_, P, O> {
 
     /// The first partners of `x` in key order (AABB p-set), visiting cells cheapest bound first.
     fn scan_pruned<const A: u8>(&mut self, x: u32, glimit: f64) {
-        let (k, w) = (self.k, self.weights);
+        let (k, w) = (self.k, self.params.weights);
         let xa = self.aabb[x as usize];
         let dx = self.diameter[x as usize];
         let (lo, hi) = self.query(&xa, glimit);
@@ -262,7 +262,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<'_, P, O> {
         let xa = self.aabb[x as usize];
         let dx = self.diameter[x as usize];
         let (lo, hi) = self.query(&xa, glimit);
-        let (hash, pset, tags, w) = (&self.hash, &self.pset, &self.tag, self.weights);
+        let (hash, pset, tags, w) = (&self.hash, &self.pset, &self.tag, self.params.weights);
         let mut list = List::EMPTY;
         let mut eligible = 0u32;
         let mut candidates = 0u64;
