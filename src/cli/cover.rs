@@ -107,25 +107,13 @@ impl CoverCmd {
         let loaded = self.scene.load()?;
         let scene = &loaded.scene;
         let params = self.group.params()?;
-        let (json_path, obj_path) = {
-            let prefix = match &self.output {
-                Some(p) => p.clone(),
-                None => {
-                    let mut p = super::record::default_prefix(&loaded.source).into_os_string();
-                    p.push("-cover");
-                    let p = PathBuf::from(p);
-                    std::fs::create_dir_all(p.parent().expect("recordings/<stem> has a parent"))
-                        .context("recordings: cannot create the default output directory")?;
-                    p
-                }
-            };
-            let with = |e: &str| {
-                let mut s = prefix.clone().into_os_string();
-                s.push(e);
-                PathBuf::from(s)
-            };
-            (with(".json"), with(".obj"))
-        };
+        let prefix = super::record::output_prefix(
+            self.output.as_deref(),
+            &loaded.source.file_name,
+            "-cover",
+        )?;
+        let json_path = super::record::with_ext(&prefix, ".json");
+        let obj_path = super::record::with_ext(&prefix, ".obj");
         let input = std::fs::canonicalize(&self.scene.scene).ok();
         for p in [&json_path, &obj_path] {
             if input.is_some() && std::fs::canonicalize(p).ok() == input {

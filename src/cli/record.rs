@@ -112,16 +112,23 @@ pub struct Written {
     pub seconds: f64,
 }
 
-/// The default output prefix for a scene: `recordings/<stem>`.
-pub fn default_prefix(source: &SceneSource) -> PathBuf {
-    let stem = Path::new(&source.file_name)
+/// The output prefix: `given`, or `recordings/<stem of scene_file><suffix>` (creating
+/// `recordings/`, the one directory wraptree makes itself).
+pub fn output_prefix(given: Option<&Path>, scene_file: &str, suffix: &str) -> Result<PathBuf> {
+    if let Some(p) = given {
+        return Ok(p.to_path_buf());
+    }
+    let stem = Path::new(scene_file)
         .file_stem()
         .map(|s| s.to_string_lossy().to_string())
         .unwrap_or_else(|| "scene".into());
-    PathBuf::from("recordings").join(stem)
+    std::fs::create_dir_all("recordings")
+        .context("recordings: cannot create the default output directory")?;
+    Ok(PathBuf::from("recordings").join(format!("{stem}{suffix}")))
 }
 
-fn with_ext(prefix: &Path, ext: &str) -> PathBuf {
+/// `prefix` with `ext` appended (`recordings/lamp` + `.rrd`).
+pub fn with_ext(prefix: &Path, ext: &str) -> PathBuf {
     let mut s = prefix.as_os_str().to_owned();
     s.push(ext);
     PathBuf::from(s)
@@ -318,15 +325,7 @@ impl RecordCmd {
         }
         let loaded = self.scene.load()?;
         let params = self.group.params()?.resolve(&loaded.scene);
-        let prefix = match self.output {
-            Some(p) => p,
-            None => {
-                let p = default_prefix(&loaded.source);
-                std::fs::create_dir_all(p.parent().expect("recordings/<stem> has a parent"))
-                    .context("recordings: cannot create the default output directory")?;
-                p
-            }
-        };
+        let prefix = output_prefix(self.output.as_deref(), &loaded.source.file_name, "")?;
         let w = record_with(
             &loaded.scene,
             &loaded.source,

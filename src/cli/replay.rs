@@ -1,6 +1,6 @@
 //! `wraptree replay`: rebuild, verify or re-weight a run from its `.mcap` recording.
 
-use super::record::{record, report};
+use super::record::{output_prefix, record, report};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::path::PathBuf;
@@ -201,21 +201,8 @@ impl ReplayCmd {
             weights,
             ..rec.params
         };
-        let prefix = match &self.output {
-            Some(p) => p.clone(),
-            None => {
-                let stem = std::path::Path::new(&rec.scene_file_name)
-                    .file_stem()
-                    .map(|s| s.to_string_lossy().to_string())
-                    .unwrap_or_else(|| "scene".into());
-                std::fs::create_dir_all("recordings")
-                    .context("recordings: cannot create the default output directory")?;
-                PathBuf::from("recordings").join(format!(
-                    "{stem}-a{}-b{}-c{}",
-                    weights.a, weights.b, weights.c
-                ))
-            }
-        };
+        let suffix = format!("-a{}-b{}-c{}", weights.a, weights.b, weights.c);
+        let prefix = output_prefix(self.output.as_deref(), &rec.scene_file_name, &suffix)?;
         let written = record(
             &loaded.scene,
             &loaded.source,
