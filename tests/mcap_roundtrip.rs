@@ -133,6 +133,15 @@ fn full_recording_reads_back_and_passes_the_python_checker() {
     for key in metadata::KEYS {
         assert!(rec.metadata.contains_key(*key), "metadata lacks {key}");
     }
+    assert_eq!(metadata::params(&rec.metadata).unwrap(), rec.params);
+    // Parameters the round loop cannot run with are rejected on reading (GLimit0 = 0 would
+    // never finish a disconnected scene in `replay --verify`).
+    for (key, bad) in [("glimit0", "0"), ("dlimit0", "NaN"), ("c", "-1")] {
+        let mut m = rec.metadata.clone();
+        m.insert(key.into(), bad.into());
+        let err = metadata::params(&m).unwrap_err().to_string();
+        assert!(err.contains(key), "{err}");
+    }
     assert_eq!(rec.metadata["depth_max"], g.tree.depth_max().to_string());
     assert_eq!(rec.metadata["scene_sha256"], loaded.source.sha256);
     assert_eq!(rec.timing["seconds"], "0.25");

@@ -103,11 +103,12 @@ pub struct GroupArgs {
 impl GroupArgs {
     /// Checks the values and turns them into [`Params`].
     pub fn params(&self) -> Result<Params> {
-        for (name, v) in [("--a", self.a), ("--b", self.b), ("--c", self.c)] {
-            if !(v.is_finite() && v >= 0.0) {
-                anyhow::bail!("{name} must be a finite number ≥ 0, got {v}");
-            }
-        }
+        let weights = Weights {
+            a: self.a,
+            b: self.b,
+            c: self.c,
+        };
+        weights.check().map_err(|e| anyhow::anyhow!("--{e}"))?;
         for (name, v) in [("--dlimit", self.dlimit), ("--glimit", self.glimit)] {
             if let Some(v) = v
                 && !(v.is_finite() && v > 0.0)
@@ -116,11 +117,7 @@ impl GroupArgs {
             }
         }
         Ok(Params {
-            weights: Weights {
-                a: self.a,
-                b: self.b,
-                c: self.c,
-            },
+            weights,
             dlimit: self.dlimit,
             glimit: self.glimit,
             pset: self.pset,

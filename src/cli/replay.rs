@@ -192,11 +192,7 @@ impl ReplayCmd {
             b: self.b.unwrap_or(w.b),
             c: self.c.unwrap_or(w.c),
         };
-        for (flag, v) in [("--a", weights.a), ("--b", weights.b), ("--c", weights.c)] {
-            if !(v.is_finite() && v >= 0.0) {
-                bail!("{flag} must be a finite number ≥ 0, got {v}");
-            }
-        }
+        weights.check().map_err(|e| anyhow::anyhow!("--{e}"))?;
         let params = ResolvedParams {
             weights,
             ..rec.params

@@ -90,6 +90,16 @@ impl Weights {
         self.cost_scaled(scale, fill, balance)
     }
 
+    /// Checks that A, B and C are finite and ≥ 0; the error names the weight (`a`, `b`, `c`).
+    pub fn check(&self) -> Result<(), String> {
+        for (name, v) in [("a", self.a), ("b", self.b), ("c", self.c)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("{name} must be a finite number ≥ 0, got {v}"));
+            }
+        }
+        Ok(())
+    }
+
     /// The cost given `scale` = diameter^A already computed.
     #[inline(always)]
     pub fn cost_scaled(&self, scale: f64, fill: f64, balance: f64) -> f64 {
@@ -147,6 +157,21 @@ pub struct ResolvedParams {
     pub pset: PSet,
     /// Seed for randomised ties, if any.
     pub seed: Option<u64>,
+}
+
+impl ResolvedParams {
+    /// Checks what the round loop relies on: valid weights and finite, positive initial limits
+    /// (with GLimit0 = 0 a scene of several components would never finish). Parameters from
+    /// [`Params::resolve`] always pass; ones read from a file may not.
+    pub fn check(&self) -> Result<(), String> {
+        self.weights.check()?;
+        for (name, v) in [("dlimit0", self.dlimit0), ("glimit0", self.glimit0)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("{name} must be a finite number > 0, got {v}"));
+            }
+        }
+        Ok(())
+    }
 }
 
 impl Params {

@@ -140,7 +140,7 @@ pub fn params(m: &BTreeMap<String, String>) -> Result<ResolvedParams> {
         "none" => None,
         _ => Some(parse::<u64>(m, "seed")?),
     };
-    Ok(ResolvedParams {
+    let params = ResolvedParams {
         weights: Weights {
             a: parse(m, "a")?,
             b: parse(m, "b")?,
@@ -150,7 +150,11 @@ pub fn params(m: &BTreeMap<String, String>) -> Result<ResolvedParams> {
         glimit0: parse(m, "glimit0")?,
         pset: parse_enum::<PSet>(m, "pset")?,
         seed,
-    })
+    };
+    params
+        .check()
+        .map_err(|e| anyhow::anyhow!("metadata parameter {e}"))?;
+    Ok(params)
 }
 
 /// The recording's detail level.
