@@ -2,18 +2,21 @@
 //! vertices, its diameter the largest distance between two of them, and the gap between two
 //! bodies their L2 distance (GJK on the two vertex sets, via parry).
 //!
-//! Vertices stay `f64`; parry (`f32`) sees them relative to the pair's AABB centre. Merged hulls
-//! keep only the vertices parry's `try_convex_hull` reports on the hull; where it fails (or
-//! panics, parry issue #49) the body keeps the union of both vertex sets, which has the same
-//! hull, so results stay correct at some cost in speed.
+//! Vertices stay `f64`; parry (`f32`) sees them relative to the pair's AABB centre. A merged
+//! body keeps the vertices of the hull of both vertex sets, from [`crate::geom::hull::hull_of`]
+//! (the same checked hull the Wrapper Trees use); where that is only a fallback box, it keeps the
+//! whole union, which has the same hull. Sets flat or collinear to within
+//! [`crate::geom::hull::FLAT_REL`] of their extent are hulled as polygons or segments, so a
+//! body may drop points that far from its hull; a merge's own diameter is always computed from
+//! both children's full vertex sets.
 
 use super::cluster::PSetBodies;
+use crate::geom::hull::hull_of;
 use crate::geom::{Aabb, P3, to_glam_local};
 use crate::scene::Scene;
 use parry3d::math::{Pose, Vector};
 use parry3d::shape::SupportMap;
 use std::cell::RefCell;
-use std::collections::HashMap;
 
 /// A vertex set seen as its convex hull through the support function.
 struct Cloud<'a>(&'a [Vector]);
@@ -60,32 +63,6 @@ fn cross_diameter(a: &[P3], b: &[P3]) -> f64 {
         }
     }
     d2.sqrt()
-}
-
-/// The vertices of `pts` on their convex hull (by parry), or all of them when that fails.
-fn hull_vertices(pts: Vec<P3>) -> Vec<P3> {
-    if pts.len() <= 4 {
-        return pts;
-    }
-    let origin = Aabb::from_points(&pts).center();
-    let local: Vec<Vector> = pts.iter().map(|p| to_glam_local(p, &origin)).collect();
-    let hull = std::panic::catch_unwind(|| parry3d::transformation::try_convex_hull(&local));
-    let Ok(Ok((hv, _))) = hull else {
-        return pts;
-    };
-    let index: HashMap<[u32; 3], usize> = local
-        .iter()
-        .enumerate()
-        .map(|(i, v)| ([v.x.to_bits(), v.y.to_bits(), v.z.to_bits()], i))
-        .collect();
-    let mut kept = Vec::with_capacity(hv.len());
-    for v in &hv {
-        match index.get(&[v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]) {
-            Some(&i) => kept.push(pts[i]),
-            None => return pts,
-        }
-    }
-    kept
 }
 
 impl HullBodies {
@@ -153,7 +130,9 @@ impl PSetBodies for HullBodies {
         let d = self.union_diameter(x, y);
         let mut union = std::mem::take(&mut self.points[x as usize]);
         union.append(&mut std::mem::take(&mut self.points[y as usize]));
-        self.points.push(hull_vertices(union));
+        // The hull's vertices, or the points themselves where the hull is only a fallback box.
+        let (hull, support) = hull_of(union);
+        self.points.push(support.unwrap_or(hull.vertices));
         self.diameter.push(d);
         d
     }

@@ -6,7 +6,7 @@
 //! - [`hull`] — convex hulls, built from the children's hull vertices, robust to flat,
 //!   collinear and duplicate points (never panics);
 //! - axis-aligned boxes are the Subset Tree's own [`SubsetTree::aabb`](crate::grouping::SubsetTree);
-//! - [`obb`] — oriented boxes from the principal axes ([`pca`]);
+//! - [`obb`] — oriented boxes from the principal axes ([`crate::geom::pca`]);
 //! - [`kind`] — [`WrapperKind`] (`--wrapper`) and [`Wrappers`], several trees built together;
 //! - [`tightness`] — per-level volume, volume ratio and surface-to-geometry error;
 //! - [`distance`] — exact point–primitive distances with the Subset Tree as BVH.
@@ -34,7 +34,6 @@ pub mod hull;
 pub mod kind;
 pub mod obb;
 pub mod order;
-pub mod pca;
 pub mod sphere;
 pub mod tightness;
 pub mod welzl;

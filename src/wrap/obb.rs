@@ -6,7 +6,7 @@
 
 use super::hull::Hull;
 use super::order::LeafOrder;
-use super::pca::Frame;
+use crate::geom::pca::Frame;
 use crate::geom::{Aabb, P3, V3};
 use crate::grouping::SubsetTree;
 use crate::scene::Scene;

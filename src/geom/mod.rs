@@ -4,6 +4,10 @@
 //! millimetre detail; parry (which is `f32`) is only handed coordinates relative to a local
 //! origin (see [`to_glam_local`]).
 
+pub mod distance;
+pub mod hull;
+pub mod pca;
+
 use nalgebra::{Point3, Vector3};
 
 /// A point in scene coordinates.

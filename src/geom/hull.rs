@@ -1,0 +1,287 @@
+//! Convex hulls of point sets ([`hull_of`]), shared by the hull p-set of the grouping phase and
+//! the hull Wrapper Trees. Vertices are stored in `f64` and are always input points; parry
+//! (`f32`) only decides which points are on the hull.
+//!
+//! Degenerate input is normal here (one polygon is flat; duplicates; collinear points). The
+//! dimension is decided first in `f64` from the extents along the principal axes
+//! ([`Frame::principal`]): a point, a segment, a flat polygon (Andrew's monotone chain in the
+//! plane of best fit, fan-triangulated, one side), or a solid. Solids go to parry's fallible
+//! `try_convex_hull` in the principal frame with every axis scaled to [−1, 1] (the hull is
+//! affine-invariant, so thin sets are well-conditioned), guarded by `catch_unwind` (parry issue
+//! #49). If parry still fails, the node gets its principal-axes box instead ([`Hull::exact`] is
+//! false): a correct but looser convex wrapper, and the parent is built from the node's points.
+//!
+//! **Tolerance**: because parry decides in `f32`, a point it drops may lie outside the `f64`
+//! hull by about 1e-7 of the node's extent; tests allow [`HULL_TOL_REL`] × the node's AABB
+//! diameter.
+
+use super::{P3, V3};
+use crate::geom::pca::Frame;
+use std::cmp::Ordering::Greater;
+use std::collections::HashMap;
+
+/// Containment tolerance of hulls, relative to the node's AABB diameter (parry is `f32`).
+pub const HULL_TOL_REL: f64 = 1e-5;
+/// Extents below this fraction of the largest extent count as zero (flat or collinear).
+pub const FLAT_REL: f64 = 1e-9;
+
+/// A convex hull: `f64` vertices (input points) and triangles; flat hulls are one-sided
+/// triangulated polygons, segments and points have no triangles.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Hull {
+    /// Hull vertices.
+    pub vertices: Vec<P3>,
+    /// Triangles indexing `vertices`, outward-facing for solids.
+    pub triangles: Vec<[u32; 3]>,
+    /// 0 point, 1 segment, 2 flat polygon, 3 solid.
+    pub dim: u8,
+    /// False when parry failed and this is the principal-axes box of the points instead.
+    pub exact: bool,
+}
+
+impl Hull {
+    /// Enclosed volume (divergence theorem; 0 unless solid).
+    pub fn volume(&self) -> f64 {
+        if self.dim < 3 {
+            return 0.0;
+        }
+        let o = self.vertices[0];
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| self.vertices[i as usize] - o);
+                a.dot(&b.cross(&c)) / 6.0
+            })
+            .sum::<f64>()
+            .abs()
+    }
+
+    /// How far `p` lies outside (≤ 0 inside). For solids: the largest signed distance to the
+    /// planes of the well-shaped faces (twice the area ≥ 1e-3 × the longest edge²; slivers
+    /// have ill-defined planes) when that is ≤ 0, else the distance to the surface. For flat hulls,
+    /// segments and points: the distance to them.
+    pub fn excess(&self, p: &P3) -> f64 {
+        let v = |i: u32| &self.vertices[i as usize];
+        let surface = || {
+            self.triangles
+                .iter()
+                .map(|t| super::distance::point_triangle(p, v(t[0]), v(t[1]), v(t[2])))
+                .fold(f64::INFINITY, f64::min)
+        };
+        match self.dim {
+            3 => {
+                let planes = self
+                    .triangles
+                    .iter()
+                    .filter_map(|t| {
+                        let [a, b, c] = t.map(v);
+                        let n = (b - a).cross(&(c - a));
+                        let e = [b - a, c - b, a - c].map(|e| e.norm());
+                        let longest = e[0].max(e[1]).max(e[2]);
+                        let shortest = e[0].min(e[1]).min(e[2]);
+                        (n.norm() >= 1e-3 * longest * longest && shortest > 0.0)
+                            .then(|| n.normalize().dot(&(p - a)))
+                    })
+                    .fold(f64::NEG_INFINITY, f64::max);
+                if planes <= 0.0 { planes } else { surface() }
+            }
+            2 => surface(),
+            _ => match self.vertices.as_slice() {
+                [a, b] => super::distance::point_segment(p, a, b),
+                [a] => (p - a).norm(),
+                _ => f64::INFINITY,
+            },
+        }
+    }
+}
+
+/// The hull of `points`, and the points themselves when the hull is only a fallback box.
+pub fn hull_of(mut points: Vec<P3>) -> (Hull, Option<Vec<P3>>) {
+    dedup(&mut points);
+    let one = |vertices: Vec<P3>, dim| Hull {
+        vertices,
+        triangles: Vec::new(),
+        dim,
+        exact: true,
+    };
+    if points.len() <= 1 {
+        return (one(points, 0), None);
+    }
+    let frame = Frame::principal(&points);
+    let (lo, hi) = frame.bounds(&points);
+    let ext = hi - lo;
+    let mut axes = [0usize, 1, 2];
+    axes.sort_by(|&a, &b| ext[b].total_cmp(&ext[a]));
+    let [big, mid, small] = axes;
+    if ext[mid].partial_cmp(&(FLAT_REL * ext[big])) != Some(Greater) {
+        let along = |p: &P3| frame.local(p)[big];
+        let lo = points.iter().min_by(|a, b| along(a).total_cmp(&along(b)));
+        let hi = points.iter().max_by(|a, b| along(a).total_cmp(&along(b)));
+        return match (lo, hi) {
+            (Some(a), Some(b)) => (one(vec![*a, *b], 1), None),
+            _ => (one(points, 0), None),
+        };
+    }
+    if ext[small].partial_cmp(&(FLAT_REL * ext[big])) != Some(Greater) {
+        return (flat_hull(&points, &frame, big, mid), None);
+    }
+    // parry's f32 quickhull can return a non-convex mesh on near-degenerate input (seen on the
+    // 12,144-polygon scene); every result is checked in f64 against all the node's points, then
+    // retried with uniform scaling, and the principal-axes box is the always-valid last resort.
+    let tol = HULL_TOL_REL * ext.norm();
+    let valid = |h: Hull| points.iter().all(|p| h.excess(p) <= tol).then_some(h);
+    let solid = solid_hull(&points, &frame, lo, hi, false)
+        .and_then(valid)
+        .or_else(|| solid_hull(&points, &frame, lo, hi, true).and_then(valid));
+    match solid {
+        Some(h) => (h, None),
+        None => (box_hull(&frame, lo, hi), Some(points)),
+    }
+}
+
+/// Removes exact duplicates (by bits), keeping the first of each.
+fn dedup(points: &mut Vec<P3>) {
+    let mut seen = std::collections::HashSet::with_capacity(points.len());
+    points.retain(|p| seen.insert(p.coords.map(f64::to_bits)));
+}
+
+/// The 2D hull in the plane of axes `u`, `v` (monotone chain, collinear points dropped),
+/// fan-triangulated.
+fn flat_hull(points: &[P3], frame: &Frame, u: usize, v: usize) -> Hull {
+    let mut pts: Vec<(f64, f64, usize)> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let l = frame.local(p);
+            (l[u], l[v], i)
+        })
+        .collect();
+    pts.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let cross = |o: &(f64, f64, usize), a: &(f64, f64, usize), b: &(f64, f64, usize)| {
+        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+    };
+    let mut chain: Vec<(f64, f64, usize)> = Vec::with_capacity(pts.len() + 1);
+    for half in [pts.clone(), pts.iter().rev().copied().collect()] {
+        let floor = chain.len();
+        for p in half {
+            while chain.len() >= floor + 2
+                && cross(&chain[chain.len() - 2], &chain[chain.len() - 1], &p) <= 0.0
+            {
+                chain.pop();
+            }
+            chain.push(p);
+        }
+        chain.pop();
+    }
+    let vertices: Vec<P3> = chain.iter().map(|c| points[c.2]).collect();
+    if vertices.len() < 3 {
+        let ends = [pts[0], pts[pts.len() - 1]].map(|c| points[c.2]);
+        return Hull {
+            vertices: ends.to_vec(),
+            triangles: Vec::new(),
+            dim: 1,
+            exact: true,
+        };
+    }
+    let triangles = (1..vertices.len() as u32 - 1)
+        .map(|i| [0, i, i + 1])
+        .collect();
+    Hull {
+        vertices,
+        triangles,
+        dim: 2,
+        exact: true,
+    }
+}
+
+/// The solid hull by parry in the principal frame, each axis scaled to [-1, 1] (or all by the
+/// largest extent when `uniform`); `None` if parry fails or panics.
+fn solid_hull(points: &[P3], frame: &Frame, lo: V3, hi: V3, uniform: bool) -> Option<Hull> {
+    let mid = (lo + hi) / 2.0;
+    let half = if uniform {
+        V3::repeat((hi - lo).max() / 2.0)
+    } else {
+        (hi - lo) / 2.0
+    };
+    let local: Vec<parry3d::math::Vector> = points
+        .iter()
+        .map(|p| {
+            let q = (frame.local(p) - mid).component_div(&half);
+            parry3d::math::Vector::new(q.x as f32, q.y as f32, q.z as f32)
+        })
+        .collect();
+    let (hv, ht) = std::panic::catch_unwind(|| parry3d::transformation::try_convex_hull(&local))
+        .ok()?
+        .ok()?;
+    let index: HashMap<[u32; 3], usize> = local
+        .iter()
+        .enumerate()
+        .map(|(i, l)| (l.to_array().map(f32::to_bits), i))
+        .collect();
+    let vertices: Vec<P3> = hv
+        .iter()
+        .map(|l| {
+            index
+                .get(&l.to_array().map(f32::to_bits))
+                .map(|&i| points[i])
+        })
+        .collect::<Option<_>>()?;
+    if vertices.len() < 4 || ht.len() < 4 {
+        return None;
+    }
+    if ht.iter().flatten().any(|&i| i as usize >= vertices.len()) {
+        return None;
+    }
+    let c = P3::from(vertices.iter().map(|p| p.coords).sum::<V3>() / vertices.len() as f64);
+    let triangles = ht
+        .iter()
+        .map(|&[a, b, t]| {
+            let [pa, pb, pc] = [a, b, t].map(|i| vertices[i as usize]);
+            if (pb - pa).cross(&(pc - pa)).dot(&(pa - c)) < 0.0 {
+                [a, t, b]
+            } else {
+                [a, b, t]
+            }
+        })
+        .collect();
+    let hull = Hull {
+        vertices,
+        triangles,
+        dim: 3,
+        exact: true,
+    };
+    (hull.volume() > 0.0).then_some(hull)
+}
+
+/// The box of local bounds `lo..hi` in `frame`, as a hull (the fallback when parry fails).
+fn box_hull(frame: &Frame, lo: V3, hi: V3) -> Hull {
+    let vertices = (0..8)
+        .map(|k| {
+            let pick = |a: usize| if k >> a & 1 == 1 { hi[a] } else { lo[a] };
+            frame.world(&V3::new(pick(0), pick(1), pick(2)))
+        })
+        .collect();
+    Hull {
+        vertices,
+        triangles: BOX_TRIANGLES.to_vec(),
+        dim: 3,
+        exact: false,
+    }
+}
+
+/// Outward triangles of a box whose corner `k` has bit `a` set when it is at the top of axis
+/// `a` (for a right-handed frame).
+pub const BOX_TRIANGLES: [[u32; 3]; 12] = [
+    [0, 2, 1],
+    [1, 2, 3],
+    [4, 5, 6],
+    [5, 7, 6],
+    [0, 1, 4],
+    [1, 5, 4],
+    [2, 6, 3],
+    [3, 6, 7],
+    [0, 4, 2],
+    [2, 4, 6],
+    [1, 3, 5],
+    [3, 7, 5],
+];
