@@ -7,6 +7,7 @@
 //! Tree: the input, then levels with leaves as polygons and interior nodes as wrappers.
 
 pub mod camera;
+pub mod chart;
 pub mod figure;
 pub mod png;
 pub mod shape;
