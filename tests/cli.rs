@@ -289,3 +289,213 @@ fn bad_cover_values_give_one_error_line() {
         assert!(!dir.path().join("c.rrd").exists() && !dir.path().join("c.mcap").exists());
     }
 }
+
+/// The files of `dir` (names), sorted.
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .collect();
+    v.sort();
+    v
+}
+
+/// Every corrupt recording in `tests/data/bad/` (and a valid `.rrd`, which `replay` does not
+/// read): one error line naming the file, non-zero exit, no panic, nothing written.
+#[test]
+fn corrupt_recordings_give_one_line_and_write_nothing() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let bad = root.join("tests/data/bad");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&bad)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "rrd" || e == "mcap"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 8, "the corpus has its recordings: {files:?}");
+    files.push(root.join("recordings/example.rrd"));
+    let dir = tempfile::tempdir().unwrap();
+    for f in &files {
+        let name = f.file_name().unwrap().to_string_lossy().to_string();
+        let path = f.display().to_string();
+        let mut runs = vec![
+            vec!["replay", &path, "--verify"],
+            vec!["replay", &path, "--a", "2"],
+        ];
+        if name.ends_with(".mcap") {
+            // `snapshot` reads `.mcap` recordings; other names are scenes.
+            runs.push(vec!["snapshot", &path, "-o", "out"]);
+        }
+        for args in runs {
+            let out = wraptree(&args, dir.path());
+            common::assert_one_line_error(&out, &name);
+            assert!(files_in(dir.path()).is_empty(), "{args:?} wrote files");
+        }
+        let out = wraptree(&["replay", &path], dir.path());
+        let err = String::from_utf8_lossy(&out.stderr);
+        if f.extension().is_some_and(|e| e == "rrd") {
+            assert!(err.contains("Rerun") || err.contains("empty"), "{err}");
+        }
+    }
+    let out = wraptree(
+        &["replay", &files[files.len() - 1].display().to_string()],
+        dir.path(),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("a Rerun .rrd recording, not an MCAP file") && err.contains("example.mcap"),
+        "a valid .rrd points to its .mcap: {err}"
+    );
+}
+
+/// A soup of `n` triangles in the unit cube, written to `dir/name`.
+fn soup(dir: &Path, name: &str, n: usize) {
+    let out = wraptree(&["scene", "soup", "-n", &n.to_string(), "-o", name], dir);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// `--max-pairs`/`--max-seconds` stop a runaway grouping (GLimit spanning the whole soup):
+/// `group` prints one error line and exits 3; `record` keeps an existing recording, writes the
+/// partial one aside marked incomplete with the reason, which `replay` reports and verifies.
+#[test]
+fn budgets_stop_a_runaway_grouping() {
+    let dir = tempfile::tempdir().unwrap();
+    soup(dir.path(), "s.obj", 20_000);
+    let out = wraptree(
+        &["group", "s.obj", "--glimit", "10", "--max-pairs", "100000"],
+        dir.path(),
+    );
+    common::assert_one_line_error(&out, "--max-pairs 100000");
+    assert_eq!(out.status.code(), Some(3));
+    assert!(out.stdout.is_empty());
+    let out = wraptree(
+        &["group", "s.obj", "--glimit", "10", "--max-seconds", "0.2"],
+        dir.path(),
+    );
+    common::assert_one_line_error(&out, "--max-seconds 0.2");
+    assert_eq!(out.status.code(), Some(3));
+    for bad in ["0", "-1", "nan", "inf"] {
+        let out = wraptree(&["group", "s.obj", "--max-seconds", bad], dir.path());
+        common::assert_one_line_error(&out, "--max-seconds");
+        assert_eq!(out.status.code(), Some(1));
+    }
+    // Within the budget the result is the same tree.
+    let free = wraptree(&["group", &scene("robot-base.obj"), "--json"], dir.path());
+    let limited = wraptree(
+        &[
+            "group",
+            &scene("robot-base.obj"),
+            "--json",
+            "--max-pairs",
+            "10000000",
+            "--max-seconds",
+            "600",
+        ],
+        dir.path(),
+    );
+    assert!(limited.status.success());
+    let parent = |o: &Output| {
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["parent"].clone()
+    };
+    assert_eq!(parent(&free), parent(&limited));
+
+    std::fs::write(dir.path().join("r.mcap"), b"old recording").unwrap();
+    std::fs::write(dir.path().join("r.rrd"), b"old recording").unwrap();
+    let args = [
+        "record", "s.obj", "-o", "r", "--force", "--detail", "levels", "--glimit", "0.3",
+    ];
+    let out = wraptree(
+        &[&args[..], &["--dlimit", "0.02", "--max-pairs", "3000000"]].concat(),
+        dir.path(),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("--max-pairs 3000000") && !err.contains("panicked"),
+        "{err}"
+    );
+    for f in ["r.mcap", "r.rrd"] {
+        assert_eq!(
+            std::fs::read(dir.path().join(f)).unwrap(),
+            b"old recording",
+            "{f} kept"
+        );
+    }
+    let rec =
+        wraptree::record::mcap::read_recording(&dir.path().join("r.incomplete.mcap")).unwrap();
+    assert!(!rec.complete);
+    assert_eq!(rec.metadata["stop_reason"], "max-pairs");
+    assert!(rec.metadata["stop_eligible_pairs"].parse::<u64>().unwrap() > 3_000_000);
+    assert_eq!(rec.metadata["merges"], rec.merges.len().to_string());
+    let rep = wraptree(&["replay", "r.incomplete.mcap", "--verify"], dir.path());
+    let text = String::from_utf8_lossy(&rep.stdout);
+    assert!(rep.status.success(), "{text}");
+    assert!(
+        text.contains("incomplete recording (stopped: max-pairs)"),
+        "{text}"
+    );
+    assert!(
+        text.contains("recorded merges match the re-run's first"),
+        "{text}"
+    );
+    let leftovers: Vec<String> = files_in(dir.path())
+        .into_iter()
+        .filter(|f| f.ends_with(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+/// SIGTERM mid-run, as SIGINT: exit 130, an existing recording kept even with `--force`, the
+/// partial files set aside as `.incomplete`, readable, marked incomplete as interrupted.
+#[test]
+fn terminated_recording_keeps_the_old_one_and_what_was_recorded() {
+    let dir = tempfile::tempdir().unwrap();
+    soup(dir.path(), "big.obj", 200_000);
+    for f in ["big.mcap", "big.rrd"] {
+        std::fs::write(dir.path().join(f), b"old recording").unwrap();
+    }
+    let child = Command::new(env!("CARGO_BIN_EXE_wraptree"))
+        .args([
+            "record", "big.obj", "-o", "big", "--detail", "levels", "--force",
+        ])
+        .current_dir(dir.path())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(400));
+    let kill = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "stderr: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for f in ["big.mcap", "big.rrd"] {
+        assert_eq!(
+            std::fs::read(dir.path().join(f)).unwrap(),
+            b"old recording",
+            "{f} kept"
+        );
+    }
+    let rec =
+        wraptree::record::mcap::read_recording(&dir.path().join("big.incomplete.mcap")).unwrap();
+    assert!(!rec.complete);
+    assert_eq!(rec.metadata["stop_reason"], "interrupted");
+    let rep = wraptree(&["replay", "big.incomplete.mcap"], dir.path());
+    let text = String::from_utf8_lossy(&rep.stdout);
+    assert!(rep.status.success(), "{text}");
+    assert!(
+        text.contains("incomplete recording (stopped: interrupted)"),
+        "{text}"
+    );
+    assert!(dir.path().join("big.incomplete.rrd").exists());
+}

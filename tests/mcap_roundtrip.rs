@@ -82,6 +82,7 @@ fn record(
         merges: log.merges.len() as u32,
         rounds: log.rounds.len() as u32,
         seconds: 0.25,
+        stopped: None,
     };
     let mut out = rec.finish(&outcome).unwrap();
     out.flush().unwrap();
@@ -377,6 +378,7 @@ fn record_into<W: Write + Seek>(loaded: &Loaded, sink: W) -> anyhow::Result<W> {
         merges: loaded.scene.len() as u32 - 1,
         rounds: g.rounds,
         seconds: 0.0,
+        stopped: None,
     };
     rec.finish(&outcome)
 }
@@ -458,6 +460,7 @@ fn record_wrappers(loaded: &Loaded, path: &Path, g: &Grouping, wrappers: &Wrappe
         merges: log.merges.len() as u32,
         rounds: log.rounds.len() as u32,
         seconds: 0.0,
+        stopped: None,
     };
     rec.finish(&outcome).unwrap().flush().unwrap();
 }

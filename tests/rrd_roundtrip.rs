@@ -90,6 +90,7 @@ fn write(
         merges: log.merges.len() as u32,
         rounds: grouping.rounds,
         seconds: 0.0,
+        stopped: None,
     };
     recorder.finish(&outcome).expect("recording finishes");
     (grouping, log)
@@ -394,6 +395,7 @@ fn a_full_disk_is_a_clear_error() {
                 merges: loaded.scene.len() as u32 - 1,
                 rounds: g.rounds,
                 seconds: 0.0,
+                stopped: None,
             };
             recorder
                 .finish(&outcome)

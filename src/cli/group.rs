@@ -4,8 +4,80 @@ use super::{GroupArgs, SceneArgs};
 use anyhow::Result;
 use clap::Args;
 use std::process::ExitCode;
-use std::time::Instant;
-use wraptree::grouping::{self, Event, Observer};
+use std::sync::atomic::AtomicBool;
+use std::time::{Duration, Instant};
+use wraptree::grouping::{self, Budget, Event, Observer, StopReason, Stopped};
+
+/// Exit code of a run stopped by `--max-seconds` or `--max-pairs`.
+pub const EXIT_BUDGET: u8 = 3;
+/// Exit code of a run stopped by Ctrl-C or SIGTERM (128 + SIGINT, as shells report it).
+pub const EXIT_INTERRUPTED: u8 = 130;
+
+/// Limits on the grouping phase, for runs that could run away (huge `--glimit`, dense soups).
+#[derive(Args, Debug, Clone, Copy, Default)]
+pub struct BudgetArgs {
+    /// Stop the grouping after S seconds of wall time (loading not counted); exit code 3.
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub max_seconds: Option<f64>,
+    /// Stop the grouping once the round-start scans (step 3) have found more than P eligible
+    /// pairs, summed over rounds; exit code 3.
+    #[arg(long, value_name = "P")]
+    pub max_pairs: Option<u64>,
+}
+
+impl BudgetArgs {
+    /// Checks the values: `--max-seconds` must be a finite number > 0.
+    pub fn check(&self) -> Result<()> {
+        if let Some(s) = self.max_seconds
+            && !(s.is_finite() && s > 0.0)
+        {
+            anyhow::bail!("--max-seconds must be a finite number > 0, got {s}");
+        }
+        Ok(())
+    }
+
+    /// The budget of a grouping starting now, with the stop flag `stop` if any.
+    pub fn budget<'a>(&self, stop: Option<&'a AtomicBool>) -> Budget<'a> {
+        Budget {
+            stop,
+            // Beyond ~10^10 s `checked_add` fails: no deadline, as good as none.
+            deadline: self
+                .max_seconds
+                .and_then(|s| Instant::now().checked_add(Duration::from_secs_f64(s.min(1e10)))),
+            max_pairs: self.max_pairs,
+        }
+    }
+
+    /// One line saying what stopped a run of `n` primitives, e.g. `grouping stopped by
+    /// --max-pairs 1000 after 12 of 275 merges (1043 eligible pairs found)`.
+    pub fn message(&self, s: &Stopped, n: usize) -> String {
+        let by = match s.reason {
+            StopReason::Interrupted => "grouping interrupted".to_string(),
+            StopReason::MaxSeconds => format!(
+                "grouping stopped by --max-seconds {}",
+                self.max_seconds.unwrap_or(f64::NAN)
+            ),
+            StopReason::MaxPairs => format!(
+                "grouping stopped by --max-pairs {}",
+                self.max_pairs.unwrap_or(0)
+            ),
+        };
+        format!(
+            "{by} after {} of {} merges ({} eligible pairs found)",
+            s.merges,
+            n.saturating_sub(1),
+            s.eligible_pairs
+        )
+    }
+
+    /// The exit code of a run stopped for `reason`.
+    pub fn exit_code(reason: StopReason) -> ExitCode {
+        match reason {
+            StopReason::Interrupted => ExitCode::from(EXIT_INTERRUPTED),
+            StopReason::MaxSeconds | StopReason::MaxPairs => ExitCode::from(EXIT_BUDGET),
+        }
+    }
+}
 
 /// Arguments of `wraptree group`.
 #[derive(Args, Debug)]
@@ -14,6 +86,8 @@ pub struct GroupCmd {
     scene: SceneArgs,
     #[command(flatten)]
     group: GroupArgs,
+    #[command(flatten)]
+    limits: BudgetArgs,
     /// Print one JSON object (with the parent array) instead of text.
     #[arg(long)]
     json: bool,
@@ -56,11 +130,29 @@ impl GroupCmd {
     pub fn run(self) -> Result<ExitCode> {
         let loaded = self.scene.load()?;
         let params = self.group.params()?;
+        self.limits.check()?;
         let scene = &loaded.scene;
         let start = Instant::now();
-        let g = match Progress::for_merges(scene.len() as u64) {
-            Some(p) => grouping::group(scene, &params, p),
-            None => grouping::group(scene, &params, ()),
+        let g = if self.limits.max_seconds.is_none() && self.limits.max_pairs.is_none() {
+            match Progress::for_merges(scene.len() as u64) {
+                Some(p) => grouping::group(scene, &params, p),
+                None => grouping::group(scene, &params, ()),
+            }
+        } else {
+            let resolved = params.resolve(scene);
+            let budget = self.limits.budget(None);
+            let run = match Progress::for_merges(scene.len() as u64) {
+                Some(p) => grouping::group_within(scene, &resolved, p, &budget),
+                None => grouping::group_within(scene, &resolved, (), &budget),
+            };
+            match run {
+                Ok(g) => g,
+                Err(s) => {
+                    let file = self.scene.scene.display();
+                    eprintln!("error: {file}: {}", self.limits.message(&s, scene.len()));
+                    return Ok(BudgetArgs::exit_code(s.reason));
+                }
+            }
         };
         let seconds = start.elapsed().as_secs_f64();
         let t = &g.tree;

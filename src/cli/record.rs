@@ -1,7 +1,7 @@
 //! `wraptree record`: group a scene step by step and write `PREFIX.rrd` and `PREFIX.mcap`.
 
 use super::cover::{Tolerance, parse_tolerance};
-use super::group::Progress;
+use super::group::{BudgetArgs, Progress};
 use super::{GroupArgs, SceneArgs};
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -11,7 +11,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 use wraptree::grouping::SubsetTree;
-use wraptree::grouping::{self, Grouping, ResolvedParams, Tee};
+use wraptree::grouping::{self, Grouping, ResolvedParams, Stopped, Tee};
 use wraptree::record::mcap::McapRecorder;
 use wraptree::record::output::Pending;
 use wraptree::record::rrd::RrdRecorder;
@@ -28,6 +28,8 @@ pub struct RecordCmd {
     scene: SceneArgs,
     #[command(flatten)]
     group: GroupArgs,
+    #[command(flatten)]
+    limits: BudgetArgs,
     /// Output prefix: writes PREFIX.rrd and PREFIX.mcap [default: recordings/<scene stem>].
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -53,6 +55,17 @@ pub struct RecordCmd {
     /// Wrapper kinds the cover chooses from, comma-separated: sphere, box (or aabb), obb, hull.
     #[arg(long, default_value = "sphere,box,hull", value_delimiter = ',', value_parser = WrapperKind::parse)]
     cover_kinds: Vec<WrapperKind>,
+}
+
+/// How a recording is made, besides what it holds.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Options {
+    /// Replace existing recordings.
+    pub force: bool,
+    /// Leave wall-clock timing out of the `.mcap`.
+    pub reproducible: bool,
+    /// Limits on the grouping (Ctrl-C/SIGTERM always stop it).
+    pub limits: BudgetArgs,
 }
 
 /// How the logged cover is bounded.
@@ -106,8 +119,12 @@ pub struct Written {
     pub rrd: PathBuf,
     /// The `.mcap` path.
     pub mcap: PathBuf,
-    /// The grouping, unless interrupted.
+    /// The grouping, unless stopped.
     pub grouping: Option<Grouping>,
+    /// Why the grouping stopped before the root, if it did.
+    pub stopped: Option<Stopped>,
+    /// The limits the grouping ran under.
+    pub limits: BudgetArgs,
     /// Grouping + recording wall time.
     pub seconds: f64,
 }
@@ -134,7 +151,7 @@ pub fn with_ext(prefix: &Path, ext: &str) -> PathBuf {
     PathBuf::from(s)
 }
 
-/// [`record_with`] logging sphere Wrapper Trees.
+/// [`record_with`] logging sphere Wrapper Trees, stopped only by Ctrl-C/SIGTERM.
 pub fn record(
     scene: &Scene,
     source: &SceneSource,
@@ -151,7 +168,11 @@ pub fn record(
         params,
         detail,
         prefix,
-        (force, reproducible),
+        Options {
+            force,
+            reproducible,
+            limits: BudgetArgs::default(),
+        },
         Logged {
             kinds: &kinds,
             cover: None,
@@ -161,8 +182,8 @@ pub fn record(
 
 /// Groups `scene` while both recorders listen, logging the levels with the Wrapper Trees of
 /// `kinds`; commits the files when complete, or sets them aside as `PREFIX.incomplete.*` when
-/// stopped by Ctrl-C/SIGTERM (an existing recording is never replaced by a partial one).
-/// `flags` is (force, reproducible). A cover in `logged` is computed after a finished grouping
+/// stopped by Ctrl-C/SIGTERM or a limit of `limits` (an existing recording is never replaced by
+/// a partial one; the partial files say why they stopped). A cover in `logged` is computed after a finished grouping
 /// and logged as one more level (it needs `detail` with levels).
 pub fn record_with(
     scene: &Scene,
@@ -170,9 +191,14 @@ pub fn record_with(
     params: &ResolvedParams,
     detail: Detail,
     prefix: &Path,
-    (force, reproducible): (bool, bool),
+    opts: Options,
     logged: Logged<'_>,
 ) -> Result<Written> {
+    let Options {
+        force,
+        reproducible,
+        limits,
+    } = opts;
     if logged.cover.is_some() && !detail.levels() {
         bail!(
             "--cover-tolerance/--cover-budget need --detail levels or full (the cover is a level)"
@@ -197,20 +223,20 @@ pub fn record_with(
     let stop = stop_flag();
     let start = Instant::now();
     let progress = Progress::for_merges(scene.len() as u64);
-    let result = grouping::group_until(
+    let result = grouping::group_within(
         scene,
         params,
         Tee(&mut rrd, Tee(&mut mcap, progress)),
-        &stop,
+        &limits.budget(Some(&stop)),
     );
     let seconds = start.elapsed().as_secs_f64();
-    let (grouping, merges, rounds) = match result {
+    let (grouping, stopped, merges, rounds) = match result {
         Ok(g) => {
             let m = g.tree.leaves() as u32 - 1;
             let r = g.rounds;
-            (Some(g), m, r)
+            (Some(g), None, m, r)
         }
-        Err(s) => (None, s.merges, s.rounds),
+        Err(s) => (None, Some(s), s.merges, s.rounds),
     };
     let mut wrappers = match (&grouping, detail.levels()) {
         (Some(g), true) => Some(Wrappers::build(
@@ -247,6 +273,7 @@ pub fn record_with(
         merges,
         rounds,
         seconds,
+        stopped,
     };
     rrd.finish(&outcome)
         .with_context(|| format!("{}", rrd_path.display()))?;
@@ -266,8 +293,20 @@ pub fn record_with(
         rrd: rrd_dest,
         mcap: mcap_dest,
         grouping,
+        stopped,
+        limits,
         seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// Success for a finished grouping, else the stop's exit code (3 for a limit, 130 for
+/// Ctrl-C/SIGTERM).
+pub fn exit_code(w: &Written) -> ExitCode {
+    match (&w.grouping, &w.stopped) {
+        (Some(_), _) => ExitCode::SUCCESS,
+        (None, Some(s)) => BudgetArgs::exit_code(s.reason),
+        (None, None) => ExitCode::from(super::group::EXIT_INTERRUPTED),
+    }
 }
 
 /// A flag set by the first Ctrl-C or SIGTERM (installed once per process).
@@ -299,7 +338,16 @@ pub fn report(w: &Written, scene: &Scene) {
             g.tree.depth_mean(),
             w.seconds
         ),
-        None => eprintln!("interrupted: wrote what was recorded, marked incomplete"),
+        None => {
+            let why = match &w.stopped {
+                Some(s) => w.limits.message(s, scene.len()),
+                None => "grouping stopped".to_string(),
+            };
+            eprintln!(
+                "incomplete: {}: {why}; wrote what was recorded, marked incomplete",
+                scene.name
+            );
+        }
     }
     println!("  {} ({:.2} MB)", w.rrd.display(), size(&w.rrd));
     println!("  {} ({:.2} MB)", w.mcap.display(), size(&w.mcap));
@@ -310,6 +358,7 @@ impl RecordCmd {
     pub fn run(self) -> Result<ExitCode> {
         // Installed before loading so an early Ctrl-C still ends in readable, incomplete files.
         stop_flag();
+        self.limits.check()?;
         if self.cover_budget == Some(0) {
             bail!("--cover-budget must be ≥ 1 (a cover needs at least one wrapper)");
         }
@@ -332,17 +381,17 @@ impl RecordCmd {
             &params,
             self.detail,
             &prefix,
-            (self.force, self.reproducible),
+            Options {
+                force: self.force,
+                reproducible: self.reproducible,
+                limits: self.limits,
+            },
             Logged {
                 kinds: &self.wrapper,
                 cover: limit.map(|l| (l, self.cover_kinds.as_slice())),
             },
         )?;
         report(&w, &loaded.scene);
-        Ok(if w.grouping.is_some() {
-            ExitCode::SUCCESS
-        } else {
-            ExitCode::from(130)
-        })
+        Ok(exit_code(&w))
     }
 }

@@ -1,16 +1,20 @@
 //! `wraptree replay`: rebuild, verify or re-weight a run from its `.mcap` recording.
 
-use super::record::{output_prefix, record, report};
+use super::group::BudgetArgs;
+use super::record::{Logged, Options, exit_code, output_prefix, record_with, report};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use wraptree::geom::Aabb;
-use wraptree::grouping::{EventLog, Merge, ResolvedParams, SubsetTree, Weights, group_until};
+use wraptree::grouping::{
+    Event, EventLog, Merge, Observer, ResolvedParams, Stopped, SubsetTree, Weights, group_within,
+};
 use wraptree::record::Detail;
-use wraptree::record::mcap::{Recorded, read_recording};
+use wraptree::record::mcap::{Recorded, metadata, read_recording};
 use wraptree::scene::{Loaded, load_bytes};
+use wraptree::wrap::WrapperKind;
 
 /// Arguments of `wraptree replay`.
 #[derive(Args, Debug)]
@@ -38,6 +42,77 @@ pub struct ReplayCmd {
     /// Replace existing recordings.
     #[arg(long)]
     force: bool,
+    /// Limits on the re-run of --verify and --a/--b/--c.
+    #[command(flatten)]
+    limits: BudgetArgs,
+}
+
+/// The magic bytes that open every Rerun `.rrd` stream, and the 8 bytes before the entry count
+/// that close a finished one (`RRF2FOOT`).
+const RRD_MAGIC: &[u8; 4] = b"RRF2";
+const RRD_FOOTER: &[u8; 8] = b"RRF2FOOT";
+/// The magic bytes that open an MCAP file.
+const MCAP_MAGIC: &[u8; 8] = b"\x89MCAP0\r\n";
+
+/// Why `path` cannot be what `replay` reads, when its first and last bytes say so: a Rerun
+/// `.rrd` file (finished, truncated or with a bad magic) or an empty file. `None` for anything
+/// else, which the MCAP reader then judges.
+pub fn not_an_mcap(path: &Path) -> Option<String> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut f = std::fs::File::open(path).ok()?;
+    let len = f.metadata().ok()?.len();
+    let name = path.display();
+    if len == 0 {
+        return Some(format!("{name}: empty file (not a recording)"));
+    }
+    let mut head = [0u8; 8];
+    let n = f.read(&mut head).ok()?;
+    let head = &head[..n];
+    let is_rrd = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("rrd"));
+    let mcap = path.with_extension("mcap");
+    let hint = if mcap != path && mcap.is_file() {
+        format!("replay reads the .mcap beside it ({})", mcap.display())
+    } else {
+        "replay reads the .mcap that `record` writes beside the .rrd".to_string()
+    };
+    if head.starts_with(RRD_MAGIC) {
+        let mut tail = [0u8; 12];
+        let finished = len >= 24
+            && f.seek(SeekFrom::End(-12)).is_ok()
+            && f.read_exact(&mut tail).is_ok()
+            && tail.starts_with(RRD_FOOTER);
+        let what = if finished {
+            "a Rerun .rrd recording"
+        } else {
+            "a truncated Rerun .rrd recording (no footer)"
+        };
+        return Some(format!("{name}: {what}, not an MCAP file; {hint}"));
+    }
+    if is_rrd && !head.starts_with(MCAP_MAGIC) {
+        return Some(format!(
+            "{name}: not a Rerun recording (bad magic, expected RRF2) nor an MCAP file"
+        ));
+    }
+    None
+}
+
+/// An observer that keeps the event log and sets `stop` once `limit` merges are made, so a
+/// re-run of an incomplete recording ends where the recording did.
+struct UpTo<'a> {
+    log: EventLog,
+    limit: Option<usize>,
+    stop: &'a AtomicBool,
+}
+
+impl Observer for UpTo<'_> {
+    fn on_event(&mut self, event: &Event<'_>) {
+        self.log.on_event(event);
+        if self.limit.is_some_and(|k| self.log.merges.len() >= k) {
+            self.stop.store(true, Ordering::Relaxed);
+        }
+    }
 }
 
 /// The Subset Tree rebuilt from the recorded merges alone (leaf boxes from the embedded scene).
@@ -53,11 +128,27 @@ fn tree_of(rec: &Recorded, loaded: &Loaded) -> Result<SubsetTree> {
     SubsetTree::from_merges(boxes, diam, &merges).map_err(anyhow::Error::msg)
 }
 
-fn rerun(loaded: &Loaded, params: &ResolvedParams) -> EventLog {
-    let mut log = EventLog::default();
-    let never = AtomicBool::new(false);
-    group_until(&loaded.scene, params, &mut log, &never).expect("the stop flag is never set");
-    log
+/// Re-runs the grouping within `limits`, up to `merges` merges when given (the length of an
+/// incomplete recording). Err: the stop, when a limit of `limits` ended the re-run first.
+fn rerun(
+    loaded: &Loaded,
+    params: &ResolvedParams,
+    limits: &BudgetArgs,
+    merges: Option<usize>,
+) -> Result<EventLog, Stopped> {
+    let stop = AtomicBool::new(merges == Some(0));
+    let mut obs = UpTo {
+        log: EventLog::default(),
+        limit: merges,
+        stop: &stop,
+    };
+    let budget = limits.budget(Some(&stop));
+    match group_within(&loaded.scene, params, &mut obs, &budget) {
+        Ok(_) => Ok(obs.log),
+        // Our own flag, set at the recorded length: the re-run went as far as the recording.
+        Err(s) if s.reason == wraptree::grouping::StopReason::Interrupted => Ok(obs.log),
+        Err(s) => Err(s),
+    }
 }
 
 /// A merge without `queue_len`, which depends on how MPairs stores pairs (it changed between
@@ -105,6 +196,10 @@ fn balance_stats(m: &[Merge]) -> (f64, f64) {
 impl ReplayCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
+        self.limits.check()?;
+        if let Some(why) = not_an_mcap(&self.file) {
+            bail!("{why}");
+        }
         let rec = read_recording(&self.file)?;
         let name = self.file.display().to_string();
         let loaded = load_bytes(
@@ -139,16 +234,29 @@ impl ReplayCmd {
                 t.depth_mean()
             );
         } else {
+            let why = metadata::stop_reason(&rec.metadata).unwrap_or("unknown");
             println!(
-                "incomplete recording: {} of {} merges, {} rounds started",
+                "incomplete recording (stopped: {why}): {} of {} merges, {} rounds started; no tree",
                 rec.merges.len(),
                 n.saturating_sub(1),
                 rec.rounds
             );
         }
         if self.verify {
-            let log = rerun(&loaded, &rec.params);
+            let upto = (!rec.complete).then_some(rec.merges.len());
+            let log = match rerun(&loaded, &rec.params, &self.limits, upto) {
+                Ok(log) => log,
+                Err(s) => {
+                    let msg = self.limits.message(&s, loaded.scene.len());
+                    eprintln!("error: {name}: --verify re-run: {msg}");
+                    return Ok(BudgetArgs::exit_code(s.reason));
+                }
+            };
             match first_divergence(&rec.merges, &log.merges) {
+                None if !rec.complete => println!(
+                    "verified: the {0} recorded merges match the re-run's first {0} (the recording stopped there)",
+                    rec.merges.len()
+                ),
                 None => {
                     println!(
                         "verified: the merge sequence is identical ({} merges)",
@@ -165,10 +273,6 @@ impl ReplayCmd {
                         );
                     }
                 }
-                Some(i) if !rec.complete && i == rec.merges.len() => println!(
-                    "verified: the {} recorded merges match the re-run's first {} (the recording stopped there)",
-                    i, i
-                ),
                 Some(i) => {
                     side_by_side(
                         i,
@@ -199,20 +303,31 @@ impl ReplayCmd {
         };
         let suffix = format!("-a{}-b{}-c{}", weights.a, weights.b, weights.c);
         let prefix = output_prefix(self.output.as_deref(), &rec.scene_file_name, &suffix)?;
-        let written = record(
+        let kinds = [WrapperKind::Sphere];
+        let logged = Logged {
+            kinds: &kinds,
+            cover: None,
+        };
+        let written = record_with(
             &loaded.scene,
             &loaded.source,
             &params,
             self.detail,
             &prefix,
-            self.force,
-            false,
+            Options {
+                force: self.force,
+                reproducible: false,
+                limits: self.limits,
+            },
+            logged,
         )?;
         let Some(g) = &written.grouping else {
             report(&written, &loaded.scene);
-            return Ok(ExitCode::from(130));
+            return Ok(exit_code(&written));
         };
-        let log = rerun(loaded, &params);
+        // The same run again for its events: it finished within the limits just now.
+        let log = rerun(loaded, &params, &BudgetArgs::default(), None)
+            .expect("an unlimited re-run is never stopped");
         let pairs = |m: &[Merge]| m.iter().map(|x| (x.a, x.b)).collect::<Vec<_>>();
         let (old_pairs, new_pairs) = (pairs(&rec.merges), pairs(&log.merges));
         match (0..old_pairs.len().max(new_pairs.len()))

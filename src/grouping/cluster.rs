@@ -7,10 +7,10 @@ use super::hull_pset::HullBodies;
 use super::mpairs::{Entry, MPairs, Partners, order_bits};
 use super::subset_tree::{NONE, SubsetTree};
 use super::voxel_hash::VoxelHash;
-use super::{Grouping, PSet, ResolvedParams, Stats, Stopped};
+use super::{Budget, Grouping, PSet, ResolvedParams, Stats, StopReason, Stopped};
 use crate::geom::Aabb;
 use crate::scene::Scene;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 
 mod scan;
 
@@ -49,7 +49,7 @@ pub(super) fn run<O: Observer>(
     scene: &Scene,
     params: &ResolvedParams,
     observer: O,
-    stop: Option<&AtomicBool>,
+    budget: &Budget<'_>,
 ) -> Result<Grouping, Stopped> {
     assert!(!scene.is_empty(), "grouping needs at least one primitive");
     match params.pset {
@@ -57,13 +57,45 @@ pub(super) fn run<O: Observer>(
             let diameters = (0..scene.len())
                 .map(|i| scene.prim_aabb(i).diameter())
                 .collect();
-            Clusterer::new(scene, params, AabbBodies, diameters, observer).run(stop)
+            Clusterer::new(scene, params, AabbBodies, diameters, observer).run(budget)
         }
         PSet::Hull => {
             let bodies = HullBodies::new(scene);
             let diameters = bodies.leaf_diameters();
-            Clusterer::new(scene, params, bodies, diameters, observer).run(stop)
+            Clusterer::new(scene, params, bodies, diameters, observer).run(budget)
         }
+    }
+}
+
+/// The budget as the round-start scans see it: pairs left before `max_pairs` is exceeded,
+/// and the stop flag and deadline, read every [`Budget::CLOCK_EVERY`] bodies.
+pub(super) struct ScanLimit<'b> {
+    budget: &'b Budget<'b>,
+    /// Eligible pairs this scan may find before the budget is exceeded (`u64::MAX`: no limit).
+    room: u64,
+    /// Whether the budget has a stop flag or a deadline.
+    timed: bool,
+    bodies: u32,
+    /// The limit that cut the scan short, if any.
+    hit: Option<StopReason>,
+}
+
+impl ScanLimit<'_> {
+    /// Whether the scan must stop before its next body, having found `pairs` so far.
+    #[inline(always)]
+    pub(super) fn over(&mut self, pairs: u64) -> bool {
+        if pairs > self.room {
+            self.hit = Some(StopReason::MaxPairs);
+            return true;
+        }
+        if self.timed {
+            self.bodies = self.bodies.wrapping_add(1);
+            if self.bodies.is_multiple_of(Budget::CLOCK_EVERY) {
+                self.hit = self.budget.exceeded_now();
+                return self.hit.is_some();
+            }
+        }
+        false
     }
 }
 
@@ -230,8 +262,22 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         }
     }
 
-    fn run(mut self, stop: Option<&AtomicBool>) -> Result<Grouping, Stopped> {
+    /// What [`run`] returns when `reason` stops it after `rounds` announced rounds.
+    fn stopped(&self, reason: StopReason, rounds: u32) -> Stopped {
+        Stopped {
+            reason,
+            merges: self.children.len() as u32,
+            rounds,
+            eligible_pairs: self.stats.eligible_pairs,
+        }
+    }
+
+    fn run(mut self, budget: &Budget<'_>) -> Result<Grouping, Stopped> {
         let n = self.n;
+        let max_pairs = budget.max_pairs.unwrap_or(u64::MAX);
+        let timed = budget.stop.is_some() || budget.deadline.is_some();
+        // Merges since the clock was last read.
+        let mut tick = 0u32;
         let mut parentless: Vec<u32> = (0..n as u32).collect();
         let (mut dlimit, mut glimit) = (self.params.dlimit0, self.params.glimit0);
         let mut round = 0u32;
@@ -240,6 +286,9 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         let mut order: Vec<u32> = Vec::new();
         // Step 2: one parent-less body left is the root.
         while parentless.len() > 1 {
+            if let Some(reason) = budget.exceeded_now() {
+                return Err(self.stopped(reason, round));
+            }
             active.clear();
             active.extend(
                 parentless
@@ -266,11 +315,24 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                 self.grow_half_ext(x);
                 self.partners.open(x);
             }
-            let pairs = self.round_start_search(&order, glimit);
+            let mut limit = ScanLimit {
+                budget,
+                room: max_pairs.saturating_sub(self.stats.eligible_pairs),
+                timed,
+                bodies: 0,
+                hit: None,
+            };
+            let pairs = self.round_start_search(&order, glimit, &mut limit);
+            self.stats.eligible_pairs += pairs;
+            if self.stats.eligible_pairs > max_pairs {
+                limit.hit = Some(StopReason::MaxPairs);
+            }
+            if let Some(reason) = limit.hit {
+                return Err(self.stopped(reason, round));
+            }
             for &x in &order {
                 self.queue_current(x);
             }
-            self.stats.eligible_pairs += pairs;
             self.observer.on_event(&Event::RoundStart {
                 round,
                 dlimit,
@@ -313,11 +375,21 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                     continue;
                 }
                 self.mpairs.pop(&self.tag);
-                if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
-                    return Err(Stopped {
-                        merges: self.children.len() as u32,
-                        rounds: round + 1,
-                    });
+                if timed {
+                    // The flag before every merge, the clock every CLOCK_EVERY merges.
+                    let clock =
+                        budget.deadline.is_some() && tick.is_multiple_of(Budget::CLOCK_EVERY);
+                    tick = tick.wrapping_add(1);
+                    let reason = if clock {
+                        budget.exceeded_now()
+                    } else if budget.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+                        Some(StopReason::Interrupted)
+                    } else {
+                        None
+                    };
+                    if let Some(reason) = reason {
+                        return Err(self.stopped(reason, round + 1));
+                    }
                 }
                 self.merge_pair(e, round, dlimit, glimit);
             }

@@ -29,6 +29,11 @@
 //! [`mpairs`]), exactly the pair the literal queue would pop, so the tree is the same; the
 //! queue is O(N) instead of O(kN). Ties break by the pair's (smaller id, larger id), or by seeded random tags with
 //! `--seed`.
+//!
+//! [`group_within`] runs under a [`Budget`] (a stop flag, a deadline, a cap on the eligible
+//! pairs of step 3), checked between merges and between the bodies of a round-start scan, and
+//! returns [`Stopped`] with the reason when one is exceeded; the merges made so far are the
+//! unlimited run's first ones.
 
 mod cluster;
 pub mod events;
@@ -41,7 +46,8 @@ pub use events::{Event, EventLog, Merge, Observer, Tee};
 pub use subset_tree::{NONE, SubsetTree};
 
 use crate::scene::Scene;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
 
 /// The p-set wrapper bodies carry while grouping.
 #[derive(
@@ -254,20 +260,111 @@ pub struct Grouping {
     pub stats: Stats,
 }
 
-/// Why a run stopped before the root.
-#[derive(Clone, Debug, PartialEq)]
+/// Limits on one run of the grouping phase; a run that exceeds one stops with [`Stopped`].
+///
+/// - `stop`: a flag (Ctrl-C/SIGTERM), checked before every merge.
+/// - `deadline`: a wall-clock instant, checked every [`Budget::CLOCK_EVERY`] merges and during
+///   the round-start scans (every [`Budget::CLOCK_EVERY`] bodies scanned).
+/// - `max_pairs`: the most eligible pairs the round-start scans (step 3) may find, summed over
+///   rounds: [`Stats::eligible_pairs`], counted as they are found, so a scan that would find
+///   more stops partway. These are the pairs the paper's MPairs would queue at step 3, and what
+///   grows quadratically when DLimit + GLimit spans too many bodies (all N active bodies
+///   within GLimit of each other give N(N − 1)/2 pairs). Partner searches for new bodies during
+///   a round (step 4b) are not counted: each reads at most the active bodies, and the deadline
+///   bounds them. A run that needs exactly `max_pairs` pairs completes.
+///
+/// The default (no limit) costs one predictable branch per merge and per scanned body.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Budget<'a> {
+    /// Stop as soon as this flag is set.
+    pub stop: Option<&'a AtomicBool>,
+    /// Stop once this instant has passed.
+    pub deadline: Option<Instant>,
+    /// Stop once the round-start scans have found more eligible pairs than this.
+    pub max_pairs: Option<u64>,
+}
+
+impl Budget<'_> {
+    /// How many merges (or scanned bodies) pass between two reads of the clock.
+    pub const CLOCK_EVERY: u32 = 64;
+
+    /// Whether no limit is set.
+    pub fn is_unlimited(&self) -> bool {
+        self.stop.is_none() && self.deadline.is_none() && self.max_pairs.is_none()
+    }
+
+    /// The limit among `stop` and `deadline` that is exceeded now, if any (`max_pairs` is
+    /// checked by the scans, which count the pairs).
+    pub fn exceeded_now(&self) -> Option<StopReason> {
+        if self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+            return Some(StopReason::Interrupted);
+        }
+        match self.deadline {
+            Some(d) if Instant::now() >= d => Some(StopReason::MaxSeconds),
+            _ => None,
+        }
+    }
+}
+
+/// Which limit of a [`Budget`] stopped a run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StopReason {
+    /// The stop flag was set (Ctrl-C or SIGTERM).
+    Interrupted,
+    /// The deadline passed (`--max-seconds`).
+    MaxSeconds,
+    /// The round-start scans found more eligible pairs than allowed (`--max-pairs`).
+    MaxPairs,
+}
+
+impl StopReason {
+    /// The name written to recordings' metadata: `interrupted`, `max-seconds`, `max-pairs`.
+    pub fn name(self) -> &'static str {
+        match self {
+            StopReason::Interrupted => "interrupted",
+            StopReason::MaxSeconds => "max-seconds",
+            StopReason::MaxPairs => "max-pairs",
+        }
+    }
+
+    /// The reason named `name` (as [`StopReason::name`] writes it).
+    pub fn from_name(name: &str) -> Option<StopReason> {
+        [
+            StopReason::Interrupted,
+            StopReason::MaxSeconds,
+            StopReason::MaxPairs,
+        ]
+        .into_iter()
+        .find(|r| r.name() == name)
+    }
+}
+
+impl std::fmt::Display for StopReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Why and where a run stopped before the root.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Stopped {
-    /// Merges completed before the stop.
+    /// The limit that stopped it.
+    pub reason: StopReason,
+    /// Merges completed before the stop (the observer has seen each of them).
     pub merges: u32,
-    /// Rounds started.
+    /// Rounds whose `RoundStart` the observer has seen (a round whose scan was cut short is
+    /// not counted).
     pub rounds: u32,
+    /// Eligible pairs found by the round-start scans so far, including a scan cut short.
+    pub eligible_pairs: u64,
 }
 
 /// Runs the grouping phase on `scene`, reporting every step to `observer`.
 ///
 /// Panics only if the scene is empty; loaders reject empty scenes first.
 pub fn group<O: Observer>(scene: &Scene, params: &Params, observer: O) -> Grouping {
-    cluster::run(scene, &params.resolve(scene), observer, None).expect("no stop flag was given")
+    cluster::run(scene, &params.resolve(scene), observer, &Budget::default())
+        .expect("an unlimited budget never stops")
 }
 
 /// Like [`group`], but checks `stop` between merges and returns [`Stopped`] once it is set
@@ -278,5 +375,20 @@ pub fn group_until<O: Observer>(
     observer: O,
     stop: &AtomicBool,
 ) -> Result<Grouping, Stopped> {
-    cluster::run(scene, params, observer, Some(stop))
+    let budget = Budget {
+        stop: Some(stop),
+        ..Budget::default()
+    };
+    cluster::run(scene, params, observer, &budget)
+}
+
+/// Like [`group`] within `budget`: returns [`Stopped`] once a limit is exceeded (the observer
+/// has then seen every merge made so far, and no `Finish`).
+pub fn group_within<O: Observer>(
+    scene: &Scene,
+    params: &ResolvedParams,
+    observer: O,
+    budget: &Budget<'_>,
+) -> Result<Grouping, Stopped> {
+    cluster::run(scene, params, observer, budget)
 }

@@ -6,7 +6,7 @@ pub mod mcap;
 pub mod output;
 pub mod rrd;
 
-use crate::grouping::{Grouping, ResolvedParams};
+use crate::grouping::{Grouping, ResolvedParams, Stopped};
 use crate::scene::{Scene, SceneSource};
 use crate::wrap::cover::Cover;
 use crate::wrap::cover::export::WrapperRecord;
@@ -81,6 +81,9 @@ pub struct Outcome<'a> {
     pub rounds: u32,
     /// Grouping wall time in seconds.
     pub seconds: f64,
+    /// Why the run stopped before the root (`grouping` is then `None`); `None` for a finished
+    /// run, or an incomplete one whose reason is unknown.
+    pub stopped: Option<Stopped>,
 }
 
 /// A cover of the finished tree (see [`crate::wrap::cover`]) with its wrappers' geometry, logged

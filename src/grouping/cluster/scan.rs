@@ -22,7 +22,7 @@
 //! With C = 0 and B > 0 the pair Cost skips Balance (then weighted by zero), bit for bit the
 //! same value. Other p-sets search every candidate for the single best partner, as in the paper.
 
-use super::{Clusterer, PSetBodies, fill_balance};
+use super::{Clusterer, PSetBodies, ScanLimit, fill_balance};
 use crate::geom::{Aabb, P3, V3};
 use crate::grouping::Weights;
 use crate::grouping::events::Observer;
@@ -90,23 +90,33 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
     }
 
     /// Step 3 after the active bodies are stored: fills every active body's partner list and
-    /// returns the number of eligible pairs.
-    pub(super) fn round_start_search(&mut self, order: &[u32], glimit: f64) -> u64 {
+    /// returns the number of eligible pairs. Stops early, with `limit.hit` set, when `limit`
+    /// is exceeded (checked before each body).
+    pub(super) fn round_start_search(
+        &mut self,
+        order: &[u32],
+        glimit: f64,
+        limit: &mut ScanLimit<'_>,
+    ) -> u64 {
         if P::AABB {
             let a = self.params.weights.a;
             if a == 1.0 {
-                self.pairs_once::<1>(glimit)
+                self.pairs_once::<1>(glimit, limit)
             } else if a == 0.0 {
-                self.pairs_once::<0>(glimit)
+                self.pairs_once::<0>(glimit, limit)
             } else {
-                self.pairs_once::<2>(glimit)
+                self.pairs_once::<2>(glimit, limit)
             }
         } else {
-            order
-                .iter()
-                .map(|&x| self.scan_all(x, glimit) as u64)
-                .sum::<u64>()
-                / 2
+            // Each pair is found from both of its bodies.
+            let mut twice = 0u64;
+            for &x in order {
+                if limit.over(twice / 2) {
+                    break;
+                }
+                twice += self.scan_all(x, glimit) as u64;
+            }
+            twice / 2
         }
     }
 
@@ -126,14 +136,15 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         }
     }
 
-    /// Every eligible pair once (AABB p-set); returns their number.
-    fn pairs_once<const A: u8>(&mut self, glimit: f64) -> u64 {
+    /// Every eligible pair once (AABB p-set); returns their number (so far, when `limit` cuts
+    /// the scan short).
+    fn pairs_once<const A: u8>(&mut self, glimit: f64, limit: &mut ScanLimit<'_>) -> u64 {
         let (k, w, finite) = (self.k, self.params.weights, self.finite);
         let mut pairs = 0u64;
         let mut candidates = 0u64;
         let mut near: Vec<u32> = Vec::with_capacity(27);
         let mut fwd: Vec<u32> = Vec::with_capacity(27);
-        for c in 0..self.hash.cells() {
+        'cells: for c in 0..self.hash.cells() {
             let vc = self.hash.coords(c);
             // The later cells any body of this cell may pair with, found once per cell.
             let (mut clo, mut chi) = (
@@ -153,6 +164,9 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                 }
             });
             for i in 0..hash.recs(c).len() {
+                if limit.over(pairs) {
+                    break 'cells;
+                }
                 let xr = hash.recs(c)[i];
                 let (x, xa, dx) = (xr.id, xr.aabb, xr.diameter);
                 let (lo, hi) = self.query(&xa, glimit);

@@ -41,6 +41,13 @@ pub const KEYS: &[&str] = &[
     "log_time",
 ];
 
+/// Keys the `wraptree` record adds when the run stopped before the root (`complete` =
+/// `false`): `stop_reason` is `interrupted` (Ctrl-C/SIGTERM), `max-seconds`, `max-pairs`, or
+/// `unknown`; `stop_eligible_pairs` is the number of eligible pairs the round-start scans had
+/// found (with a known reason). `merges` and `rounds` are then the merges made and the rounds
+/// announced.
+pub const STOP_KEYS: &[&str] = &["stop_reason", "stop_eligible_pairs"];
+
 /// Keys the `wraptree` record adds when a cover is logged (`cover_budget` only for a cover
 /// asked for by budget).
 pub const COVER_KEYS: &[&str] = &[
@@ -61,7 +68,8 @@ fn value_name<T: ValueEnum>(v: &T) -> String {
 }
 
 /// The `wraptree` record of a run. `depth_max`/`depth_mean` are present only for a finished
-/// grouping, and `complete` is `"false"` when it is missing (an interrupted run). With a cover:
+/// grouping, and `complete` is `"false"` when it is missing (a stopped run, with the
+/// [`STOP_KEYS`]). With a cover:
 /// `cover_tolerance` (absolute), `cover_budget` (when asked by budget), `cover_size` and
 /// `cover_max_error`.
 pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String, String> {
@@ -106,6 +114,13 @@ pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String,
         put("cover_max_error", c.cover.max_error().to_string());
     }
     put("complete", outcome.grouping.is_some().to_string());
+    if outcome.grouping.is_none() {
+        let reason = outcome.stopped.map_or("unknown", |s| s.reason.name());
+        put("stop_reason", reason.to_string());
+        if let Some(s) = outcome.stopped {
+            put("stop_eligible_pairs", s.eligible_pairs.to_string());
+        }
+    }
     put("log_time", LOG_TIME.to_string());
     m
 }
@@ -155,6 +170,15 @@ pub fn params(m: &BTreeMap<String, String>) -> Result<ResolvedParams> {
         .check()
         .map_err(|e| anyhow::anyhow!("metadata parameter {e}"))?;
     Ok(params)
+}
+
+/// Why the recorded run stopped before the root: `None` for a complete recording,
+/// `Some("unknown")` when an incomplete one does not say (older recordings).
+pub fn stop_reason(m: &BTreeMap<String, String>) -> Option<&str> {
+    match m.get("complete").map(String::as_str) {
+        Some("false") => Some(m.get("stop_reason").map_or("unknown", String::as_str)),
+        _ => None,
+    }
 }
 
 /// The recording's detail level.

@@ -51,7 +51,10 @@
 //!
 //! Each `levels/*` wrapper entity exists only for the kinds chosen with `record --wrapper`, and
 //! then has one row per level. Run metadata (scene, hash, parameters) is a recording property
-//! (`__properties/wraptree`) and the recording is named after the scene.
+//! (`__properties/wraptree`) and the recording is named after the scene. A run stopped before
+//! the root (Ctrl-C, SIGTERM, `--max-seconds`, `--max-pairs`) has no levels, a warning line in
+//! `log/doublings` and the property `__properties/wraptree_outcome` (`complete` = `false`,
+//! `stop_reason`, `merges`).
 //!
 //! The per-merge series and boxes are buffered and sent as columns every 4,096 merges
 //! (`columns::BATCH`), so memory stays bounded and most of a long run is already on its way to
@@ -65,7 +68,10 @@ mod blueprint;
 mod columns;
 mod levels;
 mod mesh;
+mod series_file;
 mod sink;
+
+pub use series_file::SeriesFile;
 
 use std::path::{Path, PathBuf};
 
@@ -424,6 +430,9 @@ impl RrdRecorder {
     fn write_tail(&mut self, outcome: &Outcome<'_>) -> anyhow::Result<()> {
         let rec = self.rec.as_ref().ok_or_else(closed)?;
         self.columns.flush(rec)?;
+        if outcome.grouping.is_none() {
+            self.mark_incomplete(outcome)?;
+        }
         if let (Some(mesh), Some(grouping), Some(spheres)) =
             (&self.mesh, outcome.grouping, outcome.spheres)
         {
@@ -433,6 +442,35 @@ impl RrdRecorder {
                 levels::log_cover(rec, tree, cover, &self.origin)?;
             }
         }
+        Ok(())
+    }
+}
+
+impl RrdRecorder {
+    /// Marks a run stopped before the root: a warning line in `log/doublings` at the last
+    /// merge, and the recording property `wraptree_outcome` with `complete` = `false`,
+    /// `stop_reason` (`interrupted`, `max-seconds`, `max-pairs` or `unknown`) and `merges`.
+    fn mark_incomplete(&self, outcome: &Outcome<'_>) -> anyhow::Result<()> {
+        let rec = self.rec()?;
+        let reason = outcome.stopped.map_or("unknown", |s| s.reason.name());
+        let line = format!(
+            "incomplete: stopped ({reason}) after {} merges; no tree levels",
+            outcome.merges
+        );
+        let times = [("merge", self.merges as i64), ("round", self.round as i64)];
+        let log = rerun::TextLog::new(line).with_level(rerun::TextLogLevel::WARN);
+        send_at(rec, "log/doublings", &times, &log)?;
+        let text = |s: String| [rerun::components::Text::from(s)];
+        rec.send_property(
+            "wraptree_outcome",
+            &rerun::AnyValues::default()
+                .with_component::<rerun::components::Text>("complete", text("false".into()))
+                .with_component::<rerun::components::Text>("stop_reason", text(reason.into()))
+                .with_component::<rerun::components::Text>(
+                    "merges",
+                    text(outcome.merges.to_string()),
+                ),
+        )?;
         Ok(())
     }
 }
