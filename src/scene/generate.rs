@@ -193,8 +193,8 @@ pub fn lamp() -> Scene {
     b.scene
 }
 
-/// A uniformly random rotation (Shoemake's method).
-fn random_rotation(rng: &mut ChaCha8Rng) -> UnitQuaternion<f64> {
+/// A uniformly random rotation (Shoemake's method), drawn from `rng`.
+pub fn random_rotation(rng: &mut ChaCha8Rng) -> UnitQuaternion<f64> {
     let (u1, u2, u3): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
     let (s1, s2) = ((1.0 - u1).sqrt(), u1.sqrt());
     let (t2, t3) = (std::f64::consts::TAU * u2, std::f64::consts::TAU * u3);
@@ -279,7 +279,8 @@ pub fn soup(n: usize, seed: u64) -> Scene {
 }
 
 /// The scene for `wraptree scene KIND`: `robot-base`, `lamp`, `lamps` (`copies`, default 5),
-/// `robot-bases` (`copies`, default 44) or `soup` (`n` triangles, default 10,000).
+/// `robot-bases` (`copies`, default 44), `soup` (`n` triangles, default 10,000) or one of the
+/// [`pathological`](super::pathological) kinds (`n` primitives).
 ///
 /// `copies` and `n` are errors where they do not apply, and must be at least 1.
 pub fn by_name(
@@ -294,7 +295,7 @@ pub fn by_name(
             "scene kind '{kind}' takes no copies (only lamps and robot-bases do)"
         ));
     }
-    if n.is_some() && kind != "soup" {
+    if n.is_some() && kind != "soup" && !super::pathological::KINDS.contains(&kind) {
         return Err(format!(
             "scene kind '{kind}' takes no triangle count (only soup does)"
         ));
@@ -322,9 +323,12 @@ pub fn by_name(
             let n = n.unwrap_or(10_000);
             too_big(n.saturating_mul(3)).map_or_else(|| Ok(soup(n, seed)), Err)
         }
-        _ => Err(format!(
-            "unknown scene kind '{kind}' (expected one of: {})",
-            KINDS.join(", ")
-        )),
+        _ => super::pathological::by_name(kind, n, seed).ok_or_else(|| {
+            format!(
+                "unknown scene kind '{kind}' (expected one of: {}, {})",
+                KINDS.join(", "),
+                super::pathological::KINDS.join(", ")
+            )
+        }),
     }
 }

@@ -6,10 +6,14 @@
 //! the hull's faces for a polyhedron).
 //!
 //! - [`obj`] loads Wavefront OBJ (via `tobj`) as polygons or as polyhedra, with validation;
-//! - [`generate`] makes the seeded synthetic scenes (robot base, lamp, replicas, soups).
+//! - [`generate`] makes the seeded synthetic scenes (robot base, lamp, replicas, soups);
+//! - [`pathological`] makes the seeded scenes that stress builders (spaghetti, slabs, …);
+//! - [`split`] cuts long thin polygons into pieces of limited aspect (§4).
 
 pub mod generate;
 pub mod obj;
+pub mod pathological;
+pub mod split;
 
 pub use obj::{LoadError, LoadOptions, Loaded, SceneSource, load_bytes, load_path};
 

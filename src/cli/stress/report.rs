@@ -1,0 +1,119 @@
+//! The table, CSV and charts of `wraptree stress`.
+
+use std::fmt::Write as _;
+use wraptree::render::chart::{Scatter, Series};
+
+/// One measured case: a row of the table and of stress.csv.
+#[derive(Clone, Debug, Default)]
+pub struct Row {
+    /// Scene name.
+    pub scene: String,
+    /// Primitives grouped (after the split, if any).
+    pub n: usize,
+    /// Builder: `group-aabb`, `group-hull`, `wrap-…` or a peer's name.
+    pub method: String,
+    /// The `--split-aspect` R applied first, if any.
+    pub split_r: Option<f64>,
+    /// Whether the build finished within the budget.
+    pub finished: bool,
+    /// Whether the tree (or the Wrapper Tree's containment) checked out; `None` if not built.
+    pub valid: Option<bool>,
+    /// Largest depth of the tree.
+    pub depth: Option<u32>,
+    /// Build time.
+    pub seconds: Option<f64>,
+    /// Eligible pairs per body (groupings).
+    pub k_eligible: Option<f64>,
+    /// Candidates examined per body (groupings).
+    pub k_candidates: Option<f64>,
+    /// Why a case failed or was stopped.
+    pub note: String,
+}
+
+/// Formats an optional number, blank when absent.
+pub fn opt(v: Option<f64>, prec: usize) -> String {
+    v.map(|x| format!("{x:.prec$}")).unwrap_or_default()
+}
+
+/// The CSV text of `rows` (header first).
+pub fn csv(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "scene,n,method,split_r,finished,valid,depth_max,seconds,k_eligible,k_candidates,note\n",
+    );
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},\"{}\"",
+            r.scene,
+            r.n,
+            r.method,
+            opt(r.split_r, 0),
+            r.finished,
+            r.valid.map(|v| v.to_string()).unwrap_or_default(),
+            r.depth.map(|d| d.to_string()).unwrap_or_default(),
+            opt(r.seconds, 6),
+            opt(r.k_eligible, 3),
+            opt(r.k_candidates, 3),
+            r.note.replace('"', "'")
+        );
+    }
+    s
+}
+
+/// Prints `rows` as a table.
+pub fn print_table(rows: &[Row]) {
+    println!(
+        "{:<28} {:>7} {:<22} {:>5} {:>4} {:>5} {:>5} {:>10} {:>9} {:>9}  note",
+        "scene", "N", "method", "split", "done", "valid", "depth", "ms", "k", "cand/N"
+    );
+    for r in rows {
+        println!(
+            "{:<28} {:>7} {:<22} {:>5} {:>4} {:>5} {:>5} {:>10} {:>9} {:>9}  {}",
+            r.scene,
+            r.n,
+            r.method,
+            opt(r.split_r, 0),
+            if r.finished { "yes" } else { "NO" },
+            match r.valid {
+                Some(true) => "yes",
+                Some(false) => "NO",
+                None => "",
+            },
+            r.depth.map(|d| d.to_string()).unwrap_or_default(),
+            opt(r.seconds.map(|s| s * 1e3), 2),
+            opt(r.k_eligible, 2),
+            opt(r.k_candidates, 2),
+            r.note
+        );
+    }
+}
+
+/// A log–log chart of grouping time and k against the `x` of a sweep, with and without the
+/// split at `r`.
+pub fn sweep_chart(sweep: &[(f64, Row)], title: String, x_label: &str, r: f64) -> Scatter {
+    let series = |label: String, split: bool, f: fn(&Row) -> Option<f64>| Series {
+        label,
+        points: sweep
+            .iter()
+            .filter(|(_, row)| row.split_r.is_some() == split)
+            .filter_map(|(a, row)| Some((*a, f(row)?)))
+            .collect(),
+    };
+    Scatter {
+        title,
+        x_label: x_label.into(),
+        y_label: "grouping time (ms)  ·  k = eligible pairs per body".into(),
+        log_x: true,
+        log_y: true,
+        lines: true,
+        pareto: false,
+        series: vec![
+            series("time ms".into(), false, |r| Some(r.seconds? * 1e3)),
+            series(format!("time ms, split R = {r}"), true, |r| {
+                Some(r.seconds? * 1e3)
+            }),
+            series("k".into(), false, |r| r.k_eligible),
+            series(format!("k, split R = {r}"), true, |r| r.k_eligible),
+        ],
+    }
+}
