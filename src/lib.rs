@@ -7,6 +7,9 @@
 
 pub mod geom;
 pub mod grouping;
+pub mod metrics;
+pub mod peers;
+pub mod query;
 pub mod record;
 pub mod render;
 pub mod scene;

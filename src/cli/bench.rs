@@ -1,18 +1,46 @@
-//! `wraptree bench`: time the grouping phase on the standard scenes beside parry3d's binned
-//! BVH build measured in the same run, and (with `--record`) what recording costs.
+//! `wraptree bench`: every hierarchy builder × wrapper on given scenes (CSV, charts, `.rrd`),
+//! the targets table against obvhs PLOC and parry Binned measured in the same run, and (with
+//! `--record`) what recording costs.
 
-use anyhow::Result;
+use anyhow::{Context, Result, anyhow};
 use clap::Args;
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 use wraptree::grouping::{self, Params};
+use wraptree::metrics::{
+    self,
+    compare::{Options, Row, Wrapper, evaluate},
+    report::write_bench,
+};
+use wraptree::peers::{self, Method};
+use wraptree::query::{self, Bv, Workload};
 use wraptree::record::Detail;
-use wraptree::scene::{LoadOptions, Loaded, Scene, generate, load_bytes};
+use wraptree::scene::{LoadOptions, Loaded, Scene, generate, load_bytes, load_path};
 
 /// Arguments of `wraptree bench`.
 #[derive(Args, Debug)]
 pub struct BenchCmd {
-    /// Largest soup size to include (10^4, 10^5, 10^6 by default).
+    /// Scenes to compare every method × wrapper on: OBJ files, or generated scenes as
+    /// KIND[:COUNT] (soup:100000, robot-bases:44, lamps:5, robot-base, lamp). Without scenes:
+    /// the targets table on the standard scenes and the bundled meshes.
+    scenes: Vec<String>,
+    /// Output directory for results.csv, charts and bench.rrd (with SCENEs).
+    #[arg(short, long, default_value = "recordings/bench")]
+    output: PathBuf,
+    /// Replace existing result files.
+    #[arg(long)]
+    force: bool,
+    /// Hierarchy builders to compare (comma list) [default: all].
+    #[arg(long, value_delimiter = ',', value_parser = Method::parse)]
+    methods: Vec<Method>,
+    /// Wrappers to build on each hierarchy (comma list) [default: all].
+    #[arg(long, value_delimiter = ',', value_parser = Wrapper::parse)]
+    wrappers: Vec<Wrapper>,
+    /// Tightness is measured up to this many primitives (it costs more than the builds).
+    #[arg(long, default_value_t = 50_000)]
+    tightness_max_n: usize,
+    /// Largest soup size in the targets table (10^4, 10^5, 10^6 by default).
     #[arg(long, default_value_t = 1_000_000)]
     max_soup: usize,
     /// Timed repetitions per case (the best is reported).
@@ -34,25 +62,6 @@ fn best_of(repeat: u32, mut f: impl FnMut()) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-fn parry_binned(scene: &Scene) {
-    use parry3d::bounding_volume::Aabb;
-    let origin = scene.aabb().center();
-    let leaves: Vec<Aabb> = (0..scene.len())
-        .map(|i| {
-            let b = scene.prim_aabb(i);
-            Aabb::new(
-                wraptree::geom::to_glam_local(&b.min, &origin),
-                wraptree::geom::to_glam_local(&b.max, &origin),
-            )
-        })
-        .collect();
-    let bvh = parry3d::partitioning::Bvh::from_leaves(
-        parry3d::partitioning::BvhBuildStrategy::Binned,
-        &leaves,
-    );
-    std::hint::black_box(bvh);
-}
-
 /// A generated scene as if loaded from its OBJ (so recordings can embed it).
 fn as_loaded(scene: &Scene) -> Result<Loaded> {
     let mut bytes = Vec::new();
@@ -64,12 +73,88 @@ fn as_loaded(scene: &Scene) -> Result<Loaded> {
     )?)
 }
 
+/// Loads an OBJ path, or generates KIND[:COUNT] (COUNT = triangles for soup, copies for
+/// lamps/robot-bases).
+pub(super) fn scene_spec(spec: &str) -> Result<Scene> {
+    let path = std::path::Path::new(spec);
+    if path.exists() || spec.ends_with(".obj") {
+        let loaded = load_path(path, &LoadOptions::default())?;
+        for w in &loaded.warnings {
+            eprintln!("warning: {w}");
+        }
+        return Ok(loaded.scene);
+    }
+    let (kind, count) = match spec.split_once(':') {
+        Some((k, c)) => {
+            let c: usize = c
+                .parse()
+                .map_err(|_| anyhow!("{spec}: COUNT must be a whole number"))?;
+            (k, Some(c))
+        }
+        None => (spec, None),
+    };
+    let (copies, n) = if kind == "soup" {
+        (None, count)
+    } else {
+        (count, None)
+    };
+    let mut scene = generate::by_name(kind, copies, n, 1)
+        .map_err(|e| anyhow!("{spec}: not a file, and {e}"))?;
+    scene.name = spec.replace(':', "-");
+    Ok(scene)
+}
+
 impl BenchCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         if self.record {
             return self.run_record();
         }
+        if self.scenes.is_empty() {
+            return self.run_targets();
+        }
+        let scenes = self
+            .scenes
+            .iter()
+            .map(|s| scene_spec(s))
+            .collect::<Result<Vec<_>>>()?;
+        let opts = Options {
+            methods: if self.methods.is_empty() {
+                Method::ALL.to_vec()
+            } else {
+                self.methods.clone()
+            },
+            wrappers: if self.wrappers.is_empty() {
+                Wrapper::ALL.to_vec()
+            } else {
+                self.wrappers.clone()
+            },
+            repeat: self.repeat,
+            tightness_max_n: self.tightness_max_n,
+            ..Options::default()
+        };
+        std::fs::create_dir_all(&self.output)
+            .with_context(|| format!("{}: cannot create the directory", self.output.display()))?;
+        let mut rows = Vec::new();
+        for scene in &scenes {
+            let bar = method_bar(opts.methods.len(), &scene.name);
+            let r = evaluate(scene, &opts, |m| {
+                bar.set_message(m.name());
+                bar.inc(1);
+            })
+            .map_err(|e| anyhow!(e))?;
+            bar.finish_and_clear();
+            print_rows(&r);
+            rows.extend(r);
+        }
+        for p in write_bench(&self.output, &rows, self.force)? {
+            eprintln!("wrote {}", p.display());
+        }
+        Ok(ExitCode::SUCCESS)
+    }
+
+    /// The targets: grouping time against obvhs PLOC, SAH and query cost against parry Binned.
+    fn run_targets(&self) -> Result<ExitCode> {
         let mut cases: Vec<Scene> = vec![generate::soup(10_000, 1)];
         cases.push(generate::replicate(&generate::robot_base(), 44, 1));
         for n in [100_000, 1_000_000] {
@@ -77,15 +162,28 @@ impl BenchCmd {
                 cases.push(generate::soup(n, 1));
             }
         }
+        let bundled = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+        let mut meshes: Vec<_> = std::fs::read_dir(&bundled)
+            .map(|d| d.filter_map(|e| Some(e.ok()?.path())).collect())
+            .unwrap_or_default();
+        meshes.retain(|p: &PathBuf| p.extension().is_some_and(|e| e == "obj"));
+        meshes.sort();
+        for m in meshes {
+            let mut s = load_path(&m, &LoadOptions::default())?.scene;
+            s.name = m.file_stem().unwrap_or_default().to_string_lossy().into();
+            cases.push(s);
+        }
         println!(
-            "{:<18} {:>9} {:>10} {:>9} {:>11} {:>10} {:>8} {:>6} {:>9}",
+            "{:<18} {:>8} {:>9} {:>9} {:>7} {:>9} {:>7} {:>8} {:>8} {:>6} {:>8}",
             "scene",
             "N",
             "group ms",
-            "ns/prim",
-            "ns/NlogN",
-            "parry ms",
-            "ratio",
+            "PLOC ms",
+            "t/PLOC",
+            "binned ms",
+            "t/bin",
+            "SAH/bin",
+            "qry/bin",
             "depth",
             "peak MB"
         );
@@ -97,28 +195,42 @@ impl BenchCmd {
             } else {
                 self.repeat
             };
-            let mut depth = 0;
-            let t = best_of(repeat, || {
-                let g = grouping::group(scene, &params, ());
-                depth = g.tree.depth_max();
-            });
-            let tp = best_of(repeat, || parry_binned(scene));
-            let nlogn = n as f64 * (n as f64).log2();
+            let workload = Workload::standard(scene, 1);
+            let run = |m: Method| -> Result<(f64, f64, f64, u32)> {
+                let mut best: Option<peers::Built> = None;
+                for _ in 0..repeat.max(1) {
+                    let b = peers::build(m, scene, &params).map_err(|e| anyhow!(e))?;
+                    if best.as_ref().is_none_or(|x| b.seconds < x.seconds) {
+                        best = Some(b);
+                    }
+                }
+                let b = best.expect("ran at least once");
+                let q = query::measure(&b.tree, scene, Bv::Aabb, &workload);
+                let tests = wraptree::metrics::compare::query_values(&q)[6];
+                Ok((b.seconds, metrics::sah(&b.tree), tests, b.tree.depth_max()))
+            };
+            let (t, sah, qc, depth) = run(Method::Grouping)?;
+            let (tp, ..) = run(Method::ObvhsPloc)?;
+            let (tb, sah_b, qc_b, _) = run(Method::ParryBinned)?;
             println!(
-                "{:<18} {:>9} {:>10.2} {:>9.0} {:>11.2} {:>10.2} {:>8.2} {:>6} {:>9.0}",
+                "{:<18} {:>8} {:>9.2} {:>9.2} {:>7.2} {:>9.2} {:>7.2} {:>8.3} {:>8.3} {:>6} {:>8.0}",
                 scene.name,
                 n,
                 t * 1e3,
-                t * 1e9 / n as f64,
-                t * 1e9 / nlogn,
                 tp * 1e3,
                 t / tp,
+                tb * 1e3,
+                t / tb,
+                sah / sah_b,
+                qc / qc_b,
                 depth,
                 super::peak_rss_bytes().unwrap_or(0) as f64 / 1e6
             );
         }
+        println!("t/PLOC = grouping time / obvhs PLOC build time; t/bin = / parry3d Bvh Binned.");
+        println!("SAH/bin, qry/bin = SAH cost and node tests per query (AABB BVs, standard");
         println!(
-            "ratio = grouping time / parry3d Bvh (Binned) build time on the same AABBs, same run."
+            "workload) of the grouping tree / parry Binned's. Goal: t/PLOC <= 1 and qry/bin <= 1."
         );
         println!("peak MB = process peak RSS after the case (cases run in increasing size).");
         Ok(ExitCode::SUCCESS)
@@ -180,5 +292,47 @@ impl BenchCmd {
         );
         println!("ratio = record ms / group ms (recording overhead is ratio - 1).");
         Ok(ExitCode::SUCCESS)
+    }
+}
+
+/// A bar over methods on stderr, hidden when stderr is not a terminal.
+pub(super) fn method_bar(len: usize, scene: &str) -> indicatif::ProgressBar {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(len as u64);
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} {msg} {elapsed}")
+    {
+        bar.set_style(style);
+    }
+    bar.set_prefix(scene.to_string());
+    bar
+}
+
+/// Prints one scene's comparison rows.
+fn print_rows(rows: &[Row]) {
+    println!(
+        "{:<20} {:<19} {:>10} {:>10} {:>8} {:>5} {:>9} {:>10}",
+        "method", "wrapper", "build ms", "wrap ms", "SAH", "depth", "tight", "tests/qry"
+    );
+    for r in rows {
+        let tests = r
+            .query
+            .as_ref()
+            .map(|q| format!("{:.1}", metrics::compare::query_values(q)[6]))
+            .unwrap_or_default();
+        println!(
+            "{:<20} {:<19} {:>10.2} {:>10.2} {:>8.2} {:>5} {:>9} {:>10}",
+            r.method,
+            r.wrapper,
+            r.build_s * 1e3,
+            r.wrapper_s * 1e3,
+            r.quality.sah,
+            r.quality.depth_max,
+            r.tightness.map(|t| format!("{t:.4}")).unwrap_or_default(),
+            tests
+        );
     }
 }

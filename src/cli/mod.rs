@@ -7,6 +7,8 @@ mod record;
 mod replay;
 mod scene_cmd;
 mod snapshot;
+mod stress;
+mod sweep;
 mod wrap_cmd;
 
 use anyhow::Result;
@@ -36,14 +38,19 @@ enum Command {
     Replay(replay::ReplayCmd),
     /// Generate a seeded synthetic scene as Wavefront OBJ.
     Scene(scene_cmd::SceneCmd),
-    /// Time the grouping phase on the standard scenes (12,144-polygon robot bases, soups).
+    /// Compare every hierarchy builder × wrapper on scenes (CSV, charts, .rrd), or print the
+    /// targets table against obvhs PLOC and parry Binned.
     Bench(bench::BenchCmd),
+    /// Run the A/B/C grid of the grouping Cost on a scene: table, heat maps and one .rrd.
+    Sweep(sweep::SweepCmd),
     /// Render the input and chosen tree levels as PNG/SVG frames and a figure sheet.
     Snapshot(snapshot::SnapshotCmd),
     /// Build Wrapper Trees and print their per-level tightness and containment check.
     Wrap(wrap_cmd::WrapCmd),
     /// The fewest wrappers that model a scene within --tolerance, or the best --budget of them.
     Cover(cover::CoverCmd),
+    /// Every builder on pathological scenes (spaghetti, slabs, …) under a time budget.
+    Stress(stress::StressCmd),
 }
 
 /// How to read a scene file.
@@ -57,6 +64,10 @@ pub struct SceneArgs {
     /// With --polyhedra: a group whose vertices are not in convex position is an error.
     #[arg(long)]
     pub strict: bool,
+    /// Before grouping, cut polygons whose aspect (principal : secondary extent) exceeds R
+    /// into slabs of aspect ≤ R (§4); the split scene is what is grouped and recorded.
+    #[arg(long, value_name = "R")]
+    pub split_aspect: Option<f64>,
 }
 
 impl SceneArgs {
@@ -66,7 +77,21 @@ impl SceneArgs {
             polyhedra: self.polyhedra,
             strict: self.strict,
         };
-        let loaded = wraptree::scene::load_path(&self.scene, &opts)?;
+        let mut loaded = wraptree::scene::load_path(&self.scene, &opts)?;
+        if let Some(r) = self.split_aspect {
+            if r.is_nan() || r < wraptree::scene::split::MIN_ASPECT_LIMIT {
+                anyhow::bail!("--split-aspect must be a number ≥ 2, got {r}");
+            }
+            let n = loaded.scene.len();
+            let (split, st) = wraptree::scene::split::split_loaded(loaded, r)?;
+            loaded = split;
+            eprintln!(
+                "split-aspect {r}: split {} of {n} primitives into {} pieces ({n} → {} primitives)",
+                st.split,
+                st.pieces,
+                loaded.scene.len()
+            );
+        }
         for w in &loaded.warnings {
             eprintln!("warning: {w}");
         }
@@ -134,9 +159,11 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Replay(c) => c.run(),
         Command::Scene(c) => c.run(),
         Command::Bench(c) => c.run(),
+        Command::Sweep(c) => c.run(),
         Command::Snapshot(c) => c.run(),
         Command::Wrap(c) => c.run(),
         Command::Cover(c) => c.run(),
+        Command::Stress(c) => c.run(),
     }
 }
 

@@ -26,6 +26,12 @@ const PALETTE: [RGBColor; 10] = [
     RGBColor(23, 190, 207),
 ];
 
+/// The `k`-th series colour as RGB.
+pub fn color(k: usize) -> (u8, u8, u8) {
+    let c = PALETTE[k % PALETTE.len()];
+    (c.0, c.1, c.2)
+}
+
 /// One named set of points.
 #[derive(Clone, Debug, Default)]
 pub struct Series {
@@ -201,7 +207,8 @@ impl Scatter {
     }
 }
 
-/// A grid of values, one coloured cell each (low = light, high = dark).
+/// A grid of values, one coloured cell each (low = light, high = dark; on a log scale when the
+/// positive values span more than a decade).
 #[derive(Clone, Debug, Default)]
 pub struct HeatMap {
     /// Title above the grid.
@@ -238,6 +245,13 @@ impl HeatMap {
         let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
             (lo.min(v), hi.max(v))
         });
+        // Colour by log value when positive values span more than a decade.
+        let log = lo > 0.0 && hi / lo > 10.0;
+        let level = |v: f64| match (hi > lo, log) {
+            (false, _) => 0.5,
+            (true, true) => (v / lo).ln() / (hi / lo).ln(),
+            (true, false) => (v - lo) / (hi - lo),
+        };
         let mut buf = String::new();
         {
             let root = SVGBackend::with_string(&mut buf, (width, height)).into_drawing_area();
@@ -275,7 +289,7 @@ impl HeatMap {
                 let y0 = (rows - 1 - r) as f64;
                 for (c, &v) in row.iter().enumerate() {
                     let fill = if v.is_finite() {
-                        shade(if hi > lo { (v - lo) / (hi - lo) } else { 0.5 })
+                        shade(level(v))
                     } else {
                         RGBColor(200, 200, 200)
                     };
@@ -283,7 +297,7 @@ impl HeatMap {
                     chart
                         .draw_series([Rectangle::new(cell, fill.filled())])
                         .map_err(err)?;
-                    let text_colour = if v.is_finite() && hi > lo && (v - lo) / (hi - lo) > 0.55 {
+                    let text_colour = if v.is_finite() && level(v) > 0.55 {
                         WHITE
                     } else {
                         BLACK

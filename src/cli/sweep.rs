@@ -1,0 +1,92 @@
+//! `wraptree sweep`: the A/B/C grid of the grouping phase's Cost on one scene, as a table,
+//! `sweep.csv`, heat maps and one `.rrd` with every setting side by side.
+
+use anyhow::{Context, Result, anyhow};
+use clap::Args;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use wraptree::grouping::{PSet, Params};
+use wraptree::metrics::compare::query_values;
+use wraptree::metrics::report::{SweepRrd, setting_name, write_sweep};
+use wraptree::metrics::sweep::{grid, sweep};
+
+/// Arguments of `wraptree sweep`.
+#[derive(Args, Debug)]
+pub struct SweepCmd {
+    /// OBJ file, or a generated scene as KIND[:COUNT] (see `bench`).
+    scene: String,
+    /// Values of the diameter exponent A (comma list).
+    #[arg(long, value_delimiter = ',', default_values_t = [0.0, 1.0, 2.0], allow_negative_numbers = true)]
+    a: Vec<f64>,
+    /// Values of the Fill weight B (comma list).
+    #[arg(long, value_delimiter = ',', default_values_t = [0.0, 1.0], allow_negative_numbers = true)]
+    b: Vec<f64>,
+    /// Values of the Balance weight C (comma list).
+    #[arg(long, value_delimiter = ',', default_values_t = [0.0, 1.0], allow_negative_numbers = true)]
+    c: Vec<f64>,
+    /// P-set wrapper for every setting.
+    #[arg(long, value_enum, default_value_t = PSet::Aabb)]
+    pset: PSet,
+    /// Output directory [default: recordings/sweep-<scene>].
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Replace existing result files.
+    #[arg(long)]
+    force: bool,
+    /// Timed repetitions per setting (the best is reported).
+    #[arg(long, default_value_t = 3)]
+    repeat: u32,
+}
+
+impl SweepCmd {
+    /// Runs the command.
+    pub fn run(self) -> Result<ExitCode> {
+        let scene = super::bench::scene_spec(&self.scene)?;
+        let settings = grid(&self.a, &self.b, &self.c);
+        for w in &settings {
+            w.check().map_err(|e| anyhow!("--{e}"))?;
+        }
+        let dir = self
+            .output
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(format!("recordings/sweep-{}", scene.name)));
+        std::fs::create_dir_all(&dir)
+            .with_context(|| format!("{}: cannot create the directory", dir.display()))?;
+        let rrd = SweepRrd::create(&dir.join("sweep.rrd"), &settings, self.force)?;
+        let base = Params {
+            pset: self.pset,
+            ..Params::default()
+        };
+        let bar = super::bench::method_bar(settings.len(), &scene.name);
+        let rows = sweep(&scene, &settings, &base, self.repeat, 1, |_, w, merges| {
+            bar.set_message(setting_name(w));
+            bar.inc(1);
+            rrd.setting(w, merges)
+        })?;
+        bar.finish_and_clear();
+        println!(
+            "{:>6} {:>6} {:>6} {:>10} {:>7} {:>6} {:>9} {:>9} {:>10}",
+            "A", "B", "C", "group ms", "rounds", "depth", "SAH", "balance", "tests/qry"
+        );
+        for r in &rows {
+            println!(
+                "{:>6} {:>6} {:>6} {:>10.2} {:>7} {:>6} {:>9.3} {:>9.3} {:>10.1}",
+                r.weights.a,
+                r.weights.b,
+                r.weights.c,
+                r.build_s * 1e3,
+                r.rounds,
+                r.quality.depth_max,
+                r.quality.sah,
+                r.quality.structural_balance,
+                query_values(&r.query)[6]
+            );
+        }
+        let mut written = write_sweep(&dir, &scene.name, &rows, self.force)?;
+        written.push(rrd.finish(&rows)?);
+        for p in written {
+            eprintln!("wrote {}", p.display());
+        }
+        Ok(ExitCode::SUCCESS)
+    }
+}

@@ -1,0 +1,122 @@
+//! Quality of a hierarchy, whatever built it: the surface-area heuristic, depth and balance.
+//!
+//! - SAH cost (MacDonald and Booth, 1990) with traversal cost [`C_TRAV`] = 1 per interior node
+//!   and intersection cost [`C_PRIM`] = 1 per primitive, each weighted by the probability
+//!   `area(node) / area(root)` that a random ray through the root box hits the node box:
+//!   `SAH = (C_TRAV · Σ_interior A(n) + C_PRIM · Σ_leaves A(l)) / A(root)`. The leaf term is the
+//!   same for every hierarchy over a scene; differences come from the interior nodes. A scene
+//!   whose root box has no area (all primitives in one point) gets SAH = number of nodes.
+//! - Structural balance: mean over interior nodes of `min(|L|, |R|) / max(|L|, |R|)` in leaves
+//!   (1 = perfectly balanced, → 0 = a chain).
+//! - Spatial balance: mean over interior nodes of the sibling box-volume ratio
+//!   `min(V_L, V_R) / max(V_L, V_R)`; a pair of zero-volume (flat) siblings counts as 1.
+//! - Depth: largest and mean leaf depth.
+//!
+//! Wrapper tightness per level comes from [`crate::wrap::level_tightness`]. [`compare`] runs
+//! every hierarchy builder × wrapper on a scene, [`sweep`] the A/B/C grid of the grouping
+//! phase, and [`report`] writes their CSV, charts and `.rrd`.
+
+pub mod compare;
+pub mod report;
+pub mod sweep;
+
+use crate::geom::Aabb;
+use crate::grouping::SubsetTree;
+
+/// SAH cost of visiting an interior node.
+pub const C_TRAV: f64 = 1.0;
+/// SAH cost of testing a primitive.
+pub const C_PRIM: f64 = 1.0;
+
+/// Surface area of a box (0 for an empty one).
+pub fn area(b: &Aabb) -> f64 {
+    let e = b.extents();
+    if e.iter().any(|x| x.is_nan() || *x < 0.0) {
+        return 0.0;
+    }
+    2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+}
+
+/// Quality measures of one hierarchy.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Quality {
+    /// SAH cost (see the module doc for the constants).
+    pub sah: f64,
+    /// Largest leaf depth.
+    pub depth_max: u32,
+    /// Mean leaf depth.
+    pub depth_mean: f64,
+    /// Mean leaf-count ratio of siblings.
+    pub structural_balance: f64,
+    /// Mean box-volume ratio of siblings.
+    pub spatial_balance: f64,
+}
+
+/// SAH cost of `tree`.
+pub fn sah(tree: &SubsetTree) -> f64 {
+    let n = tree.leaves();
+    let root = area(&tree.aabb[tree.root() as usize]);
+    if root.is_nan() || root <= 0.0 {
+        return tree.len() as f64;
+    }
+    let leaves: f64 = tree.aabb[..n].iter().map(area).sum();
+    let interior: f64 = tree.aabb[n..].iter().map(area).sum();
+    (C_TRAV * interior + C_PRIM * leaves) / root
+}
+
+/// Every quality measure of `tree`.
+pub fn quality(tree: &SubsetTree) -> Quality {
+    let n = tree.leaves();
+    let mut count = vec![1u32; tree.len()];
+    let (mut structural, mut spatial) = (0.0, 0.0);
+    for (i, &[a, b]) in tree.children.iter().enumerate() {
+        let (ca, cb) = (count[a as usize], count[b as usize]);
+        count[n + i] = ca + cb;
+        structural += ca.min(cb) as f64 / ca.max(cb) as f64;
+        let (va, vb) = (
+            tree.aabb[a as usize].volume(),
+            tree.aabb[b as usize].volume(),
+        );
+        spatial += if va.max(vb) > 0.0 {
+            va.min(vb) / va.max(vb)
+        } else {
+            1.0
+        };
+    }
+    let interior = tree.children.len().max(1) as f64;
+    let single = tree.children.is_empty();
+    Quality {
+        sah: sah(tree),
+        depth_max: tree.depth_max(),
+        depth_mean: tree.depth_mean(),
+        structural_balance: if single { 1.0 } else { structural / interior },
+        spatial_balance: if single { 1.0 } else { spatial / interior },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::P3;
+
+    fn unit(x: f64) -> Aabb {
+        Aabb::from_points(&[P3::new(x, 0.0, 0.0), P3::new(x + 1.0, 1.0, 1.0)])
+    }
+
+    #[test]
+    fn hand_computed_sah_and_balance() {
+        // Leaves at x = 0, 1, 3; ((0, 1), 2).
+        let b01 = unit(0.0).merge(&unit(1.0));
+        let root = b01.merge(&unit(3.0));
+        let aabb = vec![unit(0.0), unit(1.0), unit(3.0), b01, root];
+        let diameter = aabb.iter().map(Aabb::diameter).collect();
+        let t = SubsetTree::new(aabb, diameter, vec![[0, 1], [2, 3]]).unwrap();
+        let q = quality(&t);
+        // Areas: leaves 6 each, b01 = 2·(2+1+2) = 10, root = 2·(4+1+4) = 18.
+        assert!((q.sah - (10.0 + 18.0 + 18.0) / 18.0).abs() < 1e-12);
+        assert!((q.structural_balance - (1.0 + 0.5) / 2.0).abs() < 1e-12);
+        assert!((q.spatial_balance - (1.0 + 0.5) / 2.0).abs() < 1e-12);
+        assert_eq!(q.depth_max, 2);
+        assert!((q.depth_mean - 5.0 / 3.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,203 @@
+//! Our grouping phase beside its peers, on the same primitives, each as a [`SubsetTree`] so
+//! that quality ([`crate::metrics`]), Wrapper Trees ([`crate::wrap`]) and queries
+//! ([`crate::query`]) measure every hierarchy the same way.
+//!
+//! - [`Method::Grouping`], [`Method::GroupingHull`]: the paper's grouping phase (§2.2) with AABB
+//!   or convex-hull p-sets;
+//! - [`parry_bvh`]: parry3d's `Bvh`, binned SAH or PLOC, as published;
+//! - [`obvhs_ploc`]: obvhs's PLOC, with or without its reinsertion optimiser, as published;
+//! - [`median_split`]: a top-down median split;
+//! - [`goldsmith_salmon`]: Goldsmith–Salmon incremental insertion.
+//!
+//! A peer's reported time covers its own build only, from primitive boxes (`f32` relative to the
+//! scene centre for parry and obvhs, `f64` for ours) to its native tree; reading its topology
+//! into a Subset Tree ([`topology`]) is not timed. Box computation per primitive is shared and
+//! not timed either. Every method is single-threaded.
+
+pub mod goldsmith_salmon;
+pub mod median_split;
+pub mod obvhs_ploc;
+pub mod parry_bvh;
+pub mod topology;
+
+use crate::grouping::{self, PSet, Params, Stats, SubsetTree};
+use crate::scene::Scene;
+use parry3d::partitioning::BvhBuildStrategy;
+use std::time::Instant;
+
+/// A hierarchy builder.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+pub enum Method {
+    /// The grouping phase with AABB p-sets and the given parameters.
+    Grouping,
+    /// The grouping phase with convex-hull p-sets.
+    GroupingHull,
+    /// parry3d `Bvh`, binned SAH strategy.
+    ParryBinned,
+    /// parry3d `Bvh`, PLOC strategy.
+    ParryPloc,
+    /// obvhs PLOC.
+    ObvhsPloc,
+    /// obvhs PLOC followed by reinsertion.
+    ObvhsPlocReinsert,
+    /// Top-down median split.
+    MedianSplit,
+    /// Goldsmith–Salmon incremental insertion.
+    GoldsmithSalmon,
+}
+
+impl Method {
+    /// Every method, ours first.
+    pub const ALL: [Method; 8] = [
+        Method::Grouping,
+        Method::GroupingHull,
+        Method::ParryBinned,
+        Method::ParryPloc,
+        Method::ObvhsPloc,
+        Method::ObvhsPlocReinsert,
+        Method::MedianSplit,
+        Method::GoldsmithSalmon,
+    ];
+
+    /// Short name used in tables, CSV and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Grouping => "grouping",
+            Method::GroupingHull => "grouping-hull",
+            Method::ParryBinned => "parry-binned",
+            Method::ParryPloc => "parry-ploc",
+            Method::ObvhsPloc => "obvhs-ploc",
+            Method::ObvhsPlocReinsert => "obvhs-ploc-reinsert",
+            Method::MedianSplit => "median-split",
+            Method::GoldsmithSalmon => "goldsmith-salmon",
+        }
+    }
+
+    /// Parses a name as printed by [`Method::name`].
+    pub fn parse(s: &str) -> Result<Method, String> {
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == s.trim())
+            .ok_or_else(|| {
+                let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+                format!("unknown method '{s}' (valid: {})", names.join(", "))
+            })
+    }
+
+    /// Whether this is the paper's grouping phase.
+    pub fn is_grouping(self) -> bool {
+        matches!(self, Method::Grouping | Method::GroupingHull)
+    }
+}
+
+/// A built hierarchy.
+#[derive(Clone, Debug)]
+pub struct Built {
+    /// The method.
+    pub method: Method,
+    /// The hierarchy as a Subset Tree (boxes recomputed in `f64`).
+    pub tree: SubsetTree,
+    /// Build time in seconds (see the module doc for what is timed).
+    pub seconds: f64,
+    /// Grouping work counters (grouping methods only).
+    pub stats: Option<Stats>,
+}
+
+/// Builds `method`'s hierarchy over `scene`; `params` is used by the grouping methods (the hull
+/// variant overrides the p-set). Fails only if a peer's tree is malformed (a bug).
+pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, String> {
+    let t = Instant::now();
+    let done = |tree: SubsetTree, stats: Option<Stats>, seconds: f64| Built {
+        method,
+        tree,
+        seconds,
+        stats,
+    };
+    if method.is_grouping() {
+        let p = Params {
+            pset: if method == Method::GroupingHull {
+                PSet::Hull
+            } else {
+                params.pset
+            },
+            ..params.clone()
+        };
+        let g = grouping::group(scene, &p, ());
+        let seconds = t.elapsed().as_secs_f64();
+        return Ok(done(g.tree, Some(g.stats), seconds));
+    }
+    let (nodes, root, seconds) = match method {
+        Method::ParryBinned | Method::ParryPloc => {
+            let boxes = topology::local_boxes(scene);
+            let strategy = if method == Method::ParryBinned {
+                BvhBuildStrategy::Binned
+            } else {
+                BvhBuildStrategy::Ploc
+            };
+            let t = Instant::now();
+            let bvh = parry_bvh::build(&boxes, strategy);
+            let s = t.elapsed().as_secs_f64();
+            let (nodes, root) = parry_bvh::topology(&bvh);
+            (nodes, root, s)
+        }
+        Method::ObvhsPloc | Method::ObvhsPlocReinsert => {
+            let boxes = topology::local_boxes(scene);
+            let t = Instant::now();
+            let bvh = obvhs_ploc::build(&boxes, method == Method::ObvhsPlocReinsert);
+            let s = t.elapsed().as_secs_f64();
+            let (nodes, root) = obvhs_ploc::topology(&bvh);
+            (nodes, root, s)
+        }
+        Method::MedianSplit => {
+            let centres: Vec<_> = (0..scene.len())
+                .map(|i| scene.prim_aabb(i).center())
+                .collect();
+            let t = Instant::now();
+            let (nodes, root) = median_split::build(&centres);
+            (nodes, root, t.elapsed().as_secs_f64())
+        }
+        Method::GoldsmithSalmon => {
+            let boxes: Vec<_> = (0..scene.len()).map(|i| scene.prim_aabb(i)).collect();
+            let t = Instant::now();
+            let (nodes, root) = goldsmith_salmon::build(&boxes);
+            (nodes, root, t.elapsed().as_secs_f64())
+        }
+        Method::Grouping | Method::GroupingHull => unreachable!("handled above"),
+    };
+    let tree = topology::subset_tree(scene, &nodes, root)
+        .map_err(|e| format!("{}: malformed tree: {e}", method.name()))?;
+    Ok(done(tree, None, seconds))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::generate;
+
+    #[test]
+    fn every_method_builds_a_valid_tree() {
+        for scene in [
+            generate::soup(1, 3),
+            generate::soup(2, 3),
+            generate::robot_base(),
+        ] {
+            for m in Method::ALL {
+                let b = build(m, &scene, &Params::default()).unwrap();
+                let t = &b.tree;
+                assert_eq!(t.leaves(), scene.len(), "{}", m.name());
+                for (i, &[a, c]) in t.children.iter().enumerate() {
+                    let x = t.leaves() + i;
+                    assert!(t.aabb[x].contains_aabb(&t.aabb[a as usize], 0.0));
+                    assert!(t.aabb[x].contains_aabb(&t.aabb[c as usize], 0.0));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn median_split_depth_is_logarithmic() {
+        let scene = generate::soup(1000, 2);
+        let b = build(Method::MedianSplit, &scene, &Params::default()).unwrap();
+        assert_eq!(b.tree.depth_max(), 10);
+    }
+}

@@ -1,0 +1,100 @@
+//! Scene–scene queries over the bounding-volume test tree (BVTT): the pairs (node of `a`,
+//! node of `b`) reached from the root pair by splitting one side at a time.
+
+use super::prim::prim_prim;
+use super::{Counts, Entry, Hierarchy, pair_bound};
+use std::collections::BinaryHeap;
+
+/// The child pairs of the BVTT node `(x, y)`: split the side that is not a leaf, or when
+/// both are interior the one with the larger BV (ties: `a`). `None` when both are leaves.
+fn split(a: &Hierarchy, x: u32, b: &Hierarchy, y: u32) -> Option<[(u32, u32); 2]> {
+    match (a.tree.children_of(x), b.tree.children_of(y)) {
+        (None, None) => None,
+        (Some([c, d]), None) => Some([(c, y), (d, y)]),
+        (None, Some([c, d])) => Some([(x, c), (x, d)]),
+        (Some([c, d]), Some([e, f])) => Some(if a.size(x) >= b.size(y) {
+            [(c, y), (d, y)]
+        } else {
+            [(x, e), (x, f)]
+        }),
+    }
+}
+
+/// Distance between the primitive surfaces of `a` and `b` (0 when they touch).
+///
+/// Best-first branch and bound over the BVTT: node pairs are expanded smallest bound first
+/// (ties: deeper pair first) and pruned when their bound reaches the best primitive distance
+/// found. Each pair bound evaluated is one BV test (the root pair included), each leaf pair
+/// reached one primitive test.
+pub fn scene_distance(a: &Hierarchy, b: &Hierarchy, counts: &mut Counts) -> f64 {
+    let slack = a.slack() + b.slack();
+    let (ra, rb) = (a.tree.root(), b.tree.root());
+    let mut heap = BinaryHeap::new();
+    let mut best = f64::INFINITY;
+    counts.bv_tests += 1;
+    heap.push(Entry {
+        bound: pair_bound(a, ra, b, rb) - slack,
+        depth: 0,
+        a: ra,
+        b: rb,
+    });
+    while let Some(e) = heap.pop() {
+        if e.bound >= best {
+            break;
+        }
+        match split(a, e.a, b, e.b) {
+            None => {
+                counts.prim_tests += 1;
+                best = best.min(prim_prim(a.scene, e.a as usize, b.scene, e.b as usize));
+            }
+            Some(pairs) => {
+                for (x, y) in pairs {
+                    counts.bv_tests += 1;
+                    let bound = pair_bound(a, x, b, y) - slack;
+                    if bound < best {
+                        heap.push(Entry {
+                            bound,
+                            depth: e.depth + 1,
+                            a: x,
+                            b: y,
+                        });
+                    }
+                }
+            }
+        }
+    }
+    best
+}
+
+/// Whether some primitive of `a` touches some primitive of `b` (their distance is 0).
+///
+/// Depth-first over the BVTT, skipping pairs whose BVs are apart (bound above 0 after slack),
+/// and returning at the first touching primitive pair. Counted as in [`scene_distance`].
+pub fn overlap(a: &Hierarchy, b: &Hierarchy, counts: &mut Counts) -> bool {
+    let slack = a.slack() + b.slack();
+    let (ra, rb) = (a.tree.root(), b.tree.root());
+    counts.bv_tests += 1;
+    if pair_bound(a, ra, b, rb) - slack > 0.0 {
+        return false;
+    }
+    let mut stack = vec![(ra, rb)];
+    while let Some((x, y)) = stack.pop() {
+        match split(a, x, b, y) {
+            None => {
+                counts.prim_tests += 1;
+                if prim_prim(a.scene, x as usize, b.scene, y as usize) == 0.0 {
+                    return true;
+                }
+            }
+            Some(pairs) => {
+                for (c, d) in pairs.into_iter().rev() {
+                    counts.bv_tests += 1;
+                    if pair_bound(a, c, b, d) - slack <= 0.0 {
+                        stack.push((c, d));
+                    }
+                }
+            }
+        }
+    }
+    false
+}

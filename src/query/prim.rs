@@ -1,0 +1,92 @@
+//! Primitive tests: exact `f64` distances between two primitives' surfaces (each primitive's
+//! triangles, or its polygon edges when it has none). Point–primitive distances are
+//! [`crate::wrap::distance::point_prim`].
+
+use crate::geom::P3;
+use crate::geom::distance::{segment_segment, segment_triangle, triangle_triangle};
+use crate::scene::Scene;
+
+/// The surface pieces of one primitive.
+enum Surface<'a> {
+    /// Triangles (vertex indices).
+    Tris(&'a [[u32; 3]]),
+    /// The closed polygon through these vertex indices, as segments.
+    Edges(&'a [u32]),
+}
+
+impl Surface<'_> {
+    fn of(scene: &Scene, i: usize) -> Surface<'_> {
+        let tris = scene.prim_tris(i);
+        if tris.is_empty() {
+            Surface::Edges(scene.prim(i))
+        } else {
+            Surface::Tris(tris)
+        }
+    }
+}
+
+/// The `k`-th edge of the closed polygon `v` (a point when `v` has one vertex).
+fn edge<'a>(scene: &'a Scene, v: &[u32], k: usize) -> (&'a P3, &'a P3) {
+    let pt = |i: u32| &scene.points[i as usize];
+    (pt(v[k]), pt(v[(k + 1) % v.len()]))
+}
+
+/// The corners of triangle `t` of `s`.
+fn tri<'a>(s: &'a Scene, t: &[u32; 3]) -> [&'a P3; 3] {
+    [
+        &s.points[t[0] as usize],
+        &s.points[t[1] as usize],
+        &s.points[t[2] as usize],
+    ]
+}
+
+/// Exact distance between primitive `i` of `a` and primitive `j` of `b` (their surfaces);
+/// stops at the first piece pair at distance 0. A primitive with neither triangles nor
+/// vertices is infinitely far.
+pub fn prim_prim(a: &Scene, i: usize, b: &Scene, j: usize) -> f64 {
+    let mut best = f64::INFINITY;
+    match (Surface::of(a, i), Surface::of(b, j)) {
+        (Surface::Tris(t), Surface::Tris(u)) => {
+            for x in t {
+                let tx = tri(a, x);
+                for y in u {
+                    best = best.min(triangle_triangle(tx, tri(b, y)));
+                    if best == 0.0 {
+                        return 0.0;
+                    }
+                }
+            }
+        }
+        (Surface::Tris(t), Surface::Edges(v)) => return tris_edges(a, t, b, v),
+        (Surface::Edges(v), Surface::Tris(t)) => return tris_edges(b, t, a, v),
+        (Surface::Edges(v), Surface::Edges(w)) => {
+            for k in 0..v.len() {
+                let (p, q) = edge(a, v, k);
+                for m in 0..w.len() {
+                    let (r, s) = edge(b, w, m);
+                    best = best.min(segment_segment(p, q, r, s));
+                    if best == 0.0 {
+                        return 0.0;
+                    }
+                }
+            }
+        }
+    }
+    best
+}
+
+/// Distance between triangles `t` of scene `a` and the polygon edges `v` of scene `b`.
+fn tris_edges(a: &Scene, t: &[[u32; 3]], b: &Scene, v: &[u32]) -> f64 {
+    let mut best = f64::INFINITY;
+    for x in t {
+        let [p0, p1, p2] = x.map(|k| &a.points[k as usize]);
+        for k in 0..v.len() {
+            let (p, q) = edge(b, v, k);
+            best = best.min(segment_triangle(p, q, p0, p1, p2));
+            if best == 0.0 {
+                return 0.0;
+            }
+        }
+    }
+    best
+}

@@ -1,0 +1,204 @@
+//! A seeded standard query workload for one scene and its mean cost per query (eq. (1)).
+//!
+//! [`Workload::standard`] draws, with a ChaCha8 RNG seeded by `seed`:
+//! - 256 query **points** uniform in the scene's AABB scaled by 1.1 about its centre (each
+//!   half-extent at least 5% of the diagonal, so flat scenes get a slab), so about a quarter
+//!   fall outside the box;
+//! - 8 **near** poses of a copy of the scene: a uniform random rotation about the box centre,
+//!   then a translation along a uniform random direction `u` until a slab of width `gap`
+//!   perpendicular to `u` separates the vertices of the copy from the original's, with `gap`
+//!   uniform in [2%, 30%] of the diagonal. The surfaces lie within their vertices' hull, so the
+//!   scene–copy distance is at least `gap` (> 0), and near it;
+//! - 8 **touching** poses: a uniform random rotation, then the translation that puts the
+//!   centroid of a random triangle of the copy on the centroid of a random triangle of the
+//!   original (a random vertex when the scene has no triangles). The two triangles then cross
+//!   there, so the copy overlaps the original partially.
+//!
+//! [`measure`] runs all 256 point queries, a scene–copy distance query per near pose, and an
+//! overlap query per near and per touching pose (8 answers false, 8 true); moving the copies is
+//! not timed.
+
+use super::{Bv, Counts, Hierarchy, moved, moved_spheres, overlap, point_distance, scene_distance};
+use crate::geom::{P3, V3};
+use crate::grouping::SubsetTree;
+use crate::scene::Scene;
+use crate::scene::generate::random_rotation;
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::time::Instant;
+
+/// Cost of one BV test in eq. (1) as [`measure`] reports it.
+pub const C_V: f64 = 1.0;
+/// Cost of one primitive test in eq. (1) as [`measure`] reports it.
+pub const C_P: f64 = 1.0;
+
+/// Query points and poses of a copy of the scene (see the module doc).
+#[derive(Clone, Debug)]
+pub struct Workload {
+    /// Points for point–scene distance queries.
+    pub points: Vec<P3>,
+    /// Poses (copy vertex `q` ↦ `pose * q`) whose copy is apart from the scene.
+    pub poses_near: Vec<Isometry3<f64>>,
+    /// Poses whose copy overlaps the scene partially.
+    pub poses_touching: Vec<Isometry3<f64>>,
+}
+
+/// A uniform random unit vector.
+fn random_direction(rng: &mut ChaCha8Rng) -> V3 {
+    let (u, v): (f64, f64) = (rng.random(), rng.random());
+    let z = 2.0 * u - 1.0;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = std::f64::consts::TAU * v;
+    V3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// The pose `q ↦ to + rot · (q − from)`.
+fn pose_about(rot: UnitQuaternion<f64>, from: &P3, to: &P3) -> Isometry3<f64> {
+    Isometry3::from_parts(Translation3::from(to.coords - rot * from.coords), rot)
+}
+
+impl Workload {
+    /// The standard workload for `scene` (see the module doc); the same seed gives the same
+    /// workload. Panics if the scene is empty.
+    pub fn standard(scene: &Scene, seed: u64) -> Workload {
+        assert!(!scene.is_empty(), "the workload needs a non-empty scene");
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let bbox = scene.aabb();
+        let (c, diag) = (bbox.center(), bbox.diameter());
+        let half = (bbox.extents() * 0.55).map(|h| h.max(0.05 * diag));
+        let points = (0..256)
+            .map(|_| {
+                let u: [f64; 3] = rng.random();
+                c + V3::from(u.map(|x| 2.0 * x - 1.0)).component_mul(&half)
+            })
+            .collect();
+        let poses_near = (0..8)
+            .map(|_| {
+                let rot = random_rotation(&mut rng);
+                let u = random_direction(&mut rng);
+                let gap = diag * rng.random_range(0.02..=0.30);
+                let top = scene.points.iter().map(|p| u.dot(&p.coords));
+                let top = top.fold(f64::NEG_INFINITY, f64::max);
+                let low = scene.points.iter().map(|q| u.dot(&(rot * (q - c))));
+                let low = low.fold(f64::INFINITY, f64::min);
+                pose_about(rot, &c, &(c + u * (top - u.dot(&c.coords) - low + gap)))
+            })
+            .collect();
+        let anchor = |rng: &mut ChaCha8Rng| -> P3 {
+            if scene.tris.is_empty() {
+                scene.points[rng.random_range(0..scene.points.len())]
+            } else {
+                let t = scene.tris[rng.random_range(0..scene.tris.len())];
+                let [a, b, d] = t.map(|k| scene.points[k as usize].coords);
+                P3::from((a + b + d) / 3.0)
+            }
+        };
+        let poses_touching = (0..8)
+            .map(|_| {
+                let rot = random_rotation(&mut rng);
+                let (to, from) = (anchor(&mut rng), anchor(&mut rng));
+                pose_about(rot, &from, &to)
+            })
+            .collect();
+        Workload {
+            points,
+            poses_near,
+            poses_touching,
+        }
+    }
+}
+
+/// Mean work per query of one kind.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct MeanCost {
+    /// Number of queries.
+    pub queries: usize,
+    /// Mean BV tests per query (`N_v`).
+    pub bv_tests: f64,
+    /// Mean primitive tests per query (`N_p`).
+    pub prim_tests: f64,
+    /// Eq. (1) per query: `N_v·C_V + N_p·C_P` (with `C_V = C_P = 1`).
+    pub cost: f64,
+    /// Wall seconds for all queries of this kind.
+    pub seconds: f64,
+}
+
+impl MeanCost {
+    fn new(total: &Counts, queries: usize, seconds: f64) -> MeanCost {
+        let (bv_tests, prim_tests) = total.per_query(queries);
+        MeanCost {
+            queries,
+            bv_tests,
+            prim_tests,
+            cost: bv_tests * C_V + prim_tests * C_P,
+            seconds,
+        }
+    }
+}
+
+/// The cost of a [`Workload`] on one hierarchy.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct QueryCost {
+    /// Point–scene distance queries (one per workload point).
+    pub point: MeanCost,
+    /// Scene–copy distance queries (one per near pose).
+    pub distance: MeanCost,
+    /// Scene–copy overlap queries (one per near and per touching pose).
+    pub overlap: MeanCost,
+    /// How many overlap queries answered true.
+    pub overlapping: usize,
+    /// Wall seconds of all queries (moving the copies excluded).
+    pub seconds: f64,
+}
+
+/// Runs the whole workload on `tree` over `scene` with `bv` (sphere BVs are moved with each
+/// copy by [`moved_spheres`]).
+pub fn measure(tree: &SubsetTree, scene: &Scene, bv: Bv, workload: &Workload) -> QueryCost {
+    let h = Hierarchy { tree, scene, bv };
+    let mut counts = Counts::default();
+    let start = Instant::now();
+    for p in &workload.points {
+        point_distance(&h, p, &mut counts);
+    }
+    let point = MeanCost::new(
+        &counts,
+        workload.points.len(),
+        start.elapsed().as_secs_f64(),
+    );
+    let (mut dist, mut over) = (Counts::default(), Counts::default());
+    let (mut dist_s, mut over_s, mut overlapping) = (0.0, 0.0, 0);
+    let near = workload.poses_near.iter().map(|p| (p, true));
+    for (pose, is_near) in near.chain(workload.poses_touching.iter().map(|p| (p, false))) {
+        let (t, s) = moved(tree, scene, pose);
+        let spheres = match bv {
+            Bv::Aabb => Vec::new(),
+            Bv::Sphere(sp) => moved_spheres(sp, pose),
+        };
+        let bv2 = match bv {
+            Bv::Aabb => Bv::Aabb,
+            Bv::Sphere(_) => Bv::Sphere(&spheres),
+        };
+        let copy = Hierarchy {
+            tree: &t,
+            scene: &s,
+            bv: bv2,
+        };
+        if is_near {
+            let start = Instant::now();
+            scene_distance(&h, &copy, &mut dist);
+            dist_s += start.elapsed().as_secs_f64();
+        }
+        let start = Instant::now();
+        overlapping += overlap(&h, &copy, &mut over) as usize;
+        over_s += start.elapsed().as_secs_f64();
+    }
+    let n_pose = workload.poses_near.len() + workload.poses_touching.len();
+    QueryCost {
+        point,
+        distance: MeanCost::new(&dist, workload.poses_near.len(), dist_s),
+        overlap: MeanCost::new(&over, n_pose, over_s),
+        overlapping,
+        seconds: point.seconds + dist_s + over_s,
+    }
+}

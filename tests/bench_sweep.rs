@@ -1,0 +1,192 @@
+//! `bench SCENE… -o DIR` and `sweep`: the CSV has one row per method × wrapper (or setting), the
+//! charts are real PNGs, and the `.rrd` passes `rerun rrd verify` with the expected entities
+//! (PyPI `rerun-sdk==0.36.3`, installed by `.ci/run`; a missing tool fails the test).
+
+mod common;
+
+use std::collections::BTreeSet;
+use std::path::Path;
+use std::process::Command;
+
+use wraptree::metrics::{compare, quality};
+use wraptree::peers::{Method, build};
+
+/// Entity paths of the first recording in `argv[1]`.
+const ENTITIES: &str = r#"
+import json, sys
+from rerun.experimental import RrdReader
+r = RrdReader(sys.argv[1])
+print(json.dumps(sorted({c.entity_path for c in r.stream()})))
+"#;
+
+fn entities(path: &Path) -> BTreeSet<String> {
+    let verify = Command::new("rerun")
+        .args(["rrd", "verify"])
+        .arg(path)
+        .output()
+        .expect("the rerun CLI (pip install rerun-sdk==0.36.3) must be on PATH");
+    assert!(
+        verify.status.success(),
+        "rerun rrd verify {}: {}",
+        path.display(),
+        String::from_utf8_lossy(&verify.stderr)
+    );
+    let out = Command::new("python3")
+        .args(["-c", ENTITIES])
+        .arg(path)
+        .output()
+        .expect("python3");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice::<Vec<String>>(&out.stdout)
+        .unwrap()
+        .into_iter()
+        .collect()
+}
+
+fn wraptree(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_wraptree"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn assert_png(path: &Path) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(
+        bytes.starts_with(b"\x89PNG\r\n\x1a\n"),
+        "{}",
+        path.display()
+    );
+    assert!(bytes.len() > 5_000, "{} looks empty", path.display());
+}
+
+#[test]
+fn bench_writes_one_row_per_method_and_wrapper_with_charts_and_rrd() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = out.to_str().unwrap();
+    let r = wraptree(&["bench", "robot-base", "soup:300", "-o", o, "--repeat", "1"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    assert_eq!(
+        rows.len(),
+        2 * Method::ALL.len() * compare::Wrapper::ALL.len()
+    );
+    for row in &rows {
+        assert_eq!(row.len(), header.len());
+        let sah: f64 = row[col("sah")].parse().unwrap();
+        assert!(sah > 1.0, "SAH {sah}");
+        let query = row[col("node_tests_per_query")];
+        let is_query_bv = row[col("wrapper")] == "box" || row[col("wrapper")].starts_with("sphere");
+        assert_eq!(!query.is_empty(), is_query_bv, "{row:?}");
+        assert!(
+            !row[col("tightness")].is_empty(),
+            "small scenes measure tightness"
+        );
+    }
+    for m in Method::ALL {
+        assert!(
+            rows.iter().any(|r| r[col("method")] == m.name()),
+            "{}",
+            m.name()
+        );
+    }
+    for stem in ["robot-base", "soup-300"] {
+        assert_png(&out.join(format!("{stem}-time_vs_query.png")));
+        assert_png(&out.join(format!("{stem}-wrapper_time_vs_tightness.png")));
+    }
+    let e = entities(&out.join("bench.rrd"));
+    for m in Method::ALL {
+        let path = format!("/bench/robot-base/time_vs_query/{}", m.name());
+        assert!(e.contains(&path), "{path}: {e:?}");
+    }
+    assert!(
+        e.contains("/bench/soup-300/time_vs_query/pareto_front"),
+        "{e:?}"
+    );
+    assert!(
+        e.contains("/bench/soup-300/wrapper_time_vs_tightness/hull"),
+        "{e:?}"
+    );
+    assert!(e.contains("/bench/soup-300/table"), "{e:?}");
+    // Results are not replaced without --force.
+    let again = wraptree(&["bench", "robot-base", "-o", o, "--repeat", "1"]);
+    common::assert_one_line_error(&again, "already exists");
+}
+
+#[test]
+fn sweep_writes_every_setting_to_csv_heat_maps_and_one_rrd() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().to_str().unwrap();
+    let r = wraptree(&[
+        "sweep", "lamp", "--a", "0,1", "--b", "1", "--c", "0,2", "-o", o, "--repeat", "1",
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let csv = std::fs::read_to_string(dir.path().join("sweep.csv")).unwrap();
+    let settings: Vec<String> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').take(3).collect::<Vec<_>>().join(","))
+        .collect();
+    assert_eq!(settings, ["0,1,0", "0,1,2", "1,1,0", "1,1,2"]);
+    for stem in ["depth", "sah", "query", "time"] {
+        assert_png(&dir.path().join(format!("sweep-{stem}.png")));
+    }
+    let e = entities(&dir.path().join("sweep.rrd"));
+    for s in ["A0_B1_C0", "A0_B1_C2", "A1_B1_C0", "A1_B1_C2"] {
+        assert!(e.contains(&format!("/sweep/{s}/cost")), "{s}: {e:?}");
+    }
+    assert!(
+        e.contains("/summary/sah") && e.contains("/summary/table"),
+        "{e:?}"
+    );
+    let bad = wraptree(&["sweep", "lamp", "--a", "-1", "-o", o]);
+    common::assert_one_line_error(&bad, "--a must be a finite number");
+}
+
+#[test]
+fn peers_build_valid_trees_on_bundled_meshes_and_differ_in_quality() {
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let loaded = wraptree::scene::load_path(
+        &scenes.join("kuka-link0.obj"),
+        &wraptree::scene::LoadOptions::default(),
+    )
+    .unwrap();
+    let scene = loaded.scene;
+    let mut sahs = Vec::new();
+    for m in Method::ALL {
+        let b = build(m, &scene, &Default::default()).unwrap();
+        let t = &b.tree;
+        let mut leaves: Vec<u32> = t.leaves_under(t.root());
+        leaves.sort_unstable();
+        assert_eq!(
+            leaves,
+            (0..scene.len() as u32).collect::<Vec<_>>(),
+            "{}",
+            m.name()
+        );
+        let q = quality(t);
+        assert!(
+            q.depth_max as f64 >= (scene.len() as f64).log2().ceil(),
+            "{}",
+            m.name()
+        );
+        assert!((0.0..=1.0).contains(&q.structural_balance));
+        sahs.push(q.sah);
+        // Same input, same tree.
+        assert_eq!(build(m, &scene, &Default::default()).unwrap().tree, b.tree);
+    }
+    let distinct: BTreeSet<u64> = sahs.iter().map(|s| s.to_bits()).collect();
+    assert!(
+        distinct.len() >= 6,
+        "builders should not all agree: {sahs:?}"
+    );
+}
