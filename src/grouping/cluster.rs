@@ -170,6 +170,9 @@ struct Clusterer<P, O> {
     /// Whether every box coordinate is finite, so the round-start scan may stop early in a
     /// cell's records (sorted by smallest x).
     finite: bool,
+    /// Whether the scene coordinates are below 1e100 in magnitude (AABB p-set, `prune`), so
+    /// the searches' sqrt-free Cost filter keeps its operands in range.
+    quick: bool,
     stats: Stats,
 }
 
@@ -227,6 +230,9 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             k: if P::AABB { super::mpairs::K_MAX } else { 1 },
             prune,
             finite,
+            quick: prune
+                && finite
+                && (0..3).all(|k| bounds.min[k].abs() < 1e100 && bounds.max[k].abs() < 1e100),
             stats: Stats::default(),
         }
     }
@@ -306,8 +312,6 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             order.clear();
             order.extend(morton.iter().map(|&(_, x)| x));
             let ids = 2 * n - 1;
-            self.hash
-                .build(dlimit + glimit, &order, &self.aabb, &self.diameter, ids);
             self.half_ext = [0.0; 3];
             self.partners.reset(ids);
             for &x in &order {
@@ -315,6 +319,15 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                 self.grow_half_ext(x);
                 self.partners.open(x);
             }
+            let slots = self.partners.slots();
+            self.hash.build(
+                dlimit + glimit,
+                &order,
+                &self.aabb,
+                &self.diameter,
+                slots,
+                ids,
+            );
             let mut limit = ScanLimit {
                 budget,
                 room: max_pairs.saturating_sub(self.stats.eligible_pairs),
@@ -451,8 +464,9 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             // Step 4(b): the new body joins ABods and queues its best eligible pair.
             self.live[new as usize] = true;
             self.grow_half_ext(new);
-            self.hash.insert(new, &merged, d);
             self.partners.open(new);
+            let slot = self.partners.slot(new) as u32;
+            self.hash.insert(new, &merged, d, slot);
             self.search(new, glimit);
             self.queue_current(new);
         }

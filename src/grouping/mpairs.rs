@@ -296,6 +296,12 @@ impl Partners {
         self.slot[x as usize] as usize
     }
 
+    /// The list slot of every body id (`u32::MAX` for ids never given a list).
+    #[inline]
+    pub fn slots(&self) -> &[u32] {
+        &self.slot
+    }
+
     /// All list slots.
     #[inline]
     pub fn lists_mut(&mut self) -> &mut [List] {

@@ -10,8 +10,9 @@
 //! Removal swaps the body with its cell's last record (O(1), the arena position of every body is
 //! kept). At build each cell's records are sorted by their boxes' smallest x, so the round-start
 //! scan can stop early in a cell; later insertions and removals do not keep that order. Each
-//! cell also keeps the box of the centres and the largest diameter ever stored in it this
-//! round, so callers can bound the Cost of any pair with a body of that cell.
+//! cell also keeps the union of the boxes, the largest box minimum and smallest box maximum
+//! corner, and the largest and smallest diameter ever stored in it this round, so callers can
+//! bound the Cost of any pair with a body of that cell.
 
 use crate::geom::{Aabb, P3};
 use std::collections::HashMap;
@@ -26,30 +27,42 @@ pub struct Rec {
     pub diameter: f64,
     /// Body id.
     pub id: u32,
+    /// The body's partner-list slot (fills the record's padding; spares a lookup by id).
+    pub slot: u32,
 }
 
 /// What a cell knows about every body stored in it during the round (grow-only).
 #[derive(Clone, Copy, Debug)]
 pub struct CellBounds {
-    /// Smallest centre coordinates.
-    pub lo: [f64; 3],
-    /// Largest centre coordinates.
-    pub hi: [f64; 3],
+    /// The union of the boxes.
+    pub union: Aabb,
+    /// Largest box minimum corner coordinates (every box reaches at least this low).
+    pub max_lo: [f64; 3],
+    /// Smallest box maximum corner coordinates (every box reaches at least this high).
+    pub min_hi: [f64; 3],
     /// Largest diameter.
     pub dmax: f64,
+    /// Smallest diameter.
+    pub dmin: f64,
 }
 
 const EMPTY_BOUNDS: CellBounds = CellBounds {
-    lo: [f64::INFINITY; 3],
-    hi: [f64::NEG_INFINITY; 3],
+    union: Aabb::EMPTY,
+    max_lo: [f64::NEG_INFINITY; 3],
+    min_hi: [f64::INFINITY; 3],
     dmax: 0.0,
+    dmin: f64::INFINITY,
 };
 
+/// A cell's place in the arena and its bounds, together in two cache lines (one miss with
+/// the adjacent-line prefetch) since a search reads both.
 #[derive(Clone, Copy, Debug)]
+#[repr(align(128))]
 struct Cell {
     start: u32,
     len: u32,
     cap: u32,
+    bounds: CellBounds,
 }
 
 /// Voxel coordinates are clamped to `0..=MAX_COORD` so keys never alias.
@@ -59,6 +72,7 @@ const BLANK: Rec = Rec {
     aabb: Aabb::EMPTY,
     diameter: 0.0,
     id: u32::MAX,
+    slot: u32::MAX,
 };
 
 /// Voxel hash with edge length CSize = DLimit + GLimit.
@@ -72,7 +86,6 @@ pub struct VoxelHash {
     sparse: HashMap<u128, u32, foldhash::fast::FixedState>,
     cells: Vec<Cell>,
     coords: Vec<[i64; 3]>,
-    bounds: Vec<CellBounds>,
     recs: Vec<Rec>,
     /// Arena position and cell of every body id (valid while the body is stored).
     at: Vec<(u32, u32)>,
@@ -88,7 +101,6 @@ impl Default for VoxelHash {
             sparse: HashMap::with_hasher(foldhash::fast::FixedState::with_seed(0)),
             cells: Vec::new(),
             coords: Vec::new(),
-            bounds: Vec::new(),
             recs: Vec::new(),
             at: Vec::new(),
         }
@@ -98,13 +110,15 @@ impl Default for VoxelHash {
 impl VoxelHash {
     /// Empties the hash (keeping allocations), sets the voxel edge to `csize` and stores
     /// `bodies` (the round's active bodies, in the order their records should be laid out).
-    /// `boxes` and `diameters` are indexed by body id; `ids` is the number of body ids.
+    /// `boxes`, `diameters` and `slots` (partner-list slots) are indexed by body id; `ids` is
+    /// the number of body ids.
     pub fn build(
         &mut self,
         csize: f64,
         bodies: &[u32],
         boxes: &[Aabb],
         diameters: &[f64],
+        slots: &[u32],
         ids: usize,
     ) {
         self.inv_csize = 1.0 / csize;
@@ -115,7 +129,6 @@ impl VoxelHash {
         self.origin = [all.min.x, all.min.y, all.min.z];
         self.cells.clear();
         self.coords.clear();
-        self.bounds.clear();
         self.recs.clear();
         self.sparse.clear();
         self.at.resize(ids, (0, NO_CELL));
@@ -146,7 +159,16 @@ impl VoxelHash {
         }
         self.recs.resize(start as usize, BLANK);
         for (&x, &c) in bodies.iter().zip(&cell_of) {
-            self.put(c, x, &boxes[x as usize], diameters[x as usize]);
+            let x = x as usize;
+            self.put(
+                c,
+                Rec {
+                    aabb: boxes[x],
+                    diameter: diameters[x],
+                    id: x as u32,
+                    slot: slots[x],
+                },
+            );
         }
         for cell in &self.cells {
             let (s, e) = (cell.start as usize, (cell.start + cell.len) as usize);
@@ -202,13 +224,14 @@ impl VoxelHash {
             start: self.recs.len() as u32,
             len: 0,
             cap: 0,
+            bounds: EMPTY_BOUNDS,
         });
         self.coords.push(v);
-        self.bounds.push(EMPTY_BOUNDS);
         c
     }
 
-    fn put(&mut self, c: u32, id: u32, aabb: &Aabb, diameter: f64) {
+    fn put(&mut self, c: u32, rec: Rec) {
+        let (id, aabb, diameter) = (rec.id, &rec.aabb, rec.diameter);
         let cell = &mut self.cells[c as usize];
         if cell.len == cell.cap {
             // Move the cell to the end of the arena with twice the room.
@@ -225,28 +248,34 @@ impl VoxelHash {
         let cell = &mut self.cells[c as usize];
         let i = (cell.start + cell.len) as usize;
         cell.len += 1;
-        self.recs[i] = Rec {
-            aabb: *aabb,
-            diameter,
-            id,
-        };
+        self.recs[i] = rec;
         self.at[id as usize] = (i as u32, c);
-        let b = &mut self.bounds[c as usize];
-        let centre = aabb.center();
+        let b = &mut self.cells[c as usize].bounds;
         for k in 0..3 {
-            b.lo[k] = b.lo[k].min(centre[k]);
-            b.hi[k] = b.hi[k].max(centre[k]);
+            b.union.min[k] = b.union.min[k].min(aabb.min[k]);
+            b.union.max[k] = b.union.max[k].max(aabb.max[k]);
+            b.max_lo[k] = b.max_lo[k].max(aabb.min[k]);
+            b.min_hi[k] = b.min_hi[k].min(aabb.max[k]);
         }
         b.dmax = b.dmax.max(diameter);
+        b.dmin = b.dmin.min(diameter);
     }
 
-    /// Adds body `id` by the centre of its box.
-    pub fn insert(&mut self, id: u32, aabb: &Aabb, diameter: f64) {
+    /// Adds body `id` (partner-list slot `slot`) by the centre of its box.
+    pub fn insert(&mut self, id: u32, aabb: &Aabb, diameter: f64, slot: u32) {
         if self.at.len() <= id as usize {
             self.at.resize(id as usize + 1, (0, NO_CELL));
         }
         let c = self.cell_at(&aabb.center());
-        self.put(c, id, aabb, diameter);
+        self.put(
+            c,
+            Rec {
+                aabb: *aabb,
+                diameter,
+                id,
+                slot,
+            },
+        );
     }
 
     /// Removes body `id` (which must be stored).
@@ -269,14 +298,42 @@ impl VoxelHash {
     /// The records stored in cell `c`.
     #[inline]
     pub fn recs(&self, c: u32) -> &[Rec] {
-        let cell = self.cells[c as usize];
+        let cell = &self.cells[c as usize];
         &self.recs[cell.start as usize..(cell.start + cell.len) as usize]
+    }
+
+    /// Asks the CPU to start loading the first records of cell `c` (a no-op off x86-64), so a
+    /// search that will read several cells waits for their first cache misses once rather than
+    /// in turn (the hardware prefetcher follows each cell's contiguous records).
+    #[inline]
+    pub fn prefetch(&self, c: u32) {
+        #[cfg(target_arch = "x86_64")]
+        for r in self.recs(c).iter().take(2) {
+            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+            // SAFETY: SSE is part of x86-64; a prefetch reads nothing and cannot fault.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>((r as *const Rec).cast()) };
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = c;
+    }
+
+    /// Asks the CPU to start loading cell `c`'s bounds and arena place (a no-op off x86-64).
+    #[inline]
+    pub fn prefetch_cell(&self, c: u32) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+            // SAFETY: SSE is part of x86-64; a prefetch reads nothing and cannot fault.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>((&self.cells[c as usize] as *const Cell).cast()) };
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = c;
     }
 
     /// What cell `c` has held this round.
     #[inline]
     pub fn bounds(&self, c: u32) -> &CellBounds {
-        &self.bounds[c as usize]
+        &self.cells[c as usize].bounds
     }
 
     /// Voxel coordinates of cell `c`.

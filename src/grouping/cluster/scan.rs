@@ -3,7 +3,8 @@
 //!
 //! A body `x`'s eligible partners have their centres within `x`'s box grown by GLimit plus the
 //! largest half-extent of the round's active bodies, so only the cells of the voxels meeting
-//! that box are visited, and among them only cells whose centres' box meets it.
+//! that box are visited, and among them only cells the union of whose boxes is within GLimit
+//! of `x`'s box.
 //!
 //! For the AABB p-set (whose pair Cost is a symmetric function of the two boxes and diameters):
 //! - the round-start scan visits each pair of cells once — a body's own cell after it, and the
@@ -14,10 +15,13 @@
 //! - a single body's search visits the cells in increasing order of a lower bound on the Cost
 //!   of any pair with one of their bodies and stops at the first cell whose bound exceeds the
 //!   last Cost the list keeps, so the list is still exactly the first partners in key order.
-//!   The bound takes the merged box to span `x`'s box and the cell's box of centres (every
-//!   body's box holds its centre), Fill over the cell's largest diameter and Balance ≥ 1; it is
-//!   evaluated with the same floating-point operations as the Cost, on smaller operands, so it
-//!   never exceeds a Cost it bounds, and is lowered by 1e-9 relative for `powf`.
+//!   The bound takes the merged diameter D to be at least that of the box spanning `x`'s box
+//!   and, per axis, the cell's smallest box maximum and largest box minimum (every body's box
+//!   reaches them), and at least the cell's smallest diameter; Fill = d / (dx + dy) with
+//!   d ≥ max(D, dy) is then at least D / (dx + min(D, the cell's largest diameter)); Balance ≥ 1.
+//!   It is evaluated with the same floating-point operations as the Cost, on operands no larger,
+//!   so it never exceeds a Cost it bounds, and is lowered by 1e-9 relative for `powf` and the
+//!   rounding of the Fill bound's sum.
 //!
 //! With C = 0 and B > 0 the pair Cost skips Balance (then weighted by zero), bit for bit the
 //! same value. Other p-sets search every candidate for the single best partner, as in the paper.
@@ -49,18 +53,76 @@ fn pair_cost<const A: u8>(w: &Weights, d: f64, dx: f64, dy: f64) -> f64 {
     w.cost_scaled(scale, fill, balance)
 }
 
+/// The extents of `a ∪ b`: the values of `a.merge(b).extents()` up to the sign of zeros (which
+/// the diameter squares away), with `<`/`>` selects that compile to `minsd`/`maxsd`.
+#[inline(always)]
+fn merged_extents(a: &Aabb, b: &Aabb) -> V3 {
+    let lo = |k: usize| {
+        if a.min[k] < b.min[k] {
+            a.min[k]
+        } else {
+            b.min[k]
+        }
+    };
+    let hi = |k: usize| {
+        if a.max[k] > b.max[k] {
+            a.max[k]
+        } else {
+            b.max[k]
+        }
+    };
+    V3::new(hi(0) - lo(0), hi(1) - lo(1), hi(2) - lo(2))
+}
+
+/// Whether the L∞ gap of `a` and `b` exceeds `g`: the answer of `a.gap_linf(b) > g`, as the
+/// running maximum below skips NaN terms just like `f64::max`, but compiles to plain `maxsd`.
+#[inline(always)]
+fn apart(a: &Aabb, b: &Aabb, g: f64) -> bool {
+    let mut m = 0.0f64;
+    for k in 0..3 {
+        for t in [b.min[k] - a.max[k], a.min[k] - b.max[k]] {
+            m = if t > m { t } else { m };
+        }
+    }
+    m > g
+}
+
+/// A Cost filter without `sqrt` or division for A = 1, C = 0, B in [1e-40, 1e40] and scene
+/// coordinates below 1e100 in magnitude (else `None`). There the Cost of a pair with merged
+/// squared diagonal `d2` and diameter sum `sum` > 0 is B·d2/sum within a few ulps, so
+/// [`Quick::beyond`] may say it exceeds `bar` only when the exact Cost does (margin 1e-12
+/// relative; operands kept in the normal range).
+#[derive(Clone, Copy)]
+struct Quick {
+    b: f64,
+}
+
+impl Quick {
+    fn new(w: &Weights, small: bool) -> Option<Quick> {
+        (small && w.a == 1.0 && w.c == 0.0 && (1e-40..=1e40).contains(&w.b))
+            .then_some(Quick { b: w.b })
+    }
+
+    /// Whether the exact Cost of the pair is certainly greater than `bar`.
+    #[inline(always)]
+    fn beyond(self, d2: f64, sum: f64, bar: f64) -> bool {
+        let rhs = bar * sum * (1.0 + 1e-12);
+        sum > 0.0 && d2 > 1e-250 && rhs > 1e-200 && d2 * self.b > rhs
+    }
+}
+
 /// A lower bound on the Cost of pairing the body with box `xa` and diameter `dx` with any body
 /// stored in a cell with bounds `cb`.
 #[inline(always)]
 fn cost_bound<const A: u8>(w: &Weights, xa: &Aabb, dx: f64, cb: &CellBounds) -> f64 {
-    let span = |k: usize| xa.max[k].max(cb.lo[k]) - xa.min[k].min(cb.hi[k]);
-    let d = V3::new(span(0), span(1), span(2)).norm();
+    let span = |k: usize| xa.max[k].max(cb.min_hi[k]) - xa.min[k].min(cb.max_lo[k]);
+    let d = V3::new(span(0), span(1), span(2)).norm().max(cb.dmin);
     let scale = match A {
         1 => d,
         0 => 1.0,
         _ => d.powf(w.a),
     };
-    let sum = dx + cb.dmax;
+    let sum = dx + cb.dmax.min(d);
     let fill = if sum > 0.0 {
         let q = d / sum;
         if dx == 0.0 { q.min(1.0) } else { q }
@@ -70,10 +132,12 @@ fn cost_bound<const A: u8>(w: &Weights, xa: &Aabb, dx: f64, cb: &CellBounds) -> 
     w.cost_scaled(scale, fill, 1.0) * (1.0 - 1e-9)
 }
 
-/// Whether a cell's box of centres meets the box `[lo, hi]`.
+/// Whether a cell may hold an eligible partner of a body with box `xa`: the L∞ gap to the
+/// union of the cell's boxes is at most GLimit (it is at most the gap to any of them, also as
+/// rounded).
 #[inline(always)]
-fn meets(cb: &CellBounds, lo: &P3, hi: &P3) -> bool {
-    (0..3).all(|k| cb.lo[k] <= hi[k] && cb.hi[k] >= lo[k])
+fn reachable(cb: &CellBounds, xa: &Aabb, glimit: f64) -> bool {
+    !apart(xa, &cb.union, glimit)
 }
 
 impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
@@ -140,6 +204,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
     /// the scan short).
     fn pairs_once<const A: u8>(&mut self, glimit: f64, limit: &mut ScanLimit<'_>) -> u64 {
         let (k, w, finite) = (self.k, self.params.weights, self.finite);
+        let quick = Quick::new(&w, self.quick);
         let mut pairs = 0u64;
         let mut candidates = 0u64;
         let mut near: Vec<u32> = Vec::with_capacity(27);
@@ -159,7 +224,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             let hash = &self.hash;
             near.clear();
             hash.for_each_cell(&clo, &chi, |cell, v| {
-                if v > vc && meets(hash.bounds(cell), &clo, &chi) {
+                if v > vc && !apart(&hash.bounds(c).union, &hash.bounds(cell).union, glimit) {
                     near.push(cell);
                 }
             });
@@ -168,16 +233,14 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                     break 'cells;
                 }
                 let xr = hash.recs(c)[i];
-                let (x, xa, dx) = (xr.id, xr.aabb, xr.diameter);
-                let (lo, hi) = self.query(&xa, glimit);
+                let (x, xa, dx, sx) = (xr.id, xr.aabb, xr.diameter, xr.slot as usize);
                 fwd.clear();
                 fwd.extend(
                     near.iter()
                         .copied()
-                        .filter(|&cell| meets(hash.bounds(cell), &lo, &hi)),
+                        .filter(|&cell| reachable(hash.bounds(cell), &xa, glimit)),
                 );
                 let (tags, partners) = (&self.tag, &mut self.partners);
-                let sx = partners.slot(x);
                 let own = &hash.recs(c)[i + 1..];
                 for seg in std::iter::once(own).chain(fwd.iter().map(|&cell| hash.recs(cell))) {
                     for yr in seg {
@@ -186,14 +249,20 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                             break;
                         }
                         candidates += 1;
-                        if xa.gap_linf(&yr.aabb) > glimit {
+                        if apart(&xa, &yr.aabb, glimit) {
                             continue;
                         }
                         pairs += 1;
-                        let d = xa.merge(&yr.aabb).diameter();
-                        let cost = pair_cost::<A>(&w, d, dx, yr.diameter);
-                        let sy = partners.slot(yr.id);
+                        let e = merged_extents(&xa, &yr.aabb);
+                        let sy = yr.slot as usize;
                         let lists = partners.lists_mut();
+                        if let Some(q) = quick {
+                            let bar = lists[sx].bar(k).max(lists[sy].bar(k));
+                            if q.beyond(e.norm_squared(), dx + yr.diameter, bar) {
+                                continue;
+                            }
+                        }
+                        let cost = pair_cost::<A>(&w, e.norm(), dx, yr.diameter);
                         lists[sx].offer(k, cost, yr.id, tags);
                         lists[sy].offer(k, cost, x, tags);
                     }
@@ -215,9 +284,24 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         let mut cells: [(f64, u32); 64] = [(0.0, 0); 64];
         let mut n = 0;
         let mut overflow: Vec<(f64, u32)> = Vec::new();
+        // Gather the voxels' cells first and start loading their bounds, so those cache misses
+        // overlap instead of following one another.
+        let mut ids = [0u32; 64];
+        let mut m = 0;
+        let mut more: Vec<u32> = Vec::new();
         hash.for_each_cell(&lo, &hi, |cell, _| {
+            hash.prefetch_cell(cell);
+            if m < ids.len() {
+                ids[m] = cell;
+                m += 1;
+            } else {
+                more.push(cell);
+            }
+        });
+        for &cell in ids[..m].iter().chain(&more) {
             let cb = hash.bounds(cell);
-            if meets(cb, &lo, &hi) {
+            if reachable(cb, &xa, glimit) {
+                hash.prefetch(cell);
                 let bound = if prune {
                     cost_bound::<A>(&w, &xa, dx, cb)
                 } else {
@@ -230,7 +314,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                     overflow.push((bound, cell));
                 }
             }
-        });
+        }
         let mut list = List::EMPTY;
         let mut candidates = 0u64;
         let tags = &self.tag;
@@ -251,18 +335,26 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             overflow.iter_mut().for_each(|c| c.0 = f64::NEG_INFINITY);
             &mut overflow
         };
+        let quick = Quick::new(&w, self.quick);
         for &(bound, cell) in cells.iter() {
-            if bound > list.bar(k) {
+            let mut bar = list.bar(k);
+            if bound > bar {
                 break;
             }
             for r in hash.recs(cell) {
                 candidates += 1;
-                if r.id == x || xa.gap_linf(&r.aabb) > glimit {
+                if r.id == x || apart(&xa, &r.aabb, glimit) {
                     continue;
                 }
-                let d = xa.merge(&r.aabb).diameter();
-                let cost = pair_cost::<A>(&w, d, dx, r.diameter);
+                let e = merged_extents(&xa, &r.aabb);
+                if let Some(q) = quick
+                    && q.beyond(e.norm_squared(), dx + r.diameter, bar)
+                {
+                    continue;
+                }
+                let cost = pair_cost::<A>(&w, e.norm(), dx, r.diameter);
                 list.offer(k, cost, r.id, tags);
+                bar = list.bar(k);
             }
         }
         self.stats.candidates += candidates;
@@ -283,7 +375,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         hash.for_each_cell(&lo, &hi, |cell, _| {
             for r in hash.recs(cell) {
                 candidates += 1;
-                if r.id == x || xa.gap_linf(&r.aabb) > glimit {
+                if r.id == x || apart(&xa, &r.aabb, glimit) {
                     continue;
                 }
                 let merged = xa.merge(&r.aabb);
