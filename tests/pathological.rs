@@ -416,11 +416,10 @@ fn stress_quick_writes_the_csv_and_the_chart() {
     common::assert_one_line_error(&again, "already exists");
 }
 
-/// Known bug, kept as a reproduction for the owner of `geom::hull`: with sizes spanning 12
-/// decades the hull Wrapper Tree misses vertices by ~2% of a node's diameter (node 862 here:
-/// 1.2e4 outside a hull of diameter 6.2e5, `exact` true), far beyond `HULL_TOL_REL`.
+/// Sizes spanning 12 decades: node 862 here mixes points 1e-2 apart with a 6e5 extent, which
+/// collapse in parry's `f32`; its folded hull once left a vertex 1.2e4 outside while claiming
+/// `exact` (fixed by the `f64` convexity check and fallbacks of `geom::hull`).
 #[test]
-#[ignore = "known bug in geom::hull: hulls of nodes mixing 1e-6 and 1e5 sized triangles"]
 fn hull_wrappers_hold_their_vertices_across_12_decades() {
     let s = path::scales(500, 1);
     let g = wraptree::grouping::group(&s, &Params::default(), ());

@@ -8,8 +8,18 @@
 //! plane of best fit, fan-triangulated, one side), or a solid. Solids go to parry's fallible
 //! `try_convex_hull` in the principal frame with every axis scaled to [−1, 1] (the hull is
 //! affine-invariant, so thin sets are well-conditioned), guarded by `catch_unwind` (parry issue
-//! #49). If parry still fails, the node gets its principal-axes box instead ([`Hull::exact`] is
+//! #49). Points that round to the same `f32` are given to parry once: `f32` keeps 24 bits, so
+//! a node whose sizes span many decades has distinct points closer than 6e-8 of its extent,
+//! and parry then returns a non-manifold, non-convex mesh.
+//!
+//! **Check and fallbacks**: every solid is accepted only if [`is_convex_cover`] holds in `f64`:
+//! a closed, consistently oriented mesh whose every face plane has all the node's points behind
+//! it (within the tolerance). "Every point lies on or inside the mesh" is not enough: a folded
+//! mesh through all the hull's vertices passes it. When parry's hull fails, parry is retried
+//! with uniform scaling, then an incremental hull in `f64` ([`incremental`]) is built; if that
+//! fails too (ill-conditioned input), the node gets its principal-axes box ([`Hull::exact`] is
 //! false): a correct but looser convex wrapper, and the parent is built from the node's points.
+//! Nothing here panics.
 //!
 //! **Tolerance**: because parry decides in `f32`, a point it drops may lie outside the `f64`
 //! hull by about 1e-7 of the node's extent; tests allow [`HULL_TOL_REL`] × the node's AABB
@@ -19,6 +29,8 @@ use super::{P3, V3};
 use crate::geom::pca::Frame;
 use std::cmp::Ordering::Greater;
 use std::collections::HashMap;
+
+mod incremental;
 
 /// Containment tolerance of hulls, relative to the node's AABB diameter (parry is `f32`).
 pub const HULL_TOL_REL: f64 = 1e-5;
@@ -125,18 +137,59 @@ pub fn hull_of(mut points: Vec<P3>) -> (Hull, Option<Vec<P3>>) {
     if ext[small].partial_cmp(&(FLAT_REL * ext[big])) != Some(Greater) {
         return (flat_hull(&points, &frame, big, mid), None);
     }
-    // parry's f32 quickhull can return a non-convex mesh on near-degenerate input (seen on the
-    // 12,144-polygon scene); every result is checked in f64 against all the node's points, then
-    // retried with uniform scaling, and the principal-axes box is the always-valid last resort.
+    // Parry's f32 quickhull can return a folded mesh on near-degenerate input (12-decade
+    // scenes, the 12,144-polygon scene): see the module docs for the check and the fallbacks.
     let tol = HULL_TOL_REL * ext.norm();
-    let valid = |h: Hull| points.iter().all(|p| h.excess(p) <= tol).then_some(h);
+    let valid = |h: Hull| is_convex_cover(&h, &points, tol).then_some(h);
     let solid = solid_hull(&points, &frame, lo, hi, false)
         .and_then(valid)
-        .or_else(|| solid_hull(&points, &frame, lo, hi, true).and_then(valid));
+        .or_else(|| solid_hull(&points, &frame, lo, hi, true).and_then(valid))
+        .or_else(|| exact_hull(&points, &frame, tol).and_then(valid));
     match solid {
         Some(h) => (h, None),
         None => (box_hull(&frame, lo, hi), Some(points)),
     }
+}
+
+/// Whether `h` is a solid whose surface is closed (every directed edge once, its reverse once)
+/// and whose every face plane has all `points` at most `tol` in front of it: then `h` is convex
+/// and holds every point within `tol`. Zero-area faces have no plane and are not checked.
+pub fn is_convex_cover(h: &Hull, points: &[P3], tol: f64) -> bool {
+    if h.dim != 3 || h.triangles.len() < 4 {
+        return false;
+    }
+    let mut edges = HashMap::with_capacity(3 * h.triangles.len());
+    for &[a, b, c] in &h.triangles {
+        for e in [(a, b), (b, c), (c, a)] {
+            if edges.insert(e, ()).is_some() {
+                return false;
+            }
+        }
+    }
+    if edges.keys().any(|&(a, b)| !edges.contains_key(&(b, a))) {
+        return false;
+    }
+    h.triangles.iter().all(|t| {
+        let [a, b, c] = t.map(|i| h.vertices[i as usize]);
+        match (b - a).cross(&(c - a)).try_normalize(0.0) {
+            Some(n) => points.iter().all(|p| n.dot(&(p - a)) <= tol),
+            None => true,
+        }
+    })
+}
+
+/// The hull by [`incremental::hull`] in `f64`, on local coordinates (small numbers far from
+/// the scene origin); points within `tol / 4` of a face count as inside.
+fn exact_hull(points: &[P3], frame: &Frame, tol: f64) -> Option<Hull> {
+    let local: Vec<P3> = points.iter().map(|p| P3::from(frame.local(p))).collect();
+    let (used, triangles) = incremental::hull(&local, tol / 4.0)?;
+    let hull = Hull {
+        vertices: used.iter().map(|&i| points[i]).collect(),
+        triangles,
+        dim: 3,
+        exact: true,
+    };
+    (hull.volume() > 0.0).then_some(hull)
 }
 
 /// Removes exact duplicates (by bits), keeping the first of each.
@@ -203,21 +256,22 @@ fn solid_hull(points: &[P3], frame: &Frame, lo: V3, hi: V3, uniform: bool) -> Op
     } else {
         (hi - lo) / 2.0
     };
-    let local: Vec<parry3d::math::Vector> = points
-        .iter()
-        .map(|p| {
-            let q = (frame.local(p) - mid).component_div(&half);
-            parry3d::math::Vector::new(q.x as f32, q.y as f32, q.z as f32)
-        })
-        .collect();
+    // One parry point per distinct f32 value, remembering the first input point that gave it.
+    let mut index: HashMap<[u32; 3], usize> = HashMap::with_capacity(points.len());
+    let mut local: Vec<parry3d::math::Vector> = Vec::with_capacity(points.len());
+    for (i, p) in points.iter().enumerate() {
+        let q = (frame.local(p) - mid).component_div(&half);
+        let l = parry3d::math::Vector::new(q.x as f32, q.y as f32, q.z as f32);
+        if let std::collections::hash_map::Entry::Vacant(e) =
+            index.entry(l.to_array().map(f32::to_bits))
+        {
+            e.insert(i);
+            local.push(l);
+        }
+    }
     let (hv, ht) = std::panic::catch_unwind(|| parry3d::transformation::try_convex_hull(&local))
         .ok()?
         .ok()?;
-    let index: HashMap<[u32; 3], usize> = local
-        .iter()
-        .enumerate()
-        .map(|(i, l)| (l.to_array().map(f32::to_bits), i))
-        .collect();
     let vertices: Vec<P3> = hv
         .iter()
         .map(|l| {
@@ -285,3 +339,76 @@ pub const BOX_TRIANGLES: [[u32; 3]; 12] = [
     [1, 3, 5],
     [3, 7, 5],
 ];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The children's hull vertices of node 862 of `scene::pathological::scales(500, 1)`: two
+    /// pairs of points 1e-2 apart in a set 6e5 wide round to the same `f32`, and parry's hull
+    /// came back folded (every point a vertex or near one, yet 1.2e4 short of the true hull).
+    const NODE_862: [[f64; 3]; 12] = [
+        [369458.36569001165, 1441229.5701129083, 1940021.1926272416],
+        [369458.3644717401, 1441229.5563249202, 1940021.1922192422],
+        [369458.36532453017, 1441229.5662261187, 1940021.184069588],
+        [78933.97771045874, 1602711.6276975274, 1877795.1842322976],
+        [260709.21310348198, 1973355.6764059889, 1874952.0446192918],
+        [78937.15843661095, 1602712.3143425295, 1877789.8111794712],
+        [260710.07872047534, 1973354.788537742, 1874953.505605709],
+        [265306.48234324006, 1606691.5358718918, 1873738.3459693824],
+        [265307.5352089172, 1606692.1801468453, 1873739.3000611947],
+        [260710.44969918678, 1973354.7082750804, 1874951.9135727389],
+        [172315.30573832418, 1903546.6442138744, 1796111.8685013761],
+        [112294.06050034064, 1930642.4275062277, 1819438.9695206604],
+    ];
+
+    #[test]
+    fn twelve_decade_node_gets_its_true_hull() {
+        let pts: Vec<P3> = NODE_862.iter().map(|&c| P3::from(c)).collect();
+        let (h, support) = hull_of(pts.clone());
+        assert!(h.exact && support.is_none());
+        let tol = HULL_TOL_REL * 6.3e5;
+        assert!(is_convex_cover(&h, &pts, tol));
+        // A vertex of the scene 1.56e4 inside the true hull; the folded hull had it 1.2e4 out.
+        let inside = P3::new(194725.00379737755, 1758694.4144158948, 1850553.5737965864);
+        assert!(h.excess(&inside) < -1e4, "{}", h.excess(&inside));
+        for p in &pts {
+            assert!(h.excess(p) <= tol);
+        }
+    }
+
+    #[test]
+    fn folded_or_open_meshes_are_not_covers() {
+        let pts: Vec<P3> = [[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]]
+            .map(P3::from)
+            .to_vec();
+        let tet = Hull {
+            vertices: pts.clone(),
+            triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+            dim: 3,
+            exact: true,
+        };
+        assert!(is_convex_cover(&tet, &pts, 0.0));
+        let outside = [P3::new(1.0, 1.0, 1.0)];
+        assert!(!is_convex_cover(&tet, &outside, 0.1));
+        let mut open = tet.clone();
+        open.triangles.pop();
+        assert!(!is_convex_cover(&open, &pts, 0.0));
+        let mut flipped = tet;
+        flipped.triangles[0] = [0, 1, 2];
+        assert!(!is_convex_cover(&flipped, &pts, 0.0));
+    }
+
+    #[test]
+    fn incremental_hull_of_a_cube_with_inner_points() {
+        let mut pts: Vec<P3> = (0..8)
+            .map(|k| P3::new((k & 1) as f64, (k >> 1 & 1) as f64, (k >> 2 & 1) as f64))
+            .collect();
+        pts.extend([P3::new(0.5, 0.5, 0.5), P3::new(0.2, 0.7, 0.1)]);
+        let frame = Frame::principal(&pts);
+        let h = exact_hull(&pts, &frame, 1e-9).unwrap();
+        assert_eq!(h.vertices.len(), 8);
+        assert!(is_convex_cover(&h, &pts, 1e-9));
+        assert!((h.volume() - 1.0).abs() < 1e-12);
+    }
+}

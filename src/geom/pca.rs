@@ -16,14 +16,19 @@ pub struct Frame {
 impl Frame {
     /// The principal frame of `points`. Degenerate covariances (fewer than two distinct points,
     /// non-finite values) give the world axes; repeated eigenvalues give some orthonormal frame
-    /// of the eigenspace.
+    /// of the eigenspace. Offsets are taken from the first point, so the axes of a small set
+    /// far from the origin are as accurate as near it.
     pub fn principal(points: &[P3]) -> Frame {
         let n = points.len().max(1) as f64;
-        let origin = P3::from(points.iter().map(|p| p.coords).sum::<V3>() / n);
+        // Shifted data: offsets from the first point keep a tiny set far from the world origin
+        // (a 1e-6 triangle at 1e6) from being tilted by the rounding of a large mean.
+        let base = points.first().copied().unwrap_or_else(P3::origin);
+        let mean = points.iter().map(|p| p - base).sum::<V3>() / n;
+        let origin = base + mean;
         let cov = points
             .iter()
             .map(|p| {
-                let d = p - origin;
+                let d = (p - base) - mean;
                 d * d.transpose()
             })
             .sum::<Matrix3<f64>>()
