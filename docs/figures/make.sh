@@ -24,3 +24,13 @@ snap robot-base robot-base.obj --nodes 251,104,8 --size 480x360
 snap lamp lamp.obj --nodes 167,4 --wrapper sphere,hull --size 400x320
 # Figure 3: five lamps, the 8-node level as spheres and as convex hulls.
 snap lamps5 lamps5.obj --nodes 8 --wrapper sphere,hull --size 480x400
+
+# Charts (timings vary from run to run, so these bytes do too): the stability study's
+# spaghetti chart, and the speed-against-accuracy charts of the 12,144-polygon scene.
+mkdir -p "$tmp/stress" "$tmp/bench"
+"$bin" stress -o "$tmp/stress" >/dev/null
+cp "$tmp/stress/spaghetti.png" docs/figures/spaghetti.png
+"$bin" bench robot-bases -o "$tmp/bench" >/dev/null
+cp "$tmp/bench/robot-bases-time_vs_query.png" docs/figures/robot-bases-time_vs_query.png
+cp "$tmp/bench/robot-bases-wrapper_time_vs_tightness.png" docs/figures/robot-bases-wrapper_time_vs_tightness.png
+echo "docs/figures/{spaghetti,robot-bases-time_vs_query,robot-bases-wrapper_time_vs_tightness}.png"

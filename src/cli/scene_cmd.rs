@@ -9,12 +9,15 @@ use std::process::ExitCode;
 #[derive(Args, Debug)]
 pub struct SceneCmd {
     /// robot-base (276 polygons), lamp (626), lamps (lamp × --copies, default 5),
-    /// robot-bases (robot base × --copies, default 44) or soup (-n triangles).
+    /// robot-bases (robot base × --copies, default 44), soup (-n triangles), or a
+    /// pathological kind (-n primitives): spaghetti-parallel, spaghetti-random, slabs,
+    /// coincident, duplicates, coplanar, collinear, offset, scales, ngons, two-clusters,
+    /// thin-triangles.
     kind: String,
     /// Copies for `lamps` and `robot-bases`.
     #[arg(long)]
     copies: Option<usize>,
-    /// Triangle count for `soup`.
+    /// Triangle count for `soup`, primitive count for the pathological kinds.
     #[arg(short)]
     n: Option<usize>,
     /// Seed for placement and soups.
