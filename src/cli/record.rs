@@ -3,7 +3,7 @@
 use super::cover::{Tolerance, parse_tolerance};
 use super::group::{BudgetArgs, Progress};
 use super::{GroupArgs, SceneArgs};
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, anyhow, bail};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -15,7 +15,7 @@ use wraptree::grouping::{self, Grouping, ResolvedParams, Stopped, Tee};
 use wraptree::record::mcap::McapRecorder;
 use wraptree::record::output::Pending;
 use wraptree::record::rrd::RrdRecorder;
-use wraptree::record::{CoverLevel, Detail, Outcome, RunInfo};
+use wraptree::record::{CoverLevel, Detail, Outcome, RunInfo, background};
 use wraptree::scene::{Scene, SceneSource};
 use wraptree::wrap::cover::export::{self, WrapperRecord};
 use wraptree::wrap::cover::{Cover, Fits};
@@ -223,12 +223,24 @@ pub fn record_with(
     let stop = stop_flag();
     let start = Instant::now();
     let progress = Progress::for_merges(scene.len() as u64);
-    let result = grouping::group_within(
-        scene,
-        params,
-        Tee(&mut rrd, Tee(&mut mcap, progress)),
-        &limits.budget(Some(&stop)),
-    );
+    // The MCAP recorder (protobuf encoding, zstd) runs on a second thread while the grouping
+    // and the Rerun recorder (which forwards to the SDK's own threads) run here.
+    let (result, mcap) = std::thread::scope(|s| {
+        let (mut events, worker) = background::channel();
+        let mcap_thread = s.spawn(move || {
+            worker.run(&mut mcap);
+            mcap
+        });
+        let result = grouping::group_within(
+            scene,
+            params,
+            Tee(&mut rrd, Tee(&mut events, progress)),
+            &limits.budget(Some(&stop)),
+        );
+        events.close();
+        (result, mcap_thread.join())
+    });
+    let mcap = mcap.map_err(|_| anyhow!("{}: the MCAP recorder failed", mcap_path.display()))?;
     let seconds = start.elapsed().as_secs_f64();
     let (grouping, stopped, merges, rounds) = match result {
         Ok(g) => {
@@ -275,9 +287,14 @@ pub fn record_with(
         seconds,
         stopped,
     };
-    rrd.finish(&outcome)
-        .with_context(|| format!("{}", rrd_path.display()))?;
-    mcap.finish(&outcome)
+    // Both files' tails (levels, footers) are written at the same time.
+    let (rrd_done, mcap_done) = std::thread::scope(|s| {
+        let mcap_thread = s.spawn(|| mcap.finish(&outcome));
+        (rrd.finish(&outcome), mcap_thread.join())
+    });
+    rrd_done.with_context(|| format!("{}", rrd_path.display()))?;
+    mcap_done
+        .map_err(|_| anyhow!("{}: the MCAP recorder failed", mcap_path.display()))?
         .with_context(|| format!("{}", mcap_path.display()))?;
     let (rrd_dest, mcap_dest) = if grouping.is_some() {
         (rrd_file.commit()?, mcap_file.commit()?)

@@ -1,7 +1,9 @@
 //! Recordings of a grouping run: `.rrd` for the Rerun viewer ([`rrd`]) and `.mcap` for Foxglove
 //! ([`mcap`]). Both recorders are [`Observer`](crate::grouping::Observer)s fed the same events
-//! and share nothing else; [`output`] makes their files appear atomically.
+//! and share nothing else; [`output`] makes their files appear atomically, and [`background`]
+//! lets a recorder consume the events on another thread while the grouping runs.
 
+pub mod background;
 pub mod mcap;
 pub mod output;
 pub mod rrd;

@@ -1,0 +1,232 @@
+//! An [`Observer`] that hands events to another thread, where the real observer sees them in
+//! the same order. Recording then overlaps with the grouping phase instead of adding to it:
+//! the grouping thread only copies each event (a `Merge` is plain data; a round start's active
+//! list is the one allocation) into a batch and sends full batches down a bounded channel.
+
+use crate::grouping::{Event, Merge, Observer};
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+
+/// Events per batch sent to the worker.
+const BATCH: usize = 1024;
+/// Batches in flight before the grouping thread waits for the worker.
+const IN_FLIGHT: usize = 64;
+
+/// An owned copy of an [`Event`].
+#[derive(Clone, Debug)]
+enum Owned {
+    RoundStart {
+        round: u32,
+        dlimit: f64,
+        glimit: f64,
+        active: Vec<u32>,
+        dormant: u32,
+        pairs: u64,
+    },
+    Merge(Merge),
+    Dormant {
+        round: u32,
+        body: u32,
+        diameter: f64,
+    },
+    Doubling {
+        round: u32,
+        merges: u32,
+        dlimit: f64,
+        glimit: f64,
+    },
+    Finish {
+        root: u32,
+        rounds: u32,
+        merges: u32,
+    },
+}
+
+impl Owned {
+    fn of(e: &Event<'_>) -> Owned {
+        match *e {
+            Event::RoundStart {
+                round,
+                dlimit,
+                glimit,
+                active,
+                dormant,
+                pairs,
+            } => Owned::RoundStart {
+                round,
+                dlimit,
+                glimit,
+                active: active.to_vec(),
+                dormant,
+                pairs,
+            },
+            Event::Merge(m) => Owned::Merge(m),
+            Event::Dormant {
+                round,
+                body,
+                diameter,
+            } => Owned::Dormant {
+                round,
+                body,
+                diameter,
+            },
+            Event::Doubling {
+                round,
+                merges,
+                dlimit,
+                glimit,
+            } => Owned::Doubling {
+                round,
+                merges,
+                dlimit,
+                glimit,
+            },
+            Event::Finish {
+                root,
+                rounds,
+                merges,
+            } => Owned::Finish {
+                root,
+                rounds,
+                merges,
+            },
+        }
+    }
+
+    fn event(&self) -> Event<'_> {
+        match self {
+            Owned::RoundStart {
+                round,
+                dlimit,
+                glimit,
+                active,
+                dormant,
+                pairs,
+            } => Event::RoundStart {
+                round: *round,
+                dlimit: *dlimit,
+                glimit: *glimit,
+                active,
+                dormant: *dormant,
+                pairs: *pairs,
+            },
+            Owned::Merge(m) => Event::Merge(*m),
+            &Owned::Dormant {
+                round,
+                body,
+                diameter,
+            } => Event::Dormant {
+                round,
+                body,
+                diameter,
+            },
+            &Owned::Doubling {
+                round,
+                merges,
+                dlimit,
+                glimit,
+            } => Event::Doubling {
+                round,
+                merges,
+                dlimit,
+                glimit,
+            },
+            &Owned::Finish {
+                root,
+                rounds,
+                merges,
+            } => Event::Finish {
+                root,
+                rounds,
+                merges,
+            },
+        }
+    }
+}
+
+/// The sending half: pass it to the grouping phase as its observer, then call
+/// [`Background::close`] so the worker sees the last batch.
+pub struct Background {
+    tx: Option<SyncSender<Vec<Owned>>>,
+    batch: Vec<Owned>,
+}
+
+/// The receiving half: run [`Worker::run`] on another thread with the real observer.
+pub struct Worker(Receiver<Vec<Owned>>);
+
+/// A connected sender and worker.
+pub fn channel() -> (Background, Worker) {
+    let (tx, rx) = sync_channel(IN_FLIGHT);
+    (
+        Background {
+            tx: Some(tx),
+            batch: Vec::with_capacity(BATCH),
+        },
+        Worker(rx),
+    )
+}
+
+impl Background {
+    fn send(&mut self) {
+        if self.batch.is_empty() {
+            return;
+        }
+        let full = std::mem::replace(&mut self.batch, Vec::with_capacity(BATCH));
+        // A worker that has gone away (its observer panicked) is reported by its join.
+        if let Some(tx) = &self.tx
+            && tx.send(full).is_err()
+        {
+            self.tx = None;
+        }
+    }
+
+    /// Sends what is buffered and ends the stream; the worker's `run` then returns.
+    pub fn close(mut self) {
+        self.send();
+    }
+}
+
+impl Observer for Background {
+    #[inline]
+    fn on_event(&mut self, event: &Event<'_>) {
+        self.batch.push(Owned::of(event));
+        if self.batch.len() == BATCH {
+            self.send();
+        }
+    }
+}
+
+impl Worker {
+    /// Feeds every event to `observer`, in order, until the sender is closed or dropped.
+    pub fn run<O: Observer>(self, observer: &mut O) {
+        for batch in self.0 {
+            for e in &batch {
+                observer.on_event(&e.event());
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grouping::{EventLog, Params, group};
+    use crate::scene::generate;
+
+    #[test]
+    fn the_worker_sees_the_same_events_in_order() {
+        let scene = generate::lamp();
+        let mut direct = EventLog::default();
+        group(&scene, &Params::default(), &mut direct);
+        let (tx, worker) = channel();
+        let mut relayed = EventLog::default();
+        std::thread::scope(|s| {
+            let h = s.spawn(|| worker.run(&mut relayed));
+            let mut tx = tx;
+            group(&scene, &Params::default(), &mut tx);
+            tx.close();
+            h.join().unwrap();
+        });
+        assert_eq!(direct, relayed);
+        assert!(direct.merges.len() == scene.len() - 1);
+    }
+}
