@@ -311,28 +311,8 @@ pub(super) fn method_bar(len: usize, scene: &str) -> indicatif::ProgressBar {
     bar
 }
 
-/// Prints one scene's comparison rows.
+/// Prints one scene's comparison rows as a markdown table.
 fn print_rows(rows: &[Row]) {
-    println!(
-        "{:<20} {:<19} {:>10} {:>10} {:>8} {:>5} {:>9} {:>10}",
-        "method", "wrapper", "build ms", "wrap ms", "SAH", "depth", "tight", "tests/qry"
-    );
-    for r in rows {
-        let tests = r
-            .query
-            .as_ref()
-            .map(|q| format!("{:.1}", metrics::compare::query_values(q)[6]))
-            .unwrap_or_default();
-        println!(
-            "{:<20} {:<19} {:>10.2} {:>10.2} {:>8.2} {:>5} {:>9} {:>10}",
-            r.method,
-            r.wrapper,
-            r.build_s * 1e3,
-            r.wrapper_s * 1e3,
-            r.quality.sah,
-            r.quality.depth_max,
-            r.tightness.map(|t| format!("{t:.4}")).unwrap_or_default(),
-            tests
-        );
-    }
+    let rows: Vec<&Row> = rows.iter().collect();
+    print!("{}", wraptree::metrics::report::bench_table(&rows));
 }

@@ -172,6 +172,31 @@ fn sanitize(s: &str) -> String {
         .collect()
 }
 
+/// One scene's rows as a markdown table (what `bench` prints and logs).
+pub fn bench_table(rows: &[&Row]) -> String {
+    let mut md = String::from(
+        "| method | wrapper | build ms | wrapper ms | SAH | depth | tightness | tests/query |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {:.3} | {:.3} | {:.2} | {} | {} | {} |",
+            r.method,
+            r.wrapper,
+            r.build_s * 1e3,
+            r.wrapper_s * 1e3,
+            r.quality.sah,
+            r.quality.depth_max,
+            r.tightness.map(|t| format!("{t:.4}")).unwrap_or_default(),
+            r.query
+                .as_ref()
+                .map(|q| format!("{:.1}", super::compare::query_values(q)[6]))
+                .unwrap_or_default()
+        );
+    }
+    md
+}
+
 /// Per scene: the two charts as 2D views beside the results table.
 fn bench_blueprint(rows: &[Row]) -> Blueprint {
     let views: Vec<ContainerLike> = scenes_of(rows)
@@ -300,26 +325,7 @@ fn bench_rrd(path: &Path, rows: &[Row], force: bool) -> Result<PathBuf> {
         if !tight.is_empty() {
             log_chart(rec, &at("wrapper_time_vs_tightness"), &tight)?;
         }
-        let mut md = String::from(
-            "| method | wrapper | build ms | wrapper ms | SAH | depth | tightness | tests/query |\n|---|---|---|---|---|---|---|---|\n",
-        );
-        for r in &rows {
-            let _ = writeln!(
-                md,
-                "| {} | {} | {:.3} | {:.3} | {:.2} | {} | {} | {} |",
-                r.method,
-                r.wrapper,
-                r.build_s * 1e3,
-                r.wrapper_s * 1e3,
-                r.quality.sah,
-                r.quality.depth_max,
-                r.tightness.map(|t| format!("{t:.4}")).unwrap_or_default(),
-                r.query
-                    .as_ref()
-                    .map(|q| format!("{:.1}", super::compare::query_values(q)[6]))
-                    .unwrap_or_default()
-            );
-        }
+        let md = bench_table(&rows);
         rec.log_static(
             at("table"),
             &rerun::TextDocument::new(md).with_media_type(rerun::MediaType::markdown()),
