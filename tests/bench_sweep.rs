@@ -69,6 +69,9 @@ fn bench_writes_one_row_per_method_and_wrapper_with_charts_and_rrd() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     let o = out.to_str().unwrap();
+    let missing = wraptree(&["bench", "robot-base", "-o", o]);
+    common::assert_one_line_error(&missing, "output directory does not exist");
+    std::fs::create_dir(&out).unwrap();
     let r = wraptree(&["bench", "robot-base", "soup:300", "-o", o, "--repeat", "1"]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();

@@ -25,9 +25,10 @@ pub struct BenchCmd {
     /// KIND[:COUNT] (soup:100000, robot-bases:44, lamps:5, robot-base, lamp). Without scenes:
     /// the targets table on the standard scenes and the bundled meshes.
     scenes: Vec<String>,
-    /// Output directory for results.csv, charts and bench.rrd (with SCENEs).
-    #[arg(short, long, default_value = "recordings/bench")]
-    output: PathBuf,
+    /// Output directory for results.csv, charts and bench.rrd (with SCENEs) [default:
+    /// recordings/bench, created if missing; a given directory must exist].
+    #[arg(short, long)]
+    output: Option<PathBuf>,
     /// Replace existing result files.
     #[arg(long)]
     force: bool,
@@ -60,6 +61,20 @@ fn best_of(repeat: u32, mut f: impl FnMut()) -> f64 {
             t.elapsed().as_secs_f64()
         })
         .fold(f64::INFINITY, f64::min)
+}
+
+/// The output directory: `given`, which must exist, or `default`, created if missing.
+pub(super) fn output_dir(given: Option<&std::path::Path>, default: &str) -> Result<PathBuf> {
+    match given {
+        Some(d) if d.is_dir() => Ok(d.to_path_buf()),
+        Some(d) => anyhow::bail!("{}: output directory does not exist", d.display()),
+        None => {
+            let d = PathBuf::from(default);
+            std::fs::create_dir_all(&d)
+                .with_context(|| format!("{}: cannot create the output directory", d.display()))?;
+            Ok(d)
+        }
+    }
 }
 
 /// A generated scene as if loaded from its OBJ (so recordings can embed it).
@@ -133,8 +148,7 @@ impl BenchCmd {
             tightness_max_n: self.tightness_max_n,
             ..Options::default()
         };
-        std::fs::create_dir_all(&self.output)
-            .with_context(|| format!("{}: cannot create the directory", self.output.display()))?;
+        let output = output_dir(self.output.as_deref(), "recordings/bench")?;
         let mut rows = Vec::new();
         for scene in &scenes {
             let bar = method_bar(opts.methods.len(), &scene.name);
@@ -147,7 +161,7 @@ impl BenchCmd {
             print_rows(&r);
             rows.extend(r);
         }
-        for p in write_bench(&self.output, &rows, self.force)? {
+        for p in write_bench(&output, &rows, self.force)? {
             eprintln!("wrote {}", p.display());
         }
         Ok(ExitCode::SUCCESS)

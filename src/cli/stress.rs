@@ -19,10 +19,10 @@
 
 mod report;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use report::{Row, csv, print_table, sweep_chart};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, mpsc};
@@ -330,20 +330,6 @@ const OUTPUTS: [&str; 5] = [
     "spaghetti-n.png",
 ];
 
-/// The output directory: `given` (which must exist) or `recordings/stress` (created).
-fn output_dir(given: Option<&Path>) -> Result<PathBuf> {
-    match given {
-        Some(d) if d.is_dir() => Ok(d.to_path_buf()),
-        Some(d) => anyhow::bail!("{}: output directory does not exist", d.display()),
-        None => {
-            let d = PathBuf::from("recordings/stress");
-            std::fs::create_dir_all(&d)
-                .with_context(|| format!("{}: cannot create the output directory", d.display()))?;
-            Ok(d)
-        }
-    }
-}
-
 impl StressCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
@@ -353,7 +339,7 @@ impl StressCmd {
         if self.split.is_nan() || self.split < split::MIN_ASPECT_LIMIT {
             anyhow::bail!("--split must be a number ≥ 2, got {}", self.split);
         }
-        let dir = output_dir(self.output.as_deref())?;
+        let dir = super::bench::output_dir(self.output.as_deref(), "recordings/stress")?;
         for name in OUTPUTS {
             let p = dir.join(name);
             if !self.force && p.exists() {

@@ -1,7 +1,7 @@
 //! `wraptree sweep`: the A/B/C grid of the grouping phase's Cost on one scene, as a table,
 //! `sweep.csv`, heat maps and one `.rrd` with every setting side by side.
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Result, anyhow};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -27,7 +27,8 @@ pub struct SweepCmd {
     /// P-set wrapper for every setting.
     #[arg(long, value_enum, default_value_t = PSet::Aabb)]
     pset: PSet,
-    /// Output directory [default: recordings/sweep-<scene>].
+    /// Output directory [default: recordings/sweep-<scene>, created if missing; a given
+    /// directory must exist].
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Replace existing result files.
@@ -46,12 +47,10 @@ impl SweepCmd {
         for w in &settings {
             w.check().map_err(|e| anyhow!("--{e}"))?;
         }
-        let dir = self
-            .output
-            .clone()
-            .unwrap_or_else(|| PathBuf::from(format!("recordings/sweep-{}", scene.name)));
-        std::fs::create_dir_all(&dir)
-            .with_context(|| format!("{}: cannot create the directory", dir.display()))?;
+        let dir = super::bench::output_dir(
+            self.output.as_deref(),
+            &format!("recordings/sweep-{}", scene.name),
+        )?;
         let rrd = SweepRrd::create(&dir.join("sweep.rrd"), &settings, self.force)?;
         let base = Params {
             pset: self.pset,
