@@ -1,0 +1,279 @@
+//! `bench`'s files: `results.csv`, per scene the build-time/query-cost and wrapper-time/
+//! tightness charts, and `bench.rrd` with the same charts and the results table.
+
+use super::{QUERY_COLUMNS, SIZE, opt, query_fields, series_by, write_chart};
+use crate::metrics::compare::{Row, query_values};
+use crate::record::output::write_atomic;
+use crate::record::rrd::SeriesFile;
+use crate::render::chart::{Scatter, pareto_front};
+use anyhow::{Result, anyhow};
+use rerun::EntityPath;
+use rerun::blueprint::{
+    Blueprint, ContainerLike, Horizontal, Spatial2DView, TextDocumentView, Vertical,
+};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The bench rows as CSV (one header line, one line per row).
+pub fn bench_csv(rows: &[Row]) -> String {
+    let mut s = format!(
+        "scene,n,method,wrapper,build_s,wrapper_s,sah,depth_max,depth_mean,structural_balance,\
+spatial_balance,tightness,{QUERY_COLUMNS}\n"
+    );
+    for r in rows {
+        let q = &r.quality;
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{:.6e},{:.6e},{:.6e},{},{:.4},{:.4},{:.4},{},{}",
+            r.scene,
+            r.n,
+            r.method,
+            r.wrapper,
+            r.build_s,
+            r.wrapper_s,
+            q.sah,
+            q.depth_max,
+            q.depth_mean,
+            q.structural_balance,
+            q.spatial_balance,
+            opt(r.tightness),
+            query_fields(r.query.as_ref()),
+        );
+    }
+    s
+}
+
+/// The two bench charts for one scene: build time against node tests per query (hierarchy +
+/// query wrapper, Pareto front marked), and wrapper build time against tightness.
+pub fn bench_charts(scene: &str, rows: &[Row]) -> Result<Vec<(String, String)>> {
+    let rows: Vec<&Row> = rows.iter().filter(|r| r.scene == scene).collect();
+    let n = rows.first().map_or(0, |r| r.n);
+    let query = Scatter {
+        title: format!("{scene} (N = {n}): build time vs query cost"),
+        x_label: "hierarchy + wrapper build time (s, log)".into(),
+        y_label: "node tests per query".into(),
+        log_x: true,
+        pareto: true,
+        series: series_by(rows.iter().filter_map(|r| {
+            let q = r.query.as_ref()?;
+            let y = query_values(q)[6];
+            Some((r.method.to_string(), (r.build_s + r.wrapper_s, y)))
+        })),
+        ..Scatter::default()
+    };
+    let tight = Scatter {
+        title: format!("{scene} (N = {n}): wrapper build time vs tightness"),
+        x_label: "wrapper build time on top of the hierarchy (s, log)".into(),
+        y_label: "mean relative surface-to-geometry distance".into(),
+        log_x: true,
+        pareto: true,
+        series: series_by(rows.iter().filter_map(|r| {
+            let t = r.tightness?;
+            (r.wrapper_s > 0.0).then(|| (r.wrapper.to_string(), (r.wrapper_s, t)))
+        })),
+        ..Scatter::default()
+    };
+    let mut out = vec![(
+        "time_vs_query".to_string(),
+        query.to_svg(SIZE.0, SIZE.1).map_err(|e| anyhow!(e))?,
+    )];
+    if !tight.series.is_empty() {
+        out.push((
+            "wrapper_time_vs_tightness".into(),
+            tight.to_svg(SIZE.0, SIZE.1).map_err(|e| anyhow!(e))?,
+        ));
+    }
+    Ok(out)
+}
+
+/// Writes `results.csv`, per-scene charts and `bench.rrd` into `dir`; returns what it wrote.
+pub fn write_bench(dir: &Path, rows: &[Row], force: bool) -> Result<Vec<PathBuf>> {
+    let mut written = Vec::new();
+    let csv = dir.join("results.csv");
+    write_atomic(&csv, bench_csv(rows).as_bytes(), force)?;
+    written.push(csv);
+    let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
+    scenes.dedup();
+    for scene in &scenes {
+        for (name, svg) in bench_charts(scene, rows)? {
+            let stem = format!("{}-{name}", sanitize(scene));
+            written.extend(write_chart(dir, &stem, &svg, force)?);
+        }
+    }
+    written.push(bench_rrd(&dir.join("bench.rrd"), rows, force)?);
+    Ok(written)
+}
+
+fn sanitize(s: &str) -> String {
+    s.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// One scene's rows as a markdown table (what `bench` prints and logs).
+pub fn bench_table(rows: &[&Row]) -> String {
+    let mut md = String::from(
+        "| method | wrapper | build ms | wrapper ms | SAH | depth | tightness | tests/query |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {:.3} | {:.3} | {:.2} | {} | {} | {} |",
+            r.method,
+            r.wrapper,
+            r.build_s * 1e3,
+            r.wrapper_s * 1e3,
+            r.quality.sah,
+            r.quality.depth_max,
+            r.tightness.map(|t| format!("{t:.4}")).unwrap_or_default(),
+            r.query
+                .as_ref()
+                .map(|q| format!("{:.1}", query_values(q)[6]))
+                .unwrap_or_default()
+        );
+    }
+    md
+}
+
+/// Per scene: the two charts as 2D views beside the results table.
+fn bench_blueprint(rows: &[Row]) -> Blueprint {
+    let views: Vec<ContainerLike> = scenes_of(rows)
+        .into_iter()
+        .map(|s| {
+            let at = |leaf: &str| EntityPath::from(vec!["bench".into(), s.into(), leaf.into()]);
+            Horizontal::new([
+                Spatial2DView::new(format!(
+                    "{s}: build time (log, →) vs node tests per query (↑)"
+                ))
+                .with_origin(at("time_vs_query").to_string())
+                .into(),
+                Spatial2DView::new(format!("{s}: wrapper time (log, →) vs tightness (↑)"))
+                    .with_origin(at("wrapper_time_vs_tightness").to_string())
+                    .into(),
+                TextDocumentView::new(format!("{s}: results"))
+                    .with_origin(at("table").to_string())
+                    .into(),
+            ])
+            .into()
+        })
+        .collect();
+    Blueprint::new(Vertical::new(views))
+}
+
+fn scenes_of(rows: &[Row]) -> Vec<&str> {
+    let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
+    scenes.dedup();
+    scenes
+}
+
+/// Maps chart points into a 100 × 100 square (x = log10 of the first coordinate, larger y
+/// drawn higher), as the 2D view keeps a 1:1 aspect.
+fn chart_square(points: &[(f64, f64)]) -> Vec<(f32, f32)> {
+    let xs: Vec<f64> = points.iter().map(|p| p.0.max(1e-12).log10()).collect();
+    let span = |v: &mut dyn Iterator<Item = f64>| {
+        v.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+            (lo.min(x), hi.max(x))
+        })
+    };
+    let (x0, x1) = span(&mut xs.iter().copied());
+    let (y0, y1) = span(&mut points.iter().map(|p| p.1));
+    let scale = |v: f64, lo: f64, hi: f64| {
+        if hi > lo {
+            100.0 * (v - lo) / (hi - lo)
+        } else {
+            50.0
+        }
+    };
+    xs.iter()
+        .zip(points)
+        .map(|(&x, p)| (scale(x, x0, x1) as f32, (100.0 - scale(p.1, y0, y1)) as f32))
+        .collect()
+}
+
+/// Logs one chart: a labelled point series per group and the Pareto front as a line.
+fn log_chart(
+    rec: &rerun::RecordingStream,
+    base: &EntityPath,
+    points: &[(String, String, (f64, f64))],
+) -> Result<()> {
+    let xy: Vec<(f64, f64)> = points.iter().map(|p| p.2).collect();
+    let square = chart_square(&xy);
+    let mut groups: Vec<&str> = Vec::new();
+    for (g, ..) in points {
+        if !groups.contains(&g.as_str()) {
+            groups.push(g);
+        }
+    }
+    for (k, g) in groups.iter().enumerate() {
+        let idx: Vec<usize> = (0..points.len()).filter(|&i| points[i].0 == *g).collect();
+        let c = crate::render::chart::color(k);
+        rec.log_static(
+            base.join(&EntityPath::from(vec![(*g).into()])),
+            &rerun::Points2D::new(idx.iter().map(|&i| square[i]))
+                .with_labels(idx.iter().map(|&i| points[i].1.clone()))
+                .with_colors([rerun::Color::from_rgb(c.0, c.1, c.2)])
+                .with_radii([rerun::components::Radius::new_ui_points(5.0)]),
+        )?;
+    }
+    let front: Vec<(f32, f32)> = pareto_front(&xy).into_iter().map(|i| square[i]).collect();
+    rec.log_static(
+        base.join(&EntityPath::from(vec!["pareto_front".into()])),
+        &rerun::LineStrips2D::new([front]).with_colors([rerun::Color::from_rgb(230, 230, 230)]),
+    )?;
+    Ok(())
+}
+
+/// Logs, per scene, the two charts of [`bench_charts`] as static 2D points (one entity per
+/// method, resp. wrapper, each point labelled with its values; the Pareto front as a line) in
+/// a 100 × 100 chart square, and the results as a markdown table.
+fn bench_rrd(path: &Path, rows: &[Row], force: bool) -> Result<PathBuf> {
+    let file = SeriesFile::create(path, "wraptree_bench", force, Some(bench_blueprint(rows)))?;
+    let rec = file.rec();
+    for scene in scenes_of(rows) {
+        let rows: Vec<&Row> = rows.iter().filter(|r| r.scene == scene).collect();
+        let at = |leaf: &str| EntityPath::from(vec!["bench".into(), scene.into(), leaf.into()]);
+        let query: Vec<(String, String, (f64, f64))> = rows
+            .iter()
+            .filter_map(|r| {
+                let y = query_values(r.query.as_ref()?)[6];
+                let t = r.build_s + r.wrapper_s;
+                let label = format!(
+                    "{} + {}: {:.3} ms, {y:.0} tests",
+                    r.method,
+                    r.wrapper,
+                    t * 1e3
+                );
+                Some((r.method.to_string(), label, (t, y)))
+            })
+            .collect();
+        log_chart(rec, &at("time_vs_query"), &query)?;
+        let tight: Vec<(String, String, (f64, f64))> = rows
+            .iter()
+            .filter_map(|r| {
+                let y = r.tightness?;
+                let label = format!(
+                    "{} on {}: {:.3} ms, {y:.3}",
+                    r.wrapper,
+                    r.method,
+                    r.wrapper_s * 1e3
+                );
+                (r.wrapper_s > 0.0).then(|| (r.wrapper.to_string(), label, (r.wrapper_s, y)))
+            })
+            .collect();
+        if !tight.is_empty() {
+            log_chart(rec, &at("wrapper_time_vs_tightness"), &tight)?;
+        }
+        let md = bench_table(&rows);
+        rec.log_static(
+            at("table"),
+            &rerun::TextDocument::new(md).with_media_type(rerun::MediaType::markdown()),
+        )?;
+    }
+    file.commit()
+}

@@ -1,0 +1,69 @@
+//! Results of `bench` and `sweep` as files: CSV tables, charts (SVG + PNG) and `.rrd` series.
+//!
+//! - [`bench`](mod@bench): `results.csv`, the two charts per scene and `bench.rrd`;
+//! - [`sweep`](mod@sweep): `sweep.csv`, the heat maps and `sweep.rrd`.
+
+mod bench;
+mod sweep;
+
+pub use bench::{bench_charts, bench_csv, bench_table, write_bench};
+pub use sweep::{SweepRrd, setting_name, sweep_csv, sweep_heat_maps, write_sweep};
+
+use crate::query::QueryCost;
+use crate::record::output::write_atomic;
+use crate::render::chart::Series;
+use crate::render::svg_to_png;
+use anyhow::{Result, anyhow};
+use std::path::{Path, PathBuf};
+
+/// Chart size in pixels.
+pub(super) const SIZE: (u32, u32) = (960, 640);
+
+pub(super) fn opt(v: Option<f64>) -> String {
+    v.map_or_else(String::new, |x| format!("{x:.6e}"))
+}
+
+/// Columns of a query cost: node (BV) and primitive tests per query of each kind, the eq. (1)
+/// total per query, and seconds for the whole workload.
+pub(super) const QUERY_COLUMNS: &str = "point_bv,point_prim,distance_bv,distance_prim,overlap_bv,overlap_prim,\
+node_tests_per_query,query_cost,query_s";
+
+pub(super) fn query_fields(q: Option<&QueryCost>) -> String {
+    match q {
+        None => ",".repeat(QUERY_COLUMNS.matches(',').count()),
+        Some(q) => {
+            let v = crate::metrics::compare::query_values(q);
+            v.iter()
+                .map(|x| format!("{x:.6e}"))
+                .collect::<Vec<_>>()
+                .join(",")
+        }
+    }
+}
+
+/// Writes `stem.svg` and `stem.png` in `dir`; returns both paths.
+pub(super) fn write_chart(dir: &Path, stem: &str, svg: &str, force: bool) -> Result<Vec<PathBuf>> {
+    let png = svg_to_png(svg).map_err(|e| anyhow!("{stem}: {e}"))?;
+    let (s, p) = (
+        dir.join(format!("{stem}.svg")),
+        dir.join(format!("{stem}.png")),
+    );
+    write_atomic(&s, svg.as_bytes(), force)?;
+    write_atomic(&p, &png, force)?;
+    Ok(vec![s, p])
+}
+
+/// Groups points by a key in first-seen order.
+pub(super) fn series_by<'a>(rows: impl Iterator<Item = (String, (f64, f64))> + 'a) -> Vec<Series> {
+    let mut out: Vec<Series> = Vec::new();
+    for (label, p) in rows {
+        match out.iter_mut().find(|s| s.label == label) {
+            Some(s) => s.points.push(p),
+            None => out.push(Series {
+                label,
+                points: vec![p],
+            }),
+        }
+    }
+    out
+}
