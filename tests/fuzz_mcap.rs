@@ -21,7 +21,7 @@ mod common;
 
 use mcap::records::{MessageHeader, Record};
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
+use proptest::test_runner::{TestCaseError, TestRunner};
 use sha2::{Digest, Sha256};
 use std::borrow::Cow;
 use std::cell::Cell;
@@ -40,20 +40,9 @@ use wraptree::wrap::{SphereMethod, sphere_tree};
 /// Cases per run unless `WRAPTREE_FUZZ_CASES` says otherwise.
 const DEFAULT_CASES: u32 = 1536;
 
+/// This target's case count and runner.
 fn runner(salt: u64) -> (u32, TestRunner) {
-    let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<u64>().ok());
-    let cases = env("WRAPTREE_FUZZ_CASES").map_or(DEFAULT_CASES, |c| c as u32);
-    let seed = env("WRAPTREE_FUZZ_SEED").unwrap_or(0) ^ salt;
-    let mut bytes = [0u8; 32];
-    bytes[..8].copy_from_slice(&seed.to_le_bytes());
-    let config = Config {
-        cases,
-        failure_persistence: None,
-        max_shrink_iters: 256,
-        ..Config::default()
-    };
-    let rng = TestRng::from_seed(RngAlgorithm::ChaCha, &bytes);
-    (cases, TestRunner::new_with_rng(config, rng))
+    common::fuzz_runner(salt, DEFAULT_CASES)
 }
 
 /// Sets `stop` once `after` merges were seen.

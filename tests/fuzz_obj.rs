@@ -19,7 +19,7 @@
 mod common;
 
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
+use proptest::test_runner::{TestCaseError, TestRunner};
 use std::cell::Cell;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -29,22 +29,9 @@ use wraptree::scene::{LoadOptions, Scene, load_bytes};
 /// Cases per run unless `WRAPTREE_FUZZ_CASES` says otherwise.
 const DEFAULT_CASES: u32 = 16384;
 
-/// The number of cases and the runner for one fuzz target (deterministic unless
-/// `WRAPTREE_FUZZ_SEED` is set).
+/// This target's case count and runner.
 fn runner(salt: u64) -> (u32, TestRunner) {
-    let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<u64>().ok());
-    let cases = env("WRAPTREE_FUZZ_CASES").map_or(DEFAULT_CASES, |c| c as u32);
-    let seed = env("WRAPTREE_FUZZ_SEED").unwrap_or(0) ^ salt;
-    let mut bytes = [0u8; 32];
-    bytes[..8].copy_from_slice(&seed.to_le_bytes());
-    let config = Config {
-        cases,
-        failure_persistence: None,
-        max_shrink_iters: 256,
-        ..Config::default()
-    };
-    let rng = TestRng::from_seed(RngAlgorithm::ChaCha, &bytes);
-    (cases, TestRunner::new_with_rng(config, rng))
+    common::fuzz_runner(salt, DEFAULT_CASES)
 }
 
 /// The first `faces` faces of a bundled scene, with every vertex line before the last of them.

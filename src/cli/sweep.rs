@@ -6,8 +6,7 @@ use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use wraptree::grouping::{PSet, Params};
-use wraptree::metrics::compare::query_values;
-use wraptree::metrics::report::{SweepRrd, setting_name, write_sweep};
+use wraptree::metrics::report::{SweepRrd, setting_name, sweep_table, write_sweep};
 use wraptree::metrics::sweep::{grid, sweep};
 
 /// Arguments of `wraptree sweep`.
@@ -63,24 +62,7 @@ impl SweepCmd {
             rrd.setting(w, merges)
         })?;
         bar.finish_and_clear();
-        println!(
-            "{:>6} {:>6} {:>6} {:>10} {:>7} {:>6} {:>9} {:>9} {:>10}",
-            "A", "B", "C", "group ms", "rounds", "depth", "SAH", "balance", "tests/qry"
-        );
-        for r in &rows {
-            println!(
-                "{:>6} {:>6} {:>6} {:>10.2} {:>7} {:>6} {:>9.3} {:>9.3} {:>10.1}",
-                r.weights.a,
-                r.weights.b,
-                r.weights.c,
-                r.build_s * 1e3,
-                r.rounds,
-                r.quality.depth_max,
-                r.quality.sah,
-                r.quality.structural_balance,
-                query_values(&r.query)[6]
-            );
-        }
+        print!("{}", sweep_table(&rows));
         let mut written = write_sweep(&dir, &scene.name, &rows, self.force)?;
         written.push(rrd.finish(&rows)?);
         for p in written {

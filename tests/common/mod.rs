@@ -112,3 +112,23 @@ pub fn assert_one_line_error(out: &std::process::Output, needle: &str) {
     );
     assert!(!err.contains("panicked"), "no panic: {err}");
 }
+
+/// The number of cases and a deterministic proptest runner for one fuzz target: `default`
+/// cases unless `WRAPTREE_FUZZ_CASES` says otherwise, seeded by `salt` XOR
+/// `WRAPTREE_FUZZ_SEED` (0 if unset).
+pub fn fuzz_runner(salt: u64, default: u32) -> (u32, proptest::test_runner::TestRunner) {
+    use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+    let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<u64>().ok());
+    let cases = env("WRAPTREE_FUZZ_CASES").map_or(default, |c| c as u32);
+    let seed = env("WRAPTREE_FUZZ_SEED").unwrap_or(0) ^ salt;
+    let mut bytes = [0u8; 32];
+    bytes[..8].copy_from_slice(&seed.to_le_bytes());
+    let config = Config {
+        cases,
+        failure_persistence: None,
+        max_shrink_iters: 256,
+        ..Config::default()
+    };
+    let rng = TestRng::from_seed(RngAlgorithm::ChaCha, &bytes);
+    (cases, TestRunner::new_with_rng(config, rng))
+}

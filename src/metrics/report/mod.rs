@@ -7,7 +7,7 @@ mod bench;
 mod sweep;
 
 pub use bench::{bench_charts, bench_csv, bench_table, write_bench};
-pub use sweep::{SweepRrd, setting_name, sweep_csv, sweep_heat_maps, write_sweep};
+pub use sweep::{SweepRrd, setting_name, sweep_csv, sweep_heat_maps, sweep_table, write_sweep};
 
 use crate::query::QueryCost;
 use crate::record::output::write_atomic;

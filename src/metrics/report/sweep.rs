@@ -127,6 +127,28 @@ pub struct SweepRrd(SeriesFile);
 /// The per-merge series of each setting.
 const SWEEP_SERIES: [&str; 5] = ["cost", "diameter", "fill", "balance", "queue_len"];
 
+/// The sweep as a markdown table, one row per setting in grid order (what `sweep` prints and
+/// logs as `summary/table`).
+pub fn sweep_table(rows: &[SweepRow]) -> String {
+    let mut md = String::from(
+        "| tick | setting | group ms | rounds | depth | SAH | balance | tests/query |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    for (k, r) in rows.iter().enumerate() {
+        let _ = writeln!(
+            md,
+            "| {k} | {} | {:.2} | {} | {} | {:.3} | {:.3} | {:.1} |",
+            setting_name(&r.weights),
+            r.build_s * 1e3,
+            r.rounds,
+            r.quality.depth_max,
+            r.quality.sah,
+            r.quality.structural_balance,
+            query_values(&r.query)[6]
+        );
+    }
+    md
+}
+
 /// Entity name of one setting.
 pub fn setting_name(w: &Weights) -> String {
     format!("A{}_B{}_C{}", w.a, w.b, w.c)
@@ -218,22 +240,7 @@ impl SweepRrd {
                 rerun::Scalars::new(values).columns_of_unit_batches()?,
             )?;
         }
-        let mut md = String::from(
-            "| tick | setting | group ms | rounds | depth | SAH | balance | tests/query |\n|---|---|---|---|---|---|---|---|\n",
-        );
-        for (k, r) in rows.iter().enumerate() {
-            let _ = writeln!(
-                md,
-                "| {k} | {} | {:.2} | {} | {} | {:.3} | {:.3} | {:.1} |",
-                setting_name(&r.weights),
-                r.build_s * 1e3,
-                r.rounds,
-                r.quality.depth_max,
-                r.quality.sah,
-                r.quality.structural_balance,
-                query_values(&r.query)[6]
-            );
-        }
+        let md = sweep_table(rows);
         rec.log_static(
             "summary/table",
             &rerun::TextDocument::new(md).with_media_type(rerun::MediaType::markdown()),
