@@ -427,3 +427,23 @@ fn hull_wrappers_hold_their_vertices_across_12_decades() {
     let e = worst(&s, &g.tree, WrapperTree::Hulls(&h));
     assert!(e <= 0.0, "a vertex {e:e} outside its hull beyond tolerance");
 }
+
+/// N coincident triangles: every Cost ties, so the literal queue of every eligible pair merges
+/// the two live bodies of smallest tie tag (the id, unseeded) each time. The partner searches
+/// must keep that order with O(N²) candidate examinations: bodies of identical geometry that
+/// re-search between two merges share one scan, where one scan each would make it O(N³).
+#[test]
+fn coincident_bodies_merge_smallest_ids_first_in_quadratic_work() {
+    let n = 600;
+    let s = path::coincident(n);
+    let (g, log) = common::run(&s, &Params::default());
+    common::check_tree(&s, &g, &log);
+    let mut live: std::collections::BTreeSet<u32> = (0..n as u32).collect();
+    for (i, m) in log.merges.iter().enumerate() {
+        let (a, b) = (live.pop_first().unwrap(), live.pop_first().unwrap());
+        assert_eq!((m.a, m.b), (a, b), "merge {i}");
+        live.insert(m.new);
+    }
+    let c = g.stats.candidates;
+    assert!(c < 8 * (n * n) as u64, "{c} candidates for {n} bodies");
+}

@@ -12,7 +12,10 @@ use crate::geom::Aabb;
 use crate::scene::Scene;
 use std::sync::atomic::Ordering;
 
+mod keys;
 mod scan;
+
+use keys::{spread_bits, tie_tag};
 
 /// What the round loop needs from a p-set wrapper beyond each body's AABB and diameter.
 pub(super) trait PSetBodies {
@@ -99,19 +102,6 @@ impl ScanLimit<'_> {
     }
 }
 
-/// splitmix64: the seeded tie tag of a body id.
-fn tie_tag(seed: Option<u64>, id: u32) -> u64 {
-    match seed {
-        None => id as u64,
-        Some(s) => {
-            let mut z = s ^ (id as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            z ^ (z >> 31)
-        }
-    }
-}
-
 /// Fill and Balance of a would-be parent of diameter `d` over children of diameters `dx`, `dy`.
 ///
 /// Point-like children (diameter 0) get documented fallbacks: Fill = 1 when both children are
@@ -128,17 +118,6 @@ pub(super) fn fill_balance(d: f64, dx: f64, dy: f64) -> (f64, f64) {
         1.0
     };
     (fill, balance)
-}
-
-/// Spreads the low 21 bits of `v` to every third bit.
-fn spread_bits(v: u64) -> u64 {
-    let mut x = v & 0x1f_ffff;
-    x = (x | x << 32) & 0x001f_0000_0000_ffff;
-    x = (x | x << 16) & 0x001f_0000_ff00_00ff;
-    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
-    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
-    x = (x | x << 2) & 0x1249_2492_4924_9249;
-    x
 }
 
 /// The state of one grouping run.
@@ -173,6 +152,8 @@ struct Clusterer<P, O> {
     /// Whether the scene coordinates are below 1e100 in magnitude (AABB p-set, `prune`), so
     /// the searches' sqrt-free Cost filter keeps its operands in range.
     quick: bool,
+    /// The last AABB partner search, reused while the voxel hash is unchanged.
+    memo: Option<scan::Memo>,
     stats: Stats,
 }
 
@@ -233,6 +214,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             quick: prune
                 && finite
                 && (0..3).all(|k| bounds.min[k].abs() < 1e100 && bounds.max[k].abs() < 1e100),
+            memo: None,
             stats: Stats::default(),
         }
     }

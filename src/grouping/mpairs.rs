@@ -162,24 +162,40 @@ pub struct Cand {
     pub partner: u32,
 }
 
-/// A body's partner list, cheapest first.
+/// A list of at most `C` partners, cheapest first.
 #[derive(Clone, Copy, Debug)]
-pub struct List {
-    e: [Cand; K_MAX],
+pub struct Top<const C: usize> {
+    e: [Cand; C],
     len: u8,
     next: u8,
 }
 
-impl List {
+/// A body's partner list.
+pub type List = Top<K_MAX>;
+
+impl<const C: usize> Top<C> {
     /// An empty list.
-    pub const EMPTY: List = List {
+    pub const EMPTY: Top<C> = Top {
         e: [Cand {
             cost: 0.0,
             partner: u32::MAX,
-        }; K_MAX],
+        }; C],
         len: 0,
         next: 0,
     };
+
+    /// The first `k` (at most `D`) entries whose partner is not `x`, in order.
+    #[inline]
+    pub fn without<const D: usize>(&self, x: u32, k: usize) -> Top<D> {
+        let mut out = Top::<D>::EMPTY;
+        for c in &self.e[..self.len as usize] {
+            if (out.len as usize) < k.min(D) && c.partner != x {
+                out.e[out.len as usize] = *c;
+                out.len += 1;
+            }
+        }
+        out
+    }
 
     /// The Cost above which a candidate cannot enter a list of capacity `k`.
     #[inline]

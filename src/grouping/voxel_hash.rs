@@ -89,6 +89,8 @@ pub struct VoxelHash {
     recs: Vec<Rec>,
     /// Arena position and cell of every body id (valid while the body is stored).
     at: Vec<(u32, u32)>,
+    /// Bumped by every build, insertion and removal.
+    version: u64,
 }
 
 impl Default for VoxelHash {
@@ -103,6 +105,7 @@ impl Default for VoxelHash {
             coords: Vec::new(),
             recs: Vec::new(),
             at: Vec::new(),
+            version: 0,
         }
     }
 }
@@ -121,6 +124,7 @@ impl VoxelHash {
         slots: &[u32],
         ids: usize,
     ) {
+        self.version += 1;
         self.inv_csize = 1.0 / csize;
         let all = bodies
             .iter()
@@ -263,6 +267,7 @@ impl VoxelHash {
 
     /// Adds body `id` (partner-list slot `slot`) by the centre of its box.
     pub fn insert(&mut self, id: u32, aabb: &Aabb, diameter: f64, slot: u32) {
+        self.version += 1;
         if self.at.len() <= id as usize {
             self.at.resize(id as usize + 1, (0, NO_CELL));
         }
@@ -280,6 +285,7 @@ impl VoxelHash {
 
     /// Removes body `id` (which must be stored).
     pub fn remove(&mut self, id: u32) {
+        self.version += 1;
         let (i, c) = self.at[id as usize];
         let cell = &mut self.cells[c as usize];
         cell.len -= 1;
@@ -288,6 +294,12 @@ impl VoxelHash {
         let moved = self.recs[i as usize].id;
         self.at[moved as usize].0 = i;
         self.at[id as usize].1 = NO_CELL;
+    }
+
+    /// A number that changes whenever the stored bodies or the voxel edge change.
+    #[inline]
+    pub fn version(&self) -> u64 {
+        self.version
     }
 
     /// Number of cells (voxels that held a body this round).

@@ -23,6 +23,12 @@
 //!   so it never exceeds a Cost it bounds, and is lowered by 1e-9 relative for `powf` and the
 //!   rounding of the Fill bound's sum.
 //!
+//! A search keeps one partner more than a list holds and counts the searcher as a candidate of
+//! itself, so its result, with the searcher dropped, serves every body of bit-identical box and
+//! diameter: their candidates' keys are the same, and the candidates differ only by which body
+//! is left out. The last result is kept ([`Memo`]) until the voxel hash changes, so N coincident
+//! bodies re-searching between two merges cost one scan, not N.
+//!
 //! With C = 0 and B > 0 the pair Cost skips Balance (then weighted by zero), bit for bit the
 //! same value. Other p-sets search every candidate for the single best partner, as in the paper.
 
@@ -30,8 +36,16 @@ use super::{Clusterer, PSetBodies, ScanLimit, fill_balance};
 use crate::geom::{Aabb, P3, V3};
 use crate::grouping::Weights;
 use crate::grouping::events::Observer;
-use crate::grouping::mpairs::List;
+use crate::grouping::mpairs::{K_MAX, List, Top};
 use crate::grouping::voxel_hash::CellBounds;
+
+/// The last AABB search (see the module doc): the bits of its searcher's box and diameter and
+/// the voxel hash version, and the first `K_MAX + 1` partners in key order of all stored bodies,
+/// the searcher included.
+pub(super) struct Memo {
+    key: ([u64; 6], u64, u64),
+    top: Top<{ K_MAX + 1 }>,
+}
 
 /// Cost of a pair of AABB bodies whose merged box has diagonal `d`; `A` = 1 or 0 selects the
 /// exponent without `powf` (any other value uses `w.a`).
@@ -278,8 +292,21 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         let (k, w) = (self.k, self.params.weights);
         let xa = self.aabb[x as usize];
         let dx = self.diameter[x as usize];
-        let (lo, hi) = self.query(&xa, glimit);
         let hash = &self.hash;
+        let b = |p: &P3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+        let (l, h) = (b(&xa.min), b(&xa.max));
+        let key = (
+            [l[0], l[1], l[2], h[0], h[1], h[2]],
+            dx.to_bits(),
+            hash.version(),
+        );
+        if let Some(m) = &self.memo
+            && m.key == key
+        {
+            *self.partners.get(x) = m.top.without(x, k);
+            return;
+        }
+        let (lo, hi) = self.query(&xa, glimit);
         let prune = self.prune;
         let mut cells: [(f64, u32); 64] = [(0.0, 0); 64];
         let mut n = 0;
@@ -315,7 +342,9 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                 }
             }
         }
-        let mut list = List::EMPTY;
+        // One more partner than a list holds, and `x` among the candidates (see [`Memo`]).
+        let mut list = Top::<{ K_MAX + 1 }>::EMPTY;
+        let wide = k + 1;
         let mut candidates = 0u64;
         let tags = &self.tag;
         let cells: &mut [(f64, u32)] = if overflow.is_empty() {
@@ -337,13 +366,13 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         };
         let quick = Quick::new(&w, self.quick);
         for &(bound, cell) in cells.iter() {
-            let mut bar = list.bar(k);
+            let mut bar = list.bar(wide);
             if bound > bar {
                 break;
             }
             for r in hash.recs(cell) {
                 candidates += 1;
-                if r.id == x || apart(&xa, &r.aabb, glimit) {
+                if apart(&xa, &r.aabb, glimit) {
                     continue;
                 }
                 let e = merged_extents(&xa, &r.aabb);
@@ -353,12 +382,13 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                     continue;
                 }
                 let cost = pair_cost::<A>(&w, e.norm(), dx, r.diameter);
-                list.offer(k, cost, r.id, tags);
-                bar = list.bar(k);
+                list.offer(wide, cost, r.id, tags);
+                bar = list.bar(wide);
             }
         }
         self.stats.candidates += candidates;
-        *self.partners.get(x) = list;
+        *self.partners.get(x) = list.without(x, k);
+        self.memo = Some(Memo { key, top: list });
     }
 
     /// The best partner of `x` over every candidate (any p-set); returns the number of
