@@ -3,7 +3,7 @@
 //! the grouping thread only copies each event (a `Merge` is plain data; a round start's active
 //! list is the one allocation) into a batch and sends full batches down a bounded channel.
 
-use crate::grouping::{Event, Merge, Observer};
+use crate::grouping::{Event, Observer};
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 
 /// Events per batch sent to the worker.
@@ -11,34 +11,12 @@ const BATCH: usize = 1024;
 /// Batches in flight before the grouping thread waits for the worker.
 const IN_FLIGHT: usize = 64;
 
-/// An owned copy of an [`Event`].
+/// An owned copy of an [`Event`]: the event itself with a round start's active list moved
+/// into `active` (the only borrowed field).
 #[derive(Clone, Debug)]
-enum Owned {
-    RoundStart {
-        round: u32,
-        dlimit: f64,
-        glimit: f64,
-        active: Vec<u32>,
-        dormant: u32,
-        pairs: u64,
-    },
-    Merge(Merge),
-    Dormant {
-        round: u32,
-        body: u32,
-        diameter: f64,
-    },
-    Doubling {
-        round: u32,
-        merges: u32,
-        dlimit: f64,
-        glimit: f64,
-    },
-    Finish {
-        root: u32,
-        rounds: u32,
-        merges: u32,
-    },
+struct Owned {
+    event: Event<'static>,
+    active: Vec<u32>,
 }
 
 impl Owned {
@@ -51,94 +29,75 @@ impl Owned {
                 active,
                 dormant,
                 pairs,
-            } => Owned::RoundStart {
-                round,
-                dlimit,
-                glimit,
+            } => Owned {
+                event: Event::RoundStart {
+                    round,
+                    dlimit,
+                    glimit,
+                    active: &[],
+                    dormant,
+                    pairs,
+                },
                 active: active.to_vec(),
-                dormant,
-                pairs,
             },
-            Event::Merge(m) => Owned::Merge(m),
+            Event::Merge(m) => Owned::plain(Event::Merge(m)),
             Event::Dormant {
                 round,
                 body,
                 diameter,
-            } => Owned::Dormant {
+            } => Owned::plain(Event::Dormant {
                 round,
                 body,
                 diameter,
-            },
+            }),
             Event::Doubling {
                 round,
                 merges,
                 dlimit,
                 glimit,
-            } => Owned::Doubling {
+            } => Owned::plain(Event::Doubling {
                 round,
                 merges,
                 dlimit,
                 glimit,
-            },
+            }),
             Event::Finish {
                 root,
                 rounds,
                 merges,
-            } => Owned::Finish {
+            } => Owned::plain(Event::Finish {
                 root,
                 rounds,
                 merges,
-            },
+            }),
+        }
+    }
+
+    fn plain(event: Event<'static>) -> Owned {
+        Owned {
+            event,
+            active: Vec::new(),
         }
     }
 
     fn event(&self) -> Event<'_> {
-        match self {
-            Owned::RoundStart {
+        match self.event {
+            Event::RoundStart {
                 round,
                 dlimit,
                 glimit,
-                active,
                 dormant,
                 pairs,
+                ..
             } => Event::RoundStart {
-                round: *round,
-                dlimit: *dlimit,
-                glimit: *glimit,
-                active,
-                dormant: *dormant,
-                pairs: *pairs,
-            },
-            Owned::Merge(m) => Event::Merge(*m),
-            &Owned::Dormant {
                 round,
-                body,
-                diameter,
-            } => Event::Dormant {
-                round,
-                body,
-                diameter,
-            },
-            &Owned::Doubling {
-                round,
-                merges,
                 dlimit,
                 glimit,
-            } => Event::Doubling {
-                round,
-                merges,
-                dlimit,
-                glimit,
+                active: &self.active,
+                dormant,
+                pairs,
             },
-            &Owned::Finish {
-                root,
-                rounds,
-                merges,
-            } => Event::Finish {
-                root,
-                rounds,
-                merges,
-            },
+            e => e,
         }
     }
 }
