@@ -30,8 +30,7 @@ use std::io::Cursor;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
-use wraptree::geom::Aabb;
-use wraptree::grouping::{Budget, Event, Observer, Params, SubsetTree, Tee, group_within};
+use wraptree::grouping::{Budget, Event, Observer, Params, Tee, group_within};
 use wraptree::record::mcap::{McapRecorder, metadata, read_recording};
 use wraptree::record::{Detail, Outcome, RunInfo};
 use wraptree::scene::{LoadOptions, Loaded, load_bytes};
@@ -403,15 +402,8 @@ fn replay_steps(rec: &wraptree::record::mcap::Recorded) -> Result<(), TestCaseEr
     if s.len() as u32 != rec.primitives {
         return Ok(());
     }
-    let boxes: Vec<Aabb> = (0..s.len()).map(|i| s.prim_aabb(i)).collect();
-    let diam = boxes.iter().map(Aabb::diameter).collect();
-    let merges: Vec<_> = rec
-        .merges
-        .iter()
-        .map(|m| (m.a, m.b, m.aabb, m.diameter))
-        .collect();
     if rec.complete {
-        let _ = SubsetTree::from_merges(boxes, diam, &merges);
+        let _ = rec.tree(s);
     }
     Ok(())
 }

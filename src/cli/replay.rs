@@ -7,7 +7,6 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
-use wraptree::geom::Aabb;
 use wraptree::grouping::{
     Event, EventLog, Merge, Observer, ResolvedParams, Stopped, SubsetTree, Weights, group_within,
 };
@@ -117,15 +116,7 @@ impl Observer for UpTo<'_> {
 
 /// The Subset Tree rebuilt from the recorded merges alone (leaf boxes from the embedded scene).
 fn tree_of(rec: &Recorded, loaded: &Loaded) -> Result<SubsetTree> {
-    let s = &loaded.scene;
-    let boxes: Vec<Aabb> = (0..s.len()).map(|i| s.prim_aabb(i)).collect();
-    let diam = boxes.iter().map(Aabb::diameter).collect();
-    let merges: Vec<_> = rec
-        .merges
-        .iter()
-        .map(|m| (m.a, m.b, m.aabb, m.diameter))
-        .collect();
-    SubsetTree::from_merges(boxes, diam, &merges).map_err(anyhow::Error::msg)
+    rec.tree(&loaded.scene).map_err(anyhow::Error::msg)
 }
 
 /// Re-runs the grouping within `limits`, up to `merges` merges when given (the length of an

@@ -7,9 +7,10 @@
 
 use super::messages::{DormantEvent, FinishEvent, MergeEvent, RoundEvent};
 use super::metadata;
-use crate::grouping::{EventLog, Merge, ResolvedParams};
+use crate::geom::Aabb;
+use crate::grouping::{EventLog, Merge, ResolvedParams, SubsetTree};
 use crate::record::Detail;
-use crate::scene::LoadOptions;
+use crate::scene::{LoadOptions, Scene};
 use anyhow::{Result, anyhow, bail};
 use mcap::records::Record;
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
@@ -55,6 +56,19 @@ pub struct Recorded {
 }
 
 impl Recorded {
+    /// The Subset Tree rebuilt from the recorded merges alone, with the leaf boxes and
+    /// diameters of `scene` (the embedded scene, loaded). Fails unless the merges form one tree.
+    pub fn tree(&self, scene: &Scene) -> Result<SubsetTree, String> {
+        let boxes: Vec<Aabb> = (0..scene.len()).map(|i| scene.prim_aabb(i)).collect();
+        let diam = boxes.iter().map(Aabb::diameter).collect();
+        let merges: Vec<_> = self
+            .merges
+            .iter()
+            .map(|m| (m.a, m.b, m.aabb, m.diameter))
+            .collect();
+        SubsetTree::from_merges(boxes, diam, &merges)
+    }
+
     /// The recorded events as an [`EventLog`] (dormant bodies only with merge detail).
     pub fn event_log(&self) -> EventLog {
         EventLog {
