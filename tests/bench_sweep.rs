@@ -20,17 +20,7 @@ print(json.dumps(sorted({c.entity_path for c in r.stream()})))
 "#;
 
 fn entities(path: &Path) -> BTreeSet<String> {
-    let verify = Command::new("rerun")
-        .args(["rrd", "verify"])
-        .arg(path)
-        .output()
-        .expect("the rerun CLI (pip install rerun-sdk==0.36.3) must be on PATH");
-    assert!(
-        verify.status.success(),
-        "rerun rrd verify {}: {}",
-        path.display(),
-        String::from_utf8_lossy(&verify.stderr)
-    );
+    common::assert_rrd_verifies(path);
     let out = Command::new("python3")
         .args(["-c", ENTITIES])
         .arg(path)

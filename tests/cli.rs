@@ -209,16 +209,7 @@ fn interrupted_recording_keeps_what_was_recorded() {
         String::from_utf8_lossy(&rep.stderr)
     );
     assert!(text.contains("incomplete recording"), "{text}");
-    let verify = Command::new("rerun")
-        .args(["rrd", "verify"])
-        .arg(dir.path().join("big.incomplete.rrd"))
-        .output();
-    let verify = verify.expect("the rerun CLI (pip install rerun-sdk==0.36.3) is needed");
-    assert!(
-        verify.status.success(),
-        "{}",
-        String::from_utf8_lossy(&verify.stderr)
-    );
+    common::assert_rrd_verifies(&dir.path().join("big.incomplete.rrd"));
 }
 
 #[test]

@@ -132,3 +132,19 @@ pub fn fuzz_runner(salt: u64, default: u32) -> (u32, proptest::test_runner::Test
     let rng = TestRng::from_seed(RngAlgorithm::ChaCha, &bytes);
     (cases, TestRunner::new_with_rng(config, rng))
 }
+
+/// Asserts that `rerun rrd verify` (PyPI `rerun-sdk==0.36.3`, installed by `.ci/run`) accepts
+/// `path`; a missing CLI fails the test.
+pub fn assert_rrd_verifies(path: &std::path::Path) {
+    let verify = std::process::Command::new("rerun")
+        .args(["rrd", "verify"])
+        .arg(path)
+        .output()
+        .expect("the rerun CLI (pip install rerun-sdk==0.36.3) must be on PATH");
+    assert!(
+        verify.status.success(),
+        "rerun rrd verify {}: {}",
+        path.display(),
+        String::from_utf8_lossy(&verify.stderr)
+    );
+}
