@@ -122,6 +122,8 @@ pub struct Row {
     pub quality: Quality,
     /// Mean relative surface-to-geometry distance of interior wrappers (`None`: not measured).
     pub tightness: Option<f64>,
+    /// The same per level, depth 0 first (empty: not measured).
+    pub tightness_levels: Vec<f64>,
     /// Query cost with this wrapper as bounding volume (`None`: not a query volume).
     pub query: Option<QueryCost>,
 }
@@ -143,21 +145,35 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
     (out, t.elapsed().as_secs_f64())
 }
 
-/// Mean over interior nodes of each node's sampled error over its box diagonal.
+/// Mean over interior nodes of each node's sampled error over its box diagonal, and the
+/// same per level (the cut at each depth, its interior nodes only; 0 for a cut of leaves).
 fn tightness(
     tree: &SubsetTree,
     scene: &Scene,
     w: WrapperTree<'_>,
     hulls: &[Hull],
     k: usize,
-) -> f64 {
+) -> (f64, Vec<f64>) {
     let stats = node_tightness(tree, scene, w, hulls, k);
     let n = tree.leaves();
-    let rel: Vec<f64> = (n..tree.len())
-        .filter(|&x| tree.aabb[x].diameter() > 0.0)
-        .map(|x| stats[x].error / tree.aabb[x].diameter())
+    let rel = |x: usize| {
+        let d = tree.aabb[x].diameter();
+        (d > 0.0).then(|| stats[x].error / d)
+    };
+    let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    let all = mean((n..tree.len()).filter_map(rel).collect());
+    let per_level = (0..=tree.depth_max())
+        .map(|d| {
+            let cut = tree.level(d);
+            mean(
+                cut.into_iter()
+                    .filter(|&x| x as usize >= n)
+                    .filter_map(|x| rel(x as usize))
+                    .collect(),
+            )
+        })
         .collect();
-    rel.iter().sum::<f64>() / rel.len().max(1) as f64
+    (all, per_level)
 }
 
 /// Runs every method × wrapper of `opts` on `scene`, calling `progress` before each method.
@@ -219,6 +235,10 @@ pub fn evaluate(
             };
             let tight =
                 measure_tightness.then(|| tightness(tree, scene, view, &hulls, opts.samples));
+            let (tight, tight_levels) = match tight {
+                Some((t, l)) => (Some(t), l),
+                None => (None, Vec::new()),
+            };
             let query = match wrapper {
                 Wrapper::Box => Some(query::measure(tree, scene, Bv::Aabb, &workload)),
                 Wrapper::Sphere(_) => {
@@ -235,6 +255,7 @@ pub fn evaluate(
                 wrapper_s,
                 quality: q,
                 tightness: tight,
+                tightness_levels: tight_levels,
                 query,
             });
         }

@@ -18,13 +18,13 @@ use std::path::{Path, PathBuf};
 pub fn bench_csv(rows: &[Row]) -> String {
     let mut s = format!(
         "scene,n,method,wrapper,build_s,wrapper_s,sah,depth_max,depth_mean,structural_balance,\
-spatial_balance,tightness,{QUERY_COLUMNS}\n"
+spatial_balance,tightness,tightness_per_level,{QUERY_COLUMNS}\n"
     );
     for r in rows {
         let q = &r.quality;
         let _ = writeln!(
             s,
-            "{},{},{},{},{:.6e},{:.6e},{:.6e},{},{:.4},{:.4},{:.4},{},{}",
+            "{},{},{},{},{:.6e},{:.6e},{:.6e},{},{:.4},{:.4},{:.4},{},{},{}",
             r.scene,
             r.n,
             r.method,
@@ -37,6 +37,11 @@ spatial_balance,tightness,{QUERY_COLUMNS}\n"
             q.structural_balance,
             q.spatial_balance,
             opt(r.tightness),
+            r.tightness_levels
+                .iter()
+                .map(|t| format!("{t:.4}"))
+                .collect::<Vec<_>>()
+                .join(";"),
             query_fields(r.query.as_ref()),
         );
     }
