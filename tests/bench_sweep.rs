@@ -84,6 +84,9 @@ fn bench_writes_one_row_per_method_and_wrapper_with_charts_and_rrd() {
             !row[col("tightness")].is_empty(),
             "small scenes measure tightness"
         );
+        let levels = row[col("tightness_per_level")].split(';').count();
+        let depth: usize = row[col("depth_max")].parse().unwrap();
+        assert_eq!(levels, depth + 1, "one tightness per level: {row:?}");
     }
     for m in Method::ALL {
         assert!(
