@@ -214,8 +214,7 @@ pub fn record_with(
         params,
         detail,
     };
-    let mut rrd = RrdRecorder::new(rrd_file.path(), &info)
-        .with_context(|| format!("{}", rrd_path.display()))?;
+    let mut rrd = RrdRecorder::with_name(rrd_file.path(), &rrd_path, &info)?;
     let writer = std::io::BufWriter::new(mcap_file.file()?);
     let mut mcap =
         McapRecorder::new(writer, &info).with_context(|| format!("{}", mcap_path.display()))?;
@@ -292,7 +291,7 @@ pub fn record_with(
         let mcap_thread = s.spawn(|| mcap.finish(&outcome));
         (rrd.finish(&outcome), mcap_thread.join())
     });
-    rrd_done.with_context(|| format!("{}", rrd_path.display()))?;
+    rrd_done?;
     mcap_done
         .map_err(|_| anyhow!("{}: the MCAP recorder failed", mcap_path.display()))?
         .with_context(|| format!("{}", mcap_path.display()))?;

@@ -1,8 +1,9 @@
 //! The Rerun `.rrd` recorder: the grouping run as a file for the Rerun viewer (SDK 0.36.3).
 //!
-//! [`RrdRecorder`] is an [`Observer`]; it writes with the SDK's RRD encoder through a file sink
-//! that reports write errors (`sink.rs`; no viewer is spawned) and embeds a blueprint
-//! (`blueprint.rs`) so the file opens on a useful layout.
+//! [`RrdRecorder`] is an [`Observer`]; it saves with the SDK's file sink
+//! (`RecordingStreamBuilder::save`, no viewer is spawned), checks at the end that the file is
+//! complete (`sink.rs`), and embeds a blueprint (`blueprint.rs`) so the file opens on a useful
+//! layout.
 //!
 //! # Timelines
 //!
@@ -85,7 +86,6 @@ use crate::grouping::{Event, Observer};
 use crate::record::{Detail, Outcome, RunInfo};
 use columns::MergeColumns;
 use mesh::PrimMesh;
-use sink::RrdFile;
 
 /// Light grey of the input primitives.
 const SCENE_GREY: u32 = 0xC8C8C8FF;
@@ -95,8 +95,10 @@ const ACTIVE_BLUE: u32 = 0x3C78D8A0;
 /// Records a grouping run to a Rerun `.rrd` file; see the [module docs](self) for its layout.
 pub struct RrdRecorder {
     rec: Option<RecordingStream>,
-    file: RrdFile,
+    /// The file written.
     path: PathBuf,
+    /// The path named in errors.
+    name: PathBuf,
     detail: Detail,
     origin: P3,
     /// Box of every body so far, relative to `origin` (only when per-merge geometry is written).
@@ -187,17 +189,18 @@ impl RrdRecorder {
     ///
     /// Fails when the file cannot be created or the first writes fail.
     pub fn new(path: &Path, info: &RunInfo<'_>) -> anyhow::Result<Self> {
+        Self::with_name(path, path, info)
+    }
+
+    /// As [`RrdRecorder::new`], but errors name `name` instead of `path`: the destination that
+    /// a temporary `path` will be renamed to.
+    pub fn with_name(path: &Path, name: &Path, info: &RunInfo<'_>) -> anyhow::Result<Self> {
         let scene = info.scene;
-        let file = RrdFile::create(path)
-            .map_err(|e| file_error(path, "cannot create the Rerun recording", e))?;
-        let rec = rerun::RecordingStreamBuilder::new("wraptree")
+        let builder = rerun::RecordingStreamBuilder::new("wraptree")
             .recording_id(recording_id(info))
-            .enabled(true)
-            .with_blueprint(blueprint::layout(info.detail))
-            .set_sinks(vec![Box::new(file.clone()) as Box<dyn rerun::sink::LogSink>])
-            .map_err(|e| file_error(path, "cannot create the Rerun recording", e))?;
-        rec.set_log_time_enabled(false);
-        rec.set_log_tick_enabled(false);
+            .with_blueprint(blueprint::layout(info.detail));
+        let rec = sink::save(builder, path)
+            .map_err(|e| file_error(name, "cannot create the Rerun recording", e))?;
 
         let bbox = scene.aabb();
         let center = bbox.center();
@@ -215,8 +218,8 @@ impl RrdRecorder {
         };
         let mut recorder = RrdRecorder {
             rec: Some(rec),
-            file,
             path: path.to_path_buf(),
+            name: name.to_path_buf(),
             detail: info.detail,
             origin,
             boxes,
@@ -231,7 +234,7 @@ impl RrdRecorder {
         let mesh = PrimMesh::new(scene, &origin);
         recorder
             .write_header(info, &mesh)
-            .map_err(|e| file_error(path, "cannot write the Rerun recording", e))?;
+            .map_err(|e| file_error(name, "cannot write the Rerun recording", e))?;
         if info.detail.levels() {
             recorder.mesh = Some(mesh);
         }
@@ -407,24 +410,19 @@ impl RrdRecorder {
     }
 
     /// Flushes the series, writes the tree levels (when the detail asks for them and the run
-    /// finished), then ends the file with the RRD footer, flushes and syncs it.
+    /// finished), then ends the file with the RRD footer and checks that it is complete.
     ///
     /// Returns the first error met while recording, if any.
     pub fn finish(mut self, outcome: &Outcome<'_>) -> anyhow::Result<()> {
         let what = "cannot write the Rerun recording";
-        let path = self.path.clone();
-        let fail = |e: anyhow::Error| file_error(&path, what, e);
+        let (path, name) = (self.path.clone(), self.name.clone());
+        let fail = |e: anyhow::Error| file_error(&name, what, e);
         if let Some(err) = self.error.take() {
             return Err(fail(err));
         }
         self.write_tail(outcome).map_err(fail)?;
-        if let Some(rec) = self.rec.take() {
-            rec.flush_blocking().map_err(|e| fail(e.into()))?;
-            // Dropping the last handle shuts the SDK's pipeline down: nothing more reaches
-            // the file, which `close` then ends with the RRD footer.
-            drop(rec);
-        }
-        self.file.close().map_err(fail)
+        let rec = self.rec.take().ok_or_else(closed).map_err(fail)?;
+        sink::close(rec, &path).map_err(fail)
     }
 
     fn write_tail(&mut self, outcome: &Outcome<'_>) -> anyhow::Result<()> {
