@@ -19,7 +19,7 @@ use wraptree::record::{CoverLevel, Detail, Outcome, RunInfo, background};
 use wraptree::scene::{Scene, SceneSource};
 use wraptree::wrap::cover::export::{self, WrapperRecord};
 use wraptree::wrap::cover::{Cover, Fits};
-use wraptree::wrap::{DEFAULT_SAMPLES, SphereMethod, WrapperKind, Wrappers};
+use wraptree::wrap::{DEFAULT_SAMPLES, Sphere, SphereMethod, WrapperKind, Wrappers};
 
 /// Arguments of `wraptree record`.
 #[derive(Args, Debug)]
@@ -204,7 +204,6 @@ pub fn record_with(
             "--cover-tolerance/--cover-budget need --detail levels or full (the cover is a level)"
         );
     }
-    let kinds = logged.kinds;
     let (rrd_path, mcap_path) = (with_ext(prefix, ".rrd"), with_ext(prefix, ".mcap"));
     let rrd_file = Pending::create(&rrd_path, force)?;
     let mcap_file = Pending::create(&mcap_path, force)?;
@@ -215,21 +214,42 @@ pub fn record_with(
         detail,
     };
     let mut rrd = RrdRecorder::with_name(rrd_file.path(), &rrd_path, &info)?;
-    let writer = std::io::BufWriter::new(mcap_file.file()?);
-    let mut mcap =
-        McapRecorder::new(writer, &info).with_context(|| format!("{}", mcap_path.display()))?;
-    mcap.set_reproducible(reproducible);
+    let mcap_out = mcap_file.file()?;
     let stop = stop_flag();
     let start = Instant::now();
     let progress = Progress::for_merges(scene.len() as u64);
-    // The MCAP recorder (protobuf encoding, zstd) runs on a second thread while the grouping
-    // and the Rerun recorder (which forwards to the SDK's own threads) run here.
-    let (result, mcap) = std::thread::scope(|s| {
+    // Three stages overlap: the MCAP recorder (protobuf, zstd) writes its header on its own
+    // thread while the Rerun recorder writes its own here, then consumes the events there while
+    // the grouping and the Rerun recorder run here; finally both files' tails (levels, footers,
+    // sync) are written at the same time.
+    let (rrd_done, mcap_done, grouping, stopped) = std::thread::scope(|s| -> Result<_> {
         let (mut events, worker) = background::channel();
-        let mcap_thread = s.spawn(move || {
-            worker.run(&mut mcap);
-            mcap
-        });
+        let (ready_tx, ready_rx) = std::sync::mpsc::sync_channel(1);
+        let info = &info;
+        let mcap_thread = std::thread::Builder::new()
+            .name("mcap-recorder".into())
+            .spawn_scoped(s, move || {
+                let writer = std::io::BufWriter::new(mcap_out);
+                match McapRecorder::start(writer, info) {
+                    Ok(mut mcap) => {
+                        mcap.set_reproducible(reproducible);
+                        ready_tx.send(None).ok();
+                        mcap.write_scene();
+                        worker.run(&mut mcap);
+                        Some(mcap)
+                    }
+                    Err(e) => {
+                        ready_tx.send(Some(e)).ok();
+                        None
+                    }
+                }
+            })
+            .context("cannot start the MCAP recorder thread")?;
+        match ready_rx.recv() {
+            Ok(None) => {}
+            Ok(Some(e)) => return Err(e.context(mcap_path.display().to_string())),
+            Err(_) => bail!("{}: the MCAP recorder failed", mcap_path.display()),
+        }
         let result = grouping::group_within(
             scene,
             params,
@@ -237,64 +257,37 @@ pub fn record_with(
             &limits.budget(Some(&stop)),
         );
         events.close();
-        (result, mcap_thread.join())
-    });
-    let mcap = mcap.map_err(|_| anyhow!("{}: the MCAP recorder failed", mcap_path.display()))?;
-    let seconds = start.elapsed().as_secs_f64();
-    let (grouping, stopped, merges, rounds) = match result {
-        Ok(g) => {
-            let m = g.tree.leaves() as u32 - 1;
-            let r = g.rounds;
-            (Some(g), None, m, r)
-        }
-        Err(s) => (None, Some(s), s.merges, s.rounds),
-    };
-    let mut wrappers = match (&grouping, detail.levels()) {
-        (Some(g), true) => Some(Wrappers::build(
-            &g.tree,
-            scene,
-            kinds,
-            SphereMethod::AabbCenter,
-        )),
-        _ => None,
-    };
-    // Spheres travel in `Outcome::spheres`; empty = levels without spheres.
-    let spheres = wrappers
-        .as_mut()
-        .map(|w| w.spheres.take().unwrap_or_default());
-    let cover = match (&grouping, logged.cover) {
-        (Some(g), Some((limit, cover_kinds))) => {
-            Some(compute_cover(&g.tree, scene, limit, cover_kinds)?)
-        }
-        _ => None,
-    };
-    let budget = match logged.cover {
-        Some((CoverLimit::Budget(k), _)) => Some(k),
-        _ => None,
-    };
-    let outcome = Outcome {
-        grouping: grouping.as_ref(),
-        spheres: spheres.as_deref(),
-        wrappers: wrappers.as_ref(),
-        cover: cover.as_ref().map(|(cover, wrappers)| CoverLevel {
-            cover,
-            wrappers,
-            budget,
-        }),
-        merges,
-        rounds,
-        seconds,
-        stopped,
-    };
-    // Both files' tails (levels, footers) are written at the same time.
-    let (rrd_done, mcap_done) = std::thread::scope(|s| {
-        let mcap_thread = s.spawn(|| mcap.finish(&outcome));
-        (rrd.finish(&outcome), mcap_thread.join())
-    });
+        let seconds = start.elapsed().as_secs_f64();
+        let (grouping, stopped, merges, rounds) = match result {
+            Ok(g) => {
+                let m = g.tree.leaves() as u32 - 1;
+                let r = g.rounds;
+                (Some(g), None, m, r)
+            }
+            Err(s) => (None, Some(s), s.merges, s.rounds),
+        };
+        let extras = Extras::build(scene, grouping.as_ref(), detail, &logged)?;
+        let outcome = extras.outcome(grouping.as_ref(), merges, rounds, seconds, stopped);
+        let (rrd_done, mcap_done) = std::thread::scope(|t| {
+            let mcap_tail = t.spawn(|| {
+                let mcap =
+                    mcap_thread.join().ok().flatten().ok_or_else(|| {
+                        anyhow!("{}: the MCAP recorder failed", mcap_path.display())
+                    })?;
+                mcap.finish(&outcome)
+                    .with_context(|| mcap_path.display().to_string())?;
+                mcap_file.sync()
+            });
+            let rrd_done = rrd.finish(&outcome).and_then(|()| rrd_file.sync());
+            let mcap_done = mcap_tail
+                .join()
+                .unwrap_or_else(|_| bail!("{}: the MCAP recorder failed", mcap_path.display()));
+            (rrd_done, mcap_done)
+        });
+        Ok((rrd_done, mcap_done, grouping, stopped))
+    })?;
     rrd_done?;
-    mcap_done
-        .map_err(|_| anyhow!("{}: the MCAP recorder failed", mcap_path.display()))?
-        .with_context(|| format!("{}", mcap_path.display()))?;
+    mcap_done?;
     let (rrd_dest, mcap_dest) = if grouping.is_some() {
         (rrd_file.commit()?, mcap_file.commit()?)
     } else {
@@ -313,6 +306,76 @@ pub fn record_with(
         limits,
         seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// What the levels show besides the tree, built after the grouping: the Wrapper Trees and the
+/// cover.
+struct Extras {
+    wrappers: Option<Wrappers>,
+    /// Spheres travel in `Outcome::spheres`; empty = levels without spheres.
+    spheres: Option<Vec<Sphere>>,
+    cover: Option<(Cover, Vec<WrapperRecord>)>,
+    budget: Option<usize>,
+}
+
+impl Extras {
+    fn build(
+        scene: &Scene,
+        grouping: Option<&Grouping>,
+        detail: Detail,
+        logged: &Logged<'_>,
+    ) -> Result<Extras> {
+        let mut wrappers = match (grouping, detail.levels()) {
+            (Some(g), true) => Some(Wrappers::build(
+                &g.tree,
+                scene,
+                logged.kinds,
+                SphereMethod::AabbCenter,
+            )),
+            _ => None,
+        };
+        let spheres = wrappers
+            .as_mut()
+            .map(|w| w.spheres.take().unwrap_or_default());
+        let cover = match (grouping, logged.cover) {
+            (Some(g), Some((limit, kinds))) => Some(compute_cover(&g.tree, scene, limit, kinds)?),
+            _ => None,
+        };
+        let budget = match logged.cover {
+            Some((CoverLimit::Budget(k), _)) => Some(k),
+            _ => None,
+        };
+        Ok(Extras {
+            wrappers,
+            spheres,
+            cover,
+            budget,
+        })
+    }
+
+    fn outcome<'a>(
+        &'a self,
+        grouping: Option<&'a Grouping>,
+        merges: u32,
+        rounds: u32,
+        seconds: f64,
+        stopped: Option<Stopped>,
+    ) -> Outcome<'a> {
+        Outcome {
+            grouping,
+            spheres: self.spheres.as_deref(),
+            wrappers: self.wrappers.as_ref(),
+            cover: self.cover.as_ref().map(|(cover, wrappers)| CoverLevel {
+                cover,
+                wrappers,
+                budget: self.budget,
+            }),
+            merges,
+            rounds,
+            seconds,
+            stopped,
+        }
+    }
 }
 
 /// Success for a finished grouping, else the stop's exit code (3 for a limit, 130 for

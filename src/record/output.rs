@@ -70,6 +70,15 @@ impl Pending {
             .with_context(|| format!("{}: cannot open for writing", self.path().display()))
     }
 
+    /// Syncs the temporary file's data and metadata to disk (done again, cheaply, by
+    /// [`Pending::commit`]); lets two files be synced at the same time before either is moved.
+    pub fn sync(&self) -> Result<()> {
+        self.tmp
+            .as_file()
+            .sync_all()
+            .with_context(|| format!("{}: cannot sync", self.dest.display()))
+    }
+
     /// Syncs the temporary file and renames it over the destination.
     pub fn commit(self) -> Result<PathBuf> {
         self.commit_to(None)

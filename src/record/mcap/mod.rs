@@ -86,6 +86,8 @@ pub struct McapRecorder<'a, W: Write + Seek> {
     writer: mcap::Writer<W>,
     info: RunInfo<'a>,
     topics: Topics,
+    /// The `/scene` channel, written once by [`McapRecorder::write_scene`].
+    scene_topic: Topic,
     scene_update: u16,
     /// AABB of every body seen so far, indexed by body id.
     bodies: Vec<Aabb>,
@@ -129,8 +131,19 @@ fn emit<T: Encode, W: Write + Seek>(
 
 impl<'a, W: Write + Seek> McapRecorder<'a, W> {
     /// Starts a recording: writes the header, schemas, channels, the `/scene` message and the
-    /// scene attachment.
+    /// scene attachment ([`McapRecorder::start`] then [`McapRecorder::write_scene`]).
     pub fn new(writer: W, info: &RunInfo<'a>) -> Result<Self> {
+        let mut rec = Self::start(writer, info)?;
+        rec.write_scene();
+        match rec.error.take() {
+            Some(e) => Err(e),
+            None => Ok(rec),
+        }
+    }
+
+    /// Starts a recording: writes the header, schemas and channels (small; a buffered writer
+    /// holds them), but not yet the scene.
+    pub fn start(writer: W, info: &RunInfo<'a>) -> Result<Self> {
         let options = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
             .compression_level(ZSTD_LEVEL)
@@ -148,7 +161,7 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
         let round_schema = add_schema::<RoundEvent, W>(&mut w)?;
         let merge_schema = add_schema::<MergeEvent, W>(&mut w)?;
         let finish_schema = add_schema::<FinishEvent, W>(&mut w)?;
-        let mut scene_topic = add_topic(&mut w, scene_update, "/scene")?;
+        let scene_topic = add_topic(&mut w, scene_update, "/scene")?;
         let topics = Topics {
             round: add_topic(&mut w, round_schema, "/grouping/round")?,
             merge: add_topic(&mut w, merge_schema, "/grouping/merge")?,
@@ -165,30 +178,6 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             },
         };
         let scene = info.scene;
-        let mut remap = Remap::default();
-        let mut entity = scene_msgs::entity("scene", 0);
-        entity.triangles.push(scene_msgs::triangles(
-            scene,
-            0..scene.len(),
-            scene_msgs::SCENE_COLOR,
-            &mut remap,
-        ));
-        let mut buf = Vec::new();
-        emit(
-            &mut w,
-            &mut buf,
-            &mut scene_topic,
-            0,
-            &scene_msgs::update(vec![entity]),
-        )?;
-        w.attach(&mcap::Attachment {
-            log_time: 0,
-            create_time: 0,
-            name: info.source.file_name.clone(),
-            media_type: SCENE_MEDIA_TYPE.to_string(),
-            data: std::borrow::Cow::Borrowed(&info.source.bytes),
-        })
-        .context("attaching the scene")?;
         let mut bodies = Vec::with_capacity(2 * scene.len());
         bodies.extend((0..scene.len()).map(|i| scene.prim_aabb(i)));
         Ok(McapRecorder {
@@ -200,9 +189,49 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             events: 0,
             reproducible: false,
             error: None,
-            buf,
-            remap,
+            buf: Vec::new(),
+            remap: Remap::default(),
+            scene_topic,
         })
+    }
+
+    /// Writes the `/scene` message (every primitive, once) and attaches the scene file; must
+    /// come before the first event. A failure is kept and returned by [`McapRecorder::finish`],
+    /// like a write error during the run.
+    pub fn write_scene(&mut self) {
+        if self.error.is_none()
+            && let Err(e) = self.try_write_scene()
+        {
+            self.error = Some(e);
+        }
+    }
+
+    fn try_write_scene(&mut self) -> Result<()> {
+        let scene = self.info.scene;
+        let mut entity = scene_msgs::entity("scene", 0);
+        entity.triangles.push(scene_msgs::triangles(
+            scene,
+            0..scene.len(),
+            scene_msgs::SCENE_COLOR,
+            &mut self.remap,
+        ));
+        emit(
+            &mut self.writer,
+            &mut self.buf,
+            &mut self.scene_topic,
+            0,
+            &scene_msgs::update(vec![entity]),
+        )?;
+        self.writer
+            .attach(&mcap::Attachment {
+                log_time: 0,
+                create_time: 0,
+                name: self.info.source.file_name.clone(),
+                media_type: SCENE_MEDIA_TYPE.to_string(),
+                data: std::borrow::Cow::Borrowed(&self.info.source.bytes),
+            })
+            .context("attaching the scene")?;
+        Ok(())
     }
 
     /// Leaves out the `wraptree.timing` record, the only wall-clock value, so two recordings of
