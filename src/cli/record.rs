@@ -213,19 +213,29 @@ pub fn record_with(
         params,
         detail,
     };
-    let mut rrd = RrdRecorder::with_name(rrd_file.path(), &rrd_path, &info)?;
     let mcap_out = mcap_file.file()?;
     let stop = stop_flag();
     let start = Instant::now();
     let progress = Progress::for_merges(scene.len() as u64);
-    // Three stages overlap: the MCAP recorder (protobuf, zstd) writes its header on its own
-    // thread while the Rerun recorder writes its own here, then consumes the events there while
-    // the grouping and the Rerun recorder run here; finally both files' tails (levels, footers,
-    // sync) are written at the same time.
+    // Each recorder runs on its own thread: it starts its file while the grouping starts here,
+    // consumes the events as they come, then writes its tail (levels, footer, sync) at the
+    // same time as the other. The grouping thread only copies events into shared batches.
     let (rrd_done, mcap_done, grouping, stopped) = std::thread::scope(|s| -> Result<_> {
-        let (mut events, worker) = background::channel();
+        let (mut events, workers) = background::fan_out(2);
+        let [rrd_worker, mcap_worker]: [background::Worker; 2] = workers
+            .try_into()
+            .map_err(|_| anyhow!("two event channels"))?;
         let (ready_tx, ready_rx) = std::sync::mpsc::sync_channel(1);
         let info = &info;
+        let (rrd_tmp, rrd_name) = (rrd_file.path(), rrd_path.as_path());
+        let rrd_thread = std::thread::Builder::new()
+            .name("rrd-recorder".into())
+            .spawn_scoped(s, move || {
+                let mut rrd = RrdRecorder::with_name(rrd_tmp, rrd_name, info)?;
+                rrd_worker.run(&mut rrd);
+                Ok::<_, anyhow::Error>(rrd)
+            })
+            .context("cannot start the Rerun recorder thread")?;
         let mcap_thread = std::thread::Builder::new()
             .name("mcap-recorder".into())
             .spawn_scoped(s, move || {
@@ -235,7 +245,7 @@ pub fn record_with(
                         mcap.set_reproducible(reproducible);
                         ready_tx.send(None).ok();
                         mcap.write_scene();
-                        worker.run(&mut mcap);
+                        mcap_worker.run(&mut mcap);
                         Some(mcap)
                     }
                     Err(e) => {
@@ -253,7 +263,7 @@ pub fn record_with(
         let result = grouping::group_within(
             scene,
             params,
-            Tee(&mut rrd, Tee(&mut events, progress)),
+            Tee(&mut events, progress),
             &limits.budget(Some(&stop)),
         );
         events.close();
@@ -269,19 +279,30 @@ pub fn record_with(
         let extras = Extras::build(scene, grouping.as_ref(), detail, &logged)?;
         let outcome = extras.outcome(grouping.as_ref(), merges, rounds, seconds, stopped);
         let (rrd_done, mcap_done) = std::thread::scope(|t| {
-            let mcap_tail = t.spawn(|| {
-                let mcap =
-                    mcap_thread.join().ok().flatten().ok_or_else(|| {
+            let mcap_tail = std::thread::Builder::new()
+                .name("mcap-tail".into())
+                .spawn_scoped(t, || {
+                    let mcap = mcap_thread.join().ok().flatten().ok_or_else(|| {
                         anyhow!("{}: the MCAP recorder failed", mcap_path.display())
                     })?;
-                mcap.finish(&outcome)
-                    .with_context(|| mcap_path.display().to_string())?;
-                mcap_file.sync()
-            });
-            let rrd_done = rrd.finish(&outcome).and_then(|()| rrd_file.sync());
-            let mcap_done = mcap_tail
+                    mcap.finish(&outcome)
+                        .with_context(|| mcap_path.display().to_string())?;
+                    mcap_file.sync()
+                });
+            let rrd_done = rrd_thread
                 .join()
-                .unwrap_or_else(|_| bail!("{}: the MCAP recorder failed", mcap_path.display()));
+                .unwrap_or_else(|_| bail!("{}: the Rerun recorder failed", rrd_path.display()))
+                .and_then(|rrd| rrd.finish(&outcome))
+                .and_then(|()| rrd_file.sync());
+            let mcap_done = match mcap_tail {
+                Ok(h) => h
+                    .join()
+                    .unwrap_or_else(|_| bail!("{}: the MCAP recorder failed", mcap_path.display())),
+                Err(e) => Err(anyhow!(
+                    "{}: cannot start a thread: {e}",
+                    mcap_path.display()
+                )),
+            };
             (rrd_done, mcap_done)
         });
         Ok((rrd_done, mcap_done, grouping, stopped))

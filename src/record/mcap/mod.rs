@@ -44,7 +44,7 @@ use anyhow::{Context, Result, anyhow, bail};
 use foxglove::Encode;
 use foxglove::messages::SceneUpdate;
 use messages::{DormantEvent, FinishEvent, MergeEvent, RoundEvent};
-use scene_msgs::Remap;
+use scene_msgs::SceneMesh;
 use std::collections::BTreeMap;
 use std::io::{Seek, Write};
 
@@ -95,7 +95,6 @@ pub struct McapRecorder<'a, W: Write + Seek> {
     reproducible: bool,
     error: Option<anyhow::Error>,
     buf: Vec<u8>,
-    remap: Remap,
 }
 
 fn add_schema<T: Encode, W: Write + Seek>(w: &mut mcap::Writer<W>) -> Result<u16> {
@@ -190,7 +189,6 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             reproducible: false,
             error: None,
             buf: Vec::new(),
-            remap: Remap::default(),
             scene_topic,
         })
     }
@@ -209,12 +207,11 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
     fn try_write_scene(&mut self) -> Result<()> {
         let scene = self.info.scene;
         let mut entity = scene_msgs::entity("scene", 0);
-        entity.triangles.push(scene_msgs::triangles(
-            scene,
-            0..scene.len(),
-            scene_msgs::SCENE_COLOR,
-            &mut self.remap,
-        ));
+        let mut mesh = SceneMesh::new(scene);
+        mesh.add(0..scene.len());
+        entity
+            .triangles
+            .push(mesh.primitive(scene_msgs::SCENE_COLOR));
         emit(
             &mut self.writer,
             &mut self.buf,
@@ -365,6 +362,12 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             }
         }
         let scene = self.info.scene;
+        // The cut at depth d holds the leaves of depth <= d: each level adds one depth's leaves.
+        let mut leaves_by_depth = vec![Vec::new(); tree.depth_max() as usize + 1];
+        for x in 0..tree.leaves() {
+            leaves_by_depth[tree.depth[x] as usize].push(x);
+        }
+        let mut leaf_mesh = SceneMesh::new(scene);
         for d in 0..=tree.depth_max() {
             let t = (self.events + 1 + u64::from(d)) * MS;
             let mut topic =
@@ -409,16 +412,10 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
                 entities.push(e);
             }
             let mut leaves = scene_msgs::entity("leaves", t);
-            let leaf_ids = cut
-                .iter()
-                .filter(|&&x| tree.is_leaf(x))
-                .map(|&x| x as usize);
-            leaves.triangles.push(scene_msgs::triangles(
-                scene,
-                leaf_ids,
-                scene_msgs::LEAF_COLOR,
-                &mut self.remap,
-            ));
+            leaf_mesh.add(leaves_by_depth[d as usize].iter().copied());
+            leaves
+                .triangles
+                .push(leaf_mesh.primitive(scene_msgs::LEAF_COLOR));
             entities.push(leaves);
             let msg = scene_msgs::update(entities);
             emit(&mut self.writer, &mut self.buf, &mut topic, t, &msg)

@@ -140,51 +140,60 @@ pub fn sphere(s: &Sphere, rgba: [f64; 4]) -> SpherePrimitive {
     }
 }
 
-/// Reusable vertex renumbering for [`triangles`]; one per recorder.
-#[derive(Debug, Default)]
-pub struct Remap {
+/// An indexed triangle list of scene primitives, built up by [`SceneMesh::add`]: each scene
+/// vertex the primitives use appears once in `points`, and the triangles index it. Adding
+/// keeps what is there, so nested sets (the leaves of successive levels) are built once.
+#[derive(Debug)]
+pub struct SceneMesh<'s> {
+    scene: &'s Scene,
+    /// Index in `points` of each scene vertex, `u32::MAX` while unused.
     slot: Vec<u32>,
-    used: Vec<u32>,
+    points: Vec<Point3>,
+    indices: Vec<u32>,
 }
 
-/// One indexed triangle list drawing the primitives `prims` of `scene`: each scene vertex they
-/// use appears once in `points`, the triangles index it.
-pub fn triangles(
-    scene: &Scene,
-    prims: impl IntoIterator<Item = usize>,
-    rgba: [f64; 4],
-    remap: &mut Remap,
-) -> TriangleListPrimitive {
-    remap.slot.resize(scene.points.len(), u32::MAX);
-    let mut points = Vec::new();
-    let mut indices = Vec::new();
-    for i in prims {
-        for t in scene.prim_tris(i) {
-            for &v in t {
-                let slot = &mut remap.slot[v as usize];
-                if *slot == u32::MAX {
-                    *slot = points.len() as u32;
-                    remap.used.push(v);
-                    let p = &scene.points[v as usize];
-                    points.push(Point3 {
-                        x: p.x,
-                        y: p.y,
-                        z: p.z,
-                    });
+impl<'s> SceneMesh<'s> {
+    /// An empty mesh over `scene`'s vertices.
+    pub fn new(scene: &'s Scene) -> SceneMesh<'s> {
+        SceneMesh {
+            scene,
+            slot: vec![u32::MAX; scene.points.len()],
+            points: Vec::new(),
+            indices: Vec::new(),
+        }
+    }
+
+    /// Appends the triangles of primitives `prims`.
+    pub fn add(&mut self, prims: impl IntoIterator<Item = usize>) {
+        let scene = self.scene;
+        for i in prims {
+            for t in scene.prim_tris(i) {
+                for &v in t {
+                    let slot = &mut self.slot[v as usize];
+                    if *slot == u32::MAX {
+                        *slot = self.points.len() as u32;
+                        let p = &scene.points[v as usize];
+                        self.points.push(Point3 {
+                            x: p.x,
+                            y: p.y,
+                            z: p.z,
+                        });
+                    }
+                    self.indices.push(*slot);
                 }
-                indices.push(*slot);
             }
         }
     }
-    for v in remap.used.drain(..) {
-        remap.slot[v as usize] = u32::MAX;
-    }
-    TriangleListPrimitive {
-        pose: pose_at(&P3::origin()),
-        points,
-        color: color(rgba),
-        colors: Vec::new(),
-        indices,
+
+    /// The mesh so far as one primitive in colour `rgba`.
+    pub fn primitive(&self, rgba: [f64; 4]) -> TriangleListPrimitive {
+        TriangleListPrimitive {
+            pose: pose_at(&P3::origin()),
+            points: self.points.clone(),
+            color: color(rgba),
+            colors: Vec::new(),
+            indices: self.indices.clone(),
+        }
     }
 }
 
