@@ -257,43 +257,34 @@ impl BenchCmd {
             generate::replicate(&generate::robot_base(), 44, 1),
             generate::soup(100_000, 1),
         ];
+        let details = [Detail::Levels, Detail::Merges, Detail::Full];
         let dir = tempfile::tempdir()?;
+        // The fixed cost of a recording: two triangles, one merge.
+        let tiny = as_loaded(&generate::soup(2, 1))?;
+        let mut fixed = [0.0; 3];
+        for (f, &detail) in fixed.iter_mut().zip(&details) {
+            let prefix = dir.path().join(format!("fixed-{detail:?}"));
+            let (pairs, _) = self.record_pairs(&tiny, detail, &prefix)?;
+            *f = pairs.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+        }
         println!(
-            "{:<16} {:>7} {:>8} {:>9} {:>10} {:>7} {:>7} {:>9} {:>9}",
-            "scene", "N", "detail", "group ms", "record ms", "ratio", "median", "rrd MB", "mcap MB"
+            "{:<16} {:>7} {:>8} {:>9} {:>10} {:>7} {:>7} {:>8} {:>8} {:>8}",
+            "scene",
+            "N",
+            "detail",
+            "group ms",
+            "record ms",
+            "ratio",
+            "median",
+            "no-fixed",
+            "rrd MB",
+            "mcap MB"
         );
         for scene in &cases {
             let loaded = as_loaded(scene)?;
-            let params = Params::default().resolve(&loaded.scene);
-            for detail in [Detail::Levels, Detail::Merges, Detail::Full] {
+            for (&detail, &fixed) in details.iter().zip(&fixed) {
                 let prefix = dir.path().join(format!("{}-{detail:?}", scene.name));
-                let mut written = None;
-                // Each recorded run is paired with a grouping-only run just before it, so a
-                // slow spell of the machine weighs on both sides of a pair's ratio.
-                let pairs: Vec<(f64, f64)> = (0..self.repeat.max(1))
-                    .map(|_| {
-                        let t_group = best_of(1, || {
-                            std::hint::black_box(grouping::group(
-                                &loaded.scene,
-                                &Params::default(),
-                                (),
-                            ));
-                        });
-                        let t_rec = best_of(1, || {
-                            written = Some(super::record::record(
-                                &loaded.scene,
-                                &loaded.source,
-                                &params,
-                                detail,
-                                &prefix,
-                                true,
-                                true,
-                            ));
-                        });
-                        (t_group, t_rec)
-                    })
-                    .collect();
-                let w = written.expect("ran at least once")?;
+                let (pairs, w) = self.record_pairs(&loaded, detail, &prefix)?;
                 let t_group = pairs.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
                 let t_rec = pairs.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
                 let mut ratios: Vec<f64> = pairs.iter().map(|(g, r)| r / g).collect();
@@ -305,7 +296,7 @@ impl BenchCmd {
                         .unwrap_or(0.0)
                 };
                 println!(
-                    "{:<16} {:>7} {:>8} {:>9.1} {:>10.1} {:>7.2} {:>7.2} {:>9.2} {:>9.2}",
+                    "{:<16} {:>7} {:>8} {:>9.1} {:>10.1} {:>7.2} {:>7.2} {:>8.2} {:>8.2} {:>8.2}",
                     scene.name,
                     scene.len(),
                     format!("{detail:?}").to_lowercase(),
@@ -313,11 +304,13 @@ impl BenchCmd {
                     t_rec * 1e3,
                     t_rec / t_group,
                     median,
+                    (t_rec - fixed).max(0.0) / t_group,
                     mb(&w.rrd),
                     mb(&w.mcap)
                 );
             }
         }
+        let ms = fixed.map(|f| format!("{:.1}", f * 1e3));
         println!(
             "record ms = grouping with both recorders listening + sphere tree + writing both files."
         );
@@ -325,7 +318,45 @@ impl BenchCmd {
             "ratio = best record ms / best group ms; median = median over the runs of record / group"
         );
         println!("in the same pair (recording overhead is ratio - 1). Goal: merges <= 3.");
+        println!(
+            "no-fixed = (record ms - fixed cost) / group ms, the fixed cost being a 2-triangle \
+             recording: {} ms (levels / merges / full).",
+            ms.join(" / ")
+        );
         Ok(ExitCode::SUCCESS)
+    }
+
+    /// `repeat` pairs of (grouping alone, grouping recorded) wall times for `loaded`, each
+    /// recorded run just after its grouping-only run so that a slow spell of the machine weighs
+    /// on both sides of a pair; and where the last recording went.
+    fn record_pairs(
+        &self,
+        loaded: &Loaded,
+        detail: Detail,
+        prefix: &std::path::Path,
+    ) -> Result<(Vec<(f64, f64)>, super::record::Written)> {
+        let params = Params::default().resolve(&loaded.scene);
+        let mut written = None;
+        let pairs = (0..self.repeat.max(1))
+            .map(|_| {
+                let t_group = best_of(1, || {
+                    std::hint::black_box(grouping::group(&loaded.scene, &Params::default(), ()));
+                });
+                let t_rec = best_of(1, || {
+                    written = Some(super::record::record(
+                        &loaded.scene,
+                        &loaded.source,
+                        &params,
+                        detail,
+                        prefix,
+                        true,
+                        true,
+                    ));
+                });
+                (t_group, t_rec)
+            })
+            .collect();
+        Ok((pairs, written.expect("ran at least once")?))
     }
 }
 
