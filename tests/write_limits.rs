@@ -30,22 +30,23 @@ fn record_limited(dir: &Path, kib: u64, scene: &Path) -> std::process::Output {
 fn a_write_error_at_any_point_is_one_line_and_keeps_the_old_recording() {
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/lamps5.obj");
     let dir = tempfile::tempdir().unwrap();
-    let good = Command::new(env!("CARGO_BIN_EXE_wraptree"))
-        .args(["record", "--detail", "levels", "-o", "rec"])
-        .arg(&scene)
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
-    assert!(good.status.success());
+    let record = |detail: &str, prefix: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_wraptree"))
+            .args(["record", "--detail", detail, "-o", prefix])
+            .arg(&scene)
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    record("levels", "rec");
     let rrd = std::fs::read(dir.path().join("rec.rrd")).unwrap();
     let mcap = std::fs::read(dir.path().join("rec.mcap")).unwrap();
-    let full = Command::new(env!("CARGO_BIN_EXE_wraptree"))
-        .args(["record", "--detail", "full", "-o", "big"])
-        .arg(&scene)
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
-    assert!(full.status.success());
+    record("full", "big");
     let largest = ["big.rrd", "big.mcap"]
         .iter()
         .map(|f| std::fs::metadata(dir.path().join(f)).unwrap().len())
