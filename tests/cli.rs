@@ -170,27 +170,8 @@ fn replay_rejects_broken_and_foreign_files() {
 #[test]
 fn interrupted_recording_keeps_what_was_recorded() {
     let dir = tempfile::tempdir().unwrap();
-    let made = wraptree(
-        &["scene", "soup", "-n", "200000", "-o", "big.obj"],
-        dir.path(),
-    );
-    assert!(made.status.success());
-    let child = Command::new(env!("CARGO_BIN_EXE_wraptree"))
-        .args(["record", "big.obj", "-o", "big", "--detail", "levels"])
-        .current_dir(dir.path())
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    // The handler is installed before loading; whether the signal lands while loading or while
-    // grouping, the run stops before the root (200k triangles take over a second to load and group).
-    std::thread::sleep(std::time::Duration::from_millis(400));
-    let kill = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(kill.success());
-    let out = child.wait_with_output().unwrap();
+    soup(dir.path(), "big.obj", 200_000);
+    let out = record_big_then_signal(dir.path(), &[], "-INT");
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(
         out.status.code(),
@@ -349,6 +330,28 @@ fn soup(dir: &Path, name: &str, n: usize) {
     );
 }
 
+/// Starts `record big.obj -o big --detail levels` (plus `extra`) in `dir`, sends it `signal`
+/// after 400 ms, and waits for it. The handler is installed before loading; whether the
+/// signal lands while loading or while grouping, the run stops before the root (200k triangles
+/// take over a second to load and group).
+fn record_big_then_signal(dir: &Path, extra: &[&str], signal: &str) -> Output {
+    let child = Command::new(env!("CARGO_BIN_EXE_wraptree"))
+        .args(["record", "big.obj", "-o", "big", "--detail", "levels"])
+        .args(extra)
+        .current_dir(dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(400));
+    let kill = Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    child.wait_with_output().unwrap()
+}
+
 /// `--max-pairs`/`--max-seconds` stop a runaway grouping (GLimit spanning the whole soup):
 /// `group` prints one error line and exits 3; `record` keeps an existing recording, writes the
 /// partial one aside marked incomplete with the reason, which `replay` reports and verifies.
@@ -451,22 +454,7 @@ fn terminated_recording_keeps_the_old_one_and_what_was_recorded() {
     for f in ["big.mcap", "big.rrd"] {
         std::fs::write(dir.path().join(f), b"old recording").unwrap();
     }
-    let child = Command::new(env!("CARGO_BIN_EXE_wraptree"))
-        .args([
-            "record", "big.obj", "-o", "big", "--detail", "levels", "--force",
-        ])
-        .current_dir(dir.path())
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(400));
-    let kill = Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(kill.success());
-    let out = child.wait_with_output().unwrap();
+    let out = record_big_then_signal(dir.path(), &["--force"], "-TERM");
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(130), "stderr: {err}");
     assert!(!err.contains("panicked"), "{err}");
