@@ -87,14 +87,8 @@ fn recording(loaded: &Loaded, stop_after: Option<u32>) -> Vec<u8> {
         Ok(g) => {
             spheres = sphere_tree(&g.tree, &loaded.scene, SphereMethod::default());
             Outcome {
-                grouping: Some(g),
                 spheres: Some(&spheres),
-                wrappers: None,
-                cover: None,
-                merges: loaded.scene.len() as u32 - 1,
-                rounds: g.rounds,
-                seconds: 0.0,
-                stopped: None,
+                ..Outcome::finished(g)
             }
         }
         Err(s) => Outcome {

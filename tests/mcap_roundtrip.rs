@@ -371,14 +371,8 @@ fn record_into<W: Write + Seek>(loaded: &Loaded, sink: W) -> anyhow::Result<W> {
     let g = group(&loaded.scene, &params, &mut rec);
     let spheres = sphere_tree(&g.tree, &loaded.scene, SphereMethod::default());
     let outcome = Outcome {
-        grouping: Some(&g),
         spheres: Some(&spheres),
-        wrappers: None,
-        cover: None,
-        merges: loaded.scene.len() as u32 - 1,
-        rounds: g.rounds,
-        seconds: 0.0,
-        stopped: None,
+        ..Outcome::finished(&g)
     };
     rec.finish(&outcome)
 }
@@ -453,14 +447,11 @@ fn record_wrappers(loaded: &Loaded, path: &Path, g: &Grouping, wrappers: &Wrappe
     let mut log = EventLog::default();
     group(&loaded.scene, &Params::default(), Tee(&mut rec, &mut log));
     let outcome = Outcome {
-        grouping: Some(g),
         spheres: wrappers.spheres.as_deref(),
         wrappers: Some(wrappers),
-        cover: None,
         merges: log.merges.len() as u32,
         rounds: log.rounds.len() as u32,
-        seconds: 0.0,
-        stopped: None,
+        ..Outcome::finished(g)
     };
     rec.finish(&outcome).unwrap().flush().unwrap();
 }

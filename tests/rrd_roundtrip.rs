@@ -83,14 +83,10 @@ fn write(
     let mut wrappers = Wrappers::build(&grouping.tree, scene, kinds, SphereMethod::default());
     let spheres = wrappers.spheres.take().unwrap_or_default();
     let outcome = Outcome {
-        grouping: Some(&grouping),
         spheres: Some(&spheres),
         wrappers: Some(&wrappers),
-        cover: None,
         merges: log.merges.len() as u32,
-        rounds: grouping.rounds,
-        seconds: 0.0,
-        stopped: None,
+        ..Outcome::finished(&grouping)
     };
     recorder.finish(&outcome).expect("recording finishes");
     (grouping, log)
@@ -387,18 +383,8 @@ fn a_full_disk_is_a_clear_error() {
         Err(err) => err,
         Ok(mut recorder) => {
             let g = group(&loaded.scene, &params, &mut recorder);
-            let outcome = Outcome {
-                grouping: Some(&g),
-                spheres: None,
-                wrappers: None,
-                cover: None,
-                merges: loaded.scene.len() as u32 - 1,
-                rounds: g.rounds,
-                seconds: 0.0,
-                stopped: None,
-            };
             recorder
-                .finish(&outcome)
+                .finish(&Outcome::finished(&g))
                 .expect_err("writing to /dev/full fails")
         }
     };

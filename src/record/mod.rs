@@ -88,6 +88,23 @@ pub struct Outcome<'a> {
     pub stopped: Option<Stopped>,
 }
 
+impl<'a> Outcome<'a> {
+    /// The outcome of the finished `grouping`, with no Wrapper Trees, no cover and a grouping
+    /// time of 0; set the other fields with struct-update syntax.
+    pub fn finished(grouping: &'a Grouping) -> Outcome<'a> {
+        Outcome {
+            grouping: Some(grouping),
+            spheres: None,
+            wrappers: None,
+            cover: None,
+            merges: grouping.tree.leaves().saturating_sub(1) as u32,
+            rounds: grouping.rounds,
+            seconds: 0.0,
+            stopped: None,
+        }
+    }
+}
+
 /// A cover of the finished tree (see [`crate::wrap::cover`]) with its wrappers' geometry, logged
 /// as one extra level after the tree levels.
 #[derive(Clone, Copy, Debug)]
