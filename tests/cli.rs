@@ -2,16 +2,10 @@
 
 mod common;
 
+use common::wraptree;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn wraptree(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_wraptree"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the binary runs")
-}
 
 fn scene(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -5,8 +5,8 @@
 
 mod common;
 
-use std::path::Path;
-use std::process::{Command, Output};
+use common::wraptree;
+
 use wraptree::geom::{P3, V3};
 use wraptree::grouping::{PSet, Params};
 use wraptree::scene::pathological::{self as path, Layout};
@@ -270,14 +270,6 @@ fn split_at_infinity_is_the_identity_and_degenerates_are_kept() {
         (30, 30),
         "zero-area primitives stay whole"
     );
-}
-
-fn wraptree(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_wraptree"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the binary runs")
 }
 
 #[test]

@@ -2,19 +2,13 @@
 
 mod common;
 
+use common::wraptree;
+
 use resvg::{tiny_skia::Pixmap, usvg};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 use wraptree::geom::{Aabb, P3};
 use wraptree::render::{self, Camera, Frame, Shape, Style};
-
-fn wraptree(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_wraptree"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the binary runs")
-}
 
 /// Four triangles in two far-apart pairs: the tree is ((t0, t1), (t2, t3)), depth 2.
 fn tiny_scene(dir: &Path) -> PathBuf {

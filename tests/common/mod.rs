@@ -5,6 +5,15 @@ use wraptree::geom::P3;
 use wraptree::grouping::{EventLog, Grouping, Params, SubsetTree, group};
 use wraptree::scene::{PrimitiveKind, Scene};
 
+/// Runs the `wraptree` binary with `args` in `dir` and returns its output.
+pub fn wraptree(args: &[&str], dir: &std::path::Path) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_wraptree"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("the binary runs")
+}
+
 /// A scene of right triangles with legs `size` whose right-angle corners are `corners`.
 pub fn triangles(corners: &[[f64; 3]], size: f64) -> Scene {
     let mut s = Scene::new("triangles");
