@@ -29,7 +29,7 @@ impl SeriesFile {
             builder = builder.with_blueprint(b);
         }
         let rec = sink::save(builder, pending.path())
-            .map_err(|e| anyhow::anyhow!("{}: {e}", dest.display()))?;
+            .map_err(|e| anyhow::anyhow!("{}: {}", dest.display(), e.root_cause()))?;
         Ok(SeriesFile { rec, pending })
     }
 

@@ -15,7 +15,7 @@ use std::fs::File;
 use std::io::{Read as _, Seek as _, SeekFrom, Write as _};
 use std::path::Path;
 
-use anyhow::{anyhow, bail};
+use anyhow::bail;
 use rerun::external::re_log_encoding::{Decodable as _, StreamFooter};
 use rerun::{RecordingStream, RecordingStreamBuilder};
 
@@ -25,10 +25,7 @@ pub(super) fn save(
     builder: RecordingStreamBuilder,
     path: &Path,
 ) -> anyhow::Result<RecordingStream> {
-    let rec = builder
-        .enabled(true)
-        .save(path)
-        .map_err(|e| anyhow!("{}", root_message(&e)))?;
+    let rec = builder.enabled(true).save(path)?;
     rec.set_log_time_enabled(false);
     rec.set_log_tick_enabled(false);
     Ok(rec)
@@ -42,15 +39,6 @@ pub(super) fn close(rec: RecordingStream, path: &Path) -> anyhow::Result<()> {
         bail!("{}", write_probe(path).unwrap_or(err));
     }
     Ok(())
-}
-
-/// The message of the innermost cause of `err` (the SDK's errors repeat their sources).
-fn root_message(err: &(dyn std::error::Error + 'static)) -> String {
-    let mut e = err;
-    while let Some(source) = e.source() {
-        e = source;
-    }
-    e.to_string()
 }
 
 /// Checks that `path` ends with an RRD stream footer whose RRD footer is in the file and
