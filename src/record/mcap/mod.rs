@@ -1,7 +1,7 @@
 //! Foxglove `.mcap` recordings of a grouping run ([`McapRecorder`]) and their reader
 //! ([`read_recording`], used by `wraptree replay`).
 //!
-//! The file is chunked, zstd-compressed (level 3, single-threaded, so the same run gives the
+//! The file is chunked, zstd-compressed (level 2, single-threaded, so the same run gives the
 //! same bytes on every machine) with chunk, data-section, summary and attachment CRCs. Geometry
 //! uses the well-known `foxglove.SceneUpdate` schema; grouping events use small typed protobuf
 //! messages derived with `foxglove::Encode` ([`messages`]). Message encoding is `protobuf`
@@ -49,7 +49,7 @@ use std::collections::BTreeMap;
 use std::io::{Seek, Write};
 
 /// Zstd level of every chunk.
-pub const ZSTD_LEVEL: u32 = 3;
+pub const ZSTD_LEVEL: u32 = 2;
 /// Target uncompressed chunk size.
 pub const CHUNK_SIZE: u64 = 1 << 20;
 /// Media type of the embedded scene.

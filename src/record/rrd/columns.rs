@@ -1,5 +1,9 @@
-//! Per-merge data buffered as columns and sent with `send_columns` in batches: the scalar
-//! series (always) and the merged pair's and new body's boxes (with per-merge geometry).
+//! Data buffered as columns and sent with `send_columns` in batches: per merge, the scalar
+//! series (always) and the merged pair's and new body's boxes (with per-merge geometry); per
+//! round start, doubling and finish, the text log lines and the active bodies' boxes.
+//!
+//! Every `send_columns` call becomes one chunk, and the SDK spends about 60 µs on each chunk
+//! whatever its size, so rows are sent together, one chunk per entity per batch.
 
 use rerun::{RecordingStream, TimeColumn};
 
@@ -53,6 +57,14 @@ pub(super) struct MergeColumns {
     pair_halves: Vec<[f32; 3]>,
     new_centers: Vec<[f32; 3]>,
     new_halves: Vec<[f32; 3]>,
+    /// `log/doublings` rows: (merge, round) ticks, lines and levels.
+    text_ticks: Vec<(i64, i64)>,
+    text: Vec<String>,
+    text_levels: Vec<rerun::components::TextLogLevel>,
+    /// `grouping/active` rows: (merge, round) ticks and box count, then every row's boxes.
+    active_rows: Vec<(i64, i64, usize)>,
+    active_centers: Vec<[f32; 3]>,
+    active_halves: Vec<[f32; 3]>,
 }
 
 impl MergeColumns {
@@ -89,6 +101,27 @@ impl MergeColumns {
         }
     }
 
+    /// Buffers one `log/doublings` line at the given `merge` and `round` ticks.
+    pub(super) fn push_text(
+        &mut self,
+        merge: u32,
+        round: u32,
+        line: String,
+        level: rerun::components::TextLogLevel,
+    ) {
+        self.text_ticks.push((i64::from(merge), i64::from(round)));
+        self.text.push(line);
+        self.text_levels.push(level);
+    }
+
+    /// Buffers one `grouping/active` row: the boxes of the bodies active at a round start.
+    pub(super) fn push_active(&mut self, merge: u32, round: u32, boxes: &[BoxF32]) {
+        self.active_rows
+            .push((i64::from(merge), i64::from(round), boxes.len()));
+        self.active_centers.extend(boxes.iter().map(|b| b.center));
+        self.active_halves.extend(boxes.iter().map(|b| b.half));
+    }
+
     /// Number of buffered merges.
     pub(super) fn len(&self) -> usize {
         self.step.len()
@@ -104,10 +137,52 @@ impl MergeColumns {
         self.pair_halves.clear();
         self.new_centers.clear();
         self.new_halves.clear();
+        self.text_ticks.clear();
+        self.text.clear();
+        self.text_levels.clear();
+        self.active_rows.clear();
+        self.active_centers.clear();
+        self.active_halves.clear();
         result
     }
 
     fn send(&mut self, rec: &RecordingStream) -> anyhow::Result<()> {
+        self.send_rounds(rec)?;
+        self.send_merges(rec)
+    }
+
+    /// Sends the buffered text lines and active sets, one chunk each.
+    fn send_rounds(&self, rec: &RecordingStream) -> anyhow::Result<()> {
+        let ticks = |rows: &mut dyn Iterator<Item = (i64, i64)>| {
+            let (merge, round): (Vec<i64>, Vec<i64>) = rows.unzip();
+            [
+                TimeColumn::new_sequence("merge", merge),
+                TimeColumn::new_sequence("round", round),
+            ]
+        };
+        if !self.text.is_empty() {
+            let log = rerun::TextLog::update_fields()
+                .with_many_text(self.text.iter().map(String::as_str))
+                .with_many_level(self.text_levels.iter().cloned())
+                .columns_of_unit_batches()?;
+            rec.send_columns(
+                "log/doublings",
+                ticks(&mut self.text_ticks.iter().copied()),
+                log,
+            )?;
+        }
+        if !self.active_rows.is_empty() {
+            let boxes = rerun::Boxes3D::update_fields()
+                .with_centers(self.active_centers.iter().copied())
+                .with_half_sizes(self.active_halves.iter().copied())
+                .columns(self.active_rows.iter().map(|&(_, _, n)| n))?;
+            let rows = &mut self.active_rows.iter().map(|&(m, r, _)| (m, r));
+            rec.send_columns("grouping/active", ticks(rows), boxes)?;
+        }
+        Ok(())
+    }
+
+    fn send_merges(&self, rec: &RecordingStream) -> anyhow::Result<()> {
         let k = self.len();
         if k == 0 {
             return Ok(());

@@ -57,10 +57,11 @@
 //! `log/doublings` and the property `__properties/wraptree_outcome` (`complete` = `false`,
 //! `stop_reason`, `merges`).
 //!
-//! The per-merge series and boxes are buffered and sent as columns every 4,096 merges
-//! (`columns::BATCH`), so memory stays bounded and most of a long run is already on its way to
-//! the file when it is interrupted; [`RrdRecorder::finish`] (also called after Ctrl-C) sends the
-//! rest and ends the file with its footer.
+//! The per-merge series and boxes, the text lines and the active sets are buffered and sent as
+//! columns every 4,096 merges (`columns::BATCH`), one chunk per entity, so memory stays bounded
+//! and most of a long run is already on its way to the file when it is interrupted;
+//! [`RrdRecorder::finish`] (also called after Ctrl-C) sends the rest and ends the file with its
+//! footer.
 //!
 //! The recording id is derived from the scene's SHA-256 and the resolved parameters (not the
 //! detail level), so recordings of the same run share it and the viewer shows them as one.
@@ -314,10 +315,9 @@ impl RrdRecorder {
         Ok(())
     }
 
-    fn text(&self, round: u32, line: String) -> anyhow::Result<()> {
-        let times = [("merge", self.merges as i64), ("round", round as i64)];
-        let log = rerun::TextLog::new(line).with_level(rerun::TextLogLevel::INFO);
-        send_at(self.rec()?, "log/doublings", &times, &log)
+    fn text(&mut self, round: u32, line: String) {
+        let info = rerun::components::TextLogLevel::from(rerun::TextLogLevel::INFO);
+        self.columns.push_text(self.merges, round, line, info);
     }
 
     fn handle(&mut self, event: &Event<'_>) -> anyhow::Result<()> {
@@ -336,22 +336,13 @@ impl RrdRecorder {
                 let n = active.len();
                 let limits = format!("DLimit {dlimit:.6e}, GLimit {glimit:.6e}");
                 let sets = format!("{n} active, {dormant} dormant, {pairs} pairs");
-                self.text(round, format!("round {round}: {limits}, {sets}"))?;
+                self.text(round, format!("round {round}: {limits}, {sets}"));
                 if self.detail.merges() {
-                    let (centers, halves): (Vec<_>, Vec<_>) = active
+                    let boxes = active
                         .iter()
-                        .map(|&b| {
-                            let b = self.body(b)?;
-                            Ok((b.center, b.half))
-                        })
-                        .collect::<anyhow::Result<Vec<_>>>()?
-                        .into_iter()
-                        .unzip();
-                    let times = [("merge", self.merges as i64), ("round", round as i64)];
-                    let boxes = rerun::Boxes3D::update_fields()
-                        .with_centers(centers)
-                        .with_half_sizes(halves);
-                    send_at(self.rec()?, "grouping/active", &times, &boxes)?;
+                        .map(|&b| self.body(b))
+                        .collect::<anyhow::Result<Vec<_>>>()?;
+                    self.columns.push_active(self.merges, round, &boxes);
                 }
             }
             Event::Merge(m) => {
@@ -387,7 +378,7 @@ impl RrdRecorder {
             } => {
                 let limits = format!("DLimit → {dlimit:.6e}, GLimit → {glimit:.6e}");
                 let line = format!("doubling after round {round} ({merges} merges): {limits}");
-                self.text(round, line)?;
+                self.text(round, line);
             }
             Event::Finish {
                 root,
@@ -396,7 +387,7 @@ impl RrdRecorder {
             } => {
                 let line =
                     format!("finished: root {root} after {rounds} rounds and {merges} merges");
-                self.text(self.round, line)?;
+                self.text(self.round, line);
             }
         }
         Ok(())
@@ -426,11 +417,11 @@ impl RrdRecorder {
     }
 
     fn write_tail(&mut self, outcome: &Outcome<'_>) -> anyhow::Result<()> {
-        let rec = self.rec.as_ref().ok_or_else(closed)?;
-        self.columns.flush(rec)?;
         if outcome.grouping.is_none() {
             self.mark_incomplete(outcome)?;
         }
+        let rec = self.rec.as_ref().ok_or_else(closed)?;
+        self.columns.flush(rec)?;
         if let (Some(mesh), Some(grouping), Some(spheres)) =
             (&self.mesh, outcome.grouping, outcome.spheres)
         {
@@ -448,16 +439,15 @@ impl RrdRecorder {
     /// Marks a run stopped before the root: a warning line in `log/doublings` at the last
     /// merge, and the recording property `wraptree_outcome` with `complete` = `false`,
     /// `stop_reason` (`interrupted`, `max-seconds`, `max-pairs` or `unknown`) and `merges`.
-    fn mark_incomplete(&self, outcome: &Outcome<'_>) -> anyhow::Result<()> {
-        let rec = self.rec()?;
+    fn mark_incomplete(&mut self, outcome: &Outcome<'_>) -> anyhow::Result<()> {
         let reason = outcome.stopped.map_or("unknown", |s| s.reason.name());
         let line = format!(
             "incomplete: stopped ({reason}) after {} merges; no tree levels",
             outcome.merges
         );
-        let times = [("merge", self.merges as i64), ("round", self.round as i64)];
-        let log = rerun::TextLog::new(line).with_level(rerun::TextLogLevel::WARN);
-        send_at(rec, "log/doublings", &times, &log)?;
+        let warn = rerun::components::TextLogLevel::from(rerun::TextLogLevel::WARN);
+        self.columns.push_text(self.merges, self.round, line, warn);
+        let rec = self.rec()?;
         let text = |s: String| [rerun::components::Text::from(s)];
         rec.send_property(
             "wraptree_outcome",
