@@ -225,7 +225,6 @@ pub fn record_with(
         let [rrd_worker, mcap_worker]: [background::Worker; 2] = workers
             .try_into()
             .map_err(|_| anyhow!("two event channels"))?;
-        let (ready_tx, ready_rx) = std::sync::mpsc::sync_channel(1);
         let info = &info;
         let (rrd_tmp, rrd_name) = (rrd_file.path(), rrd_path.as_path());
         let rrd_thread = std::thread::Builder::new()
@@ -240,26 +239,17 @@ pub fn record_with(
             .name("mcap-recorder".into())
             .spawn_scoped(s, move || {
                 let writer = std::io::BufWriter::new(mcap_out);
-                match McapRecorder::start(writer, info) {
-                    Ok(mut mcap) => {
-                        mcap.set_reproducible(reproducible);
-                        ready_tx.send(None).ok();
-                        mcap.write_scene();
-                        mcap_worker.run(&mut mcap);
-                        Some(mcap)
-                    }
-                    Err(e) => {
-                        ready_tx.send(Some(e)).ok();
-                        None
-                    }
-                }
+                let mut mcap = McapRecorder::start(writer, info)?;
+                mcap.set_reproducible(reproducible);
+                mcap.write_scene();
+                mcap_worker.run(&mut mcap);
+                Ok::<_, anyhow::Error>(mcap)
             })
             .context("cannot start the MCAP recorder thread")?;
-        match ready_rx.recv() {
-            Ok(None) => {}
-            Ok(Some(e)) => return Err(e.context(mcap_path.display().to_string())),
-            Err(_) => bail!("{}: the MCAP recorder failed", mcap_path.display()),
-        }
+        // The grouping starts without waiting for either recorder: a recorder that fails to
+        // start drops its worker (the grouping stops sending to it) and its error is reported
+        // after the grouping, like a write error during the run. Missing or unwritable
+        // destinations were already refused by `Pending::create`.
         let result = grouping::group_within(
             scene,
             params,
@@ -282,9 +272,10 @@ pub fn record_with(
             let mcap_tail = std::thread::Builder::new()
                 .name("mcap-tail".into())
                 .spawn_scoped(t, || {
-                    let mcap = mcap_thread.join().ok().flatten().ok_or_else(|| {
-                        anyhow!("{}: the MCAP recorder failed", mcap_path.display())
-                    })?;
+                    let mcap = mcap_thread
+                        .join()
+                        .unwrap_or_else(|_| Err(anyhow!("the MCAP recorder failed")))
+                        .with_context(|| mcap_path.display().to_string())?;
                     mcap.finish(&outcome)
                         .with_context(|| mcap_path.display().to_string())?;
                     mcap_file.sync()

@@ -36,7 +36,8 @@ pub(super) fn log_styles(rec: &RecordingStream) -> anyhow::Result<()> {
         ("grouping/merge/pair", PAIR_ORANGE, 2.0),
         ("grouping/merge/new", NEW_GREEN, 2.5),
     ] {
-        rec.log_static(
+        super::send_static(
+            rec,
             path,
             &rerun::Boxes3D::update_fields()
                 .with_colors([color])

@@ -20,7 +20,7 @@ use rerun::RecordingStream;
 use rerun::components::FillMode;
 
 use super::mesh::PrimMesh;
-use super::{rel, send_at};
+use super::{rel, send_at, send_static};
 use crate::geom::{P3, V3};
 use crate::grouping::SubsetTree;
 use crate::record::CoverLevel;
@@ -217,7 +217,8 @@ pub(super) fn log_cover(
     origin: &P3,
 ) -> anyhow::Result<()> {
     let times = [("level", i64::from(tree.depth_max()) + 1)];
-    rec.log_static(
+    send_static(
+        rec,
         "cover",
         &rerun::Transform3D::from_translation([origin.x as f32, origin.y as f32, origin.z as f32]),
     )?;
@@ -310,7 +311,7 @@ pub(super) fn log_cover(
         c.nodes.len(),
         c.max_error()
     );
-    rec.log_static("cover/summary", &rerun::TextLog::new(line))?;
+    send_static(rec, "cover/summary", &rerun::TextLog::new(line))?;
     Ok(())
 }
 

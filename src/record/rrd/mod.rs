@@ -163,7 +163,15 @@ fn recording_id(info: &RunInfo<'_>) -> String {
     )
 }
 
-/// Sends one row of `arch` at the given sequence times, without `log_time`.
+/// Sends one row of `arch` as static data. Unlike `log_static`, whose rows wait in the SDK's
+/// batcher until the stream is flushed or dropped, the chunk goes straight to the file writer,
+/// which encodes it while the grouping runs.
+fn send_static(rec: &RecordingStream, entity: &str, arch: &dyn AsComponents) -> anyhow::Result<()> {
+    send_at(rec, entity, &[], arch)
+}
+
+/// Sends one row of `arch` at the given sequence times (static without times), without
+/// `log_time`.
 fn send_at(
     rec: &RecordingStream,
     entity: &str,
@@ -286,13 +294,15 @@ impl RrdRecorder {
         )?;
         let o = self.origin;
         for root in ["scene", "grouping", "levels"] {
-            rec.log_static(
+            send_static(
+                rec,
                 root,
                 &rerun::Transform3D::from_translation([o.x as f32, o.y as f32, o.z as f32]),
             )?;
         }
-        rec.log_static("/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
-        rec.log_static(
+        send_static(rec, "/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
+        send_static(
+            rec,
             "scene/primitives",
             &rerun::Mesh3D::new(mesh.positions.iter().copied())
                 .with_vertex_normals(mesh.normals.iter().copied())
@@ -300,11 +310,12 @@ impl RrdRecorder {
                 .with_albedo_factor(SCENE_GREY),
         )?;
         for (path, name) in columns::SERIES {
-            rec.log_static(path, &rerun::SeriesLines::new().with_names([name]))?;
+            send_static(rec, path, &rerun::SeriesLines::new().with_names([name]))?;
         }
         if self.detail.merges() {
             columns::log_styles(rec)?;
-            rec.log_static(
+            send_static(
+                rec,
                 "grouping/active",
                 &rerun::Boxes3D::update_fields()
                     .with_colors([ACTIVE_BLUE])
