@@ -6,12 +6,15 @@
 
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// A file being written; [`Pending::commit`] moves it into place.
 #[derive(Debug)]
 pub struct Pending {
     tmp: tempfile::NamedTempFile,
     dest: PathBuf,
+    /// Set by [`Pending::sync`]; [`Pending::commit`] then does not sync again.
+    synced: AtomicBool,
 }
 
 impl Pending {
@@ -47,9 +50,20 @@ impl Pending {
                     dir.display()
                 )
             })?;
+        // The temporary file is created private (0600); it gets the finished file's ordinary
+        // permissions now, so that changing them does not cost one more sync at commit.
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let perms = std::fs::Permissions::from_mode(0o644);
+            tmp.as_file()
+                .set_permissions(perms)
+                .with_context(|| format!("{}: cannot set permissions", dest.display()))?;
+        }
         Ok(Pending {
             tmp,
             dest: dest.to_path_buf(),
+            synced: AtomicBool::new(false),
         })
     }
 
@@ -70,16 +84,20 @@ impl Pending {
             .with_context(|| format!("{}: cannot open for writing", self.path().display()))
     }
 
-    /// Syncs the temporary file's data and metadata to disk (done again, cheaply, by
-    /// [`Pending::commit`]); lets two files be synced at the same time before either is moved.
+    /// Syncs the temporary file's data and metadata to disk after its last write, so that
+    /// [`Pending::commit`] need not; lets two files be synced at the same time before either is
+    /// moved.
     pub fn sync(&self) -> Result<()> {
         self.tmp
             .as_file()
             .sync_all()
-            .with_context(|| format!("{}: cannot sync", self.dest.display()))
+            .with_context(|| format!("{}: cannot sync", self.dest.display()))?;
+        self.synced.store(true, Ordering::Release);
+        Ok(())
     }
 
-    /// Syncs the temporary file and renames it over the destination.
+    /// Syncs the temporary file (unless [`Pending::sync`] did) and renames it over the
+    /// destination.
     pub fn commit(self) -> Result<PathBuf> {
         self.commit_to(None)
     }
@@ -88,20 +106,12 @@ impl Pending {
     /// interrupted recording aside without touching an existing one).
     pub fn commit_to(self, other: Option<&Path>) -> Result<PathBuf> {
         let dest = other.map(Path::to_path_buf).unwrap_or(self.dest);
-        // Temporary files are private (0600); the finished file gets ordinary permissions.
-        #[cfg(unix)]
-        {
-            use std::os::unix::fs::PermissionsExt;
-            let perms = std::fs::Permissions::from_mode(0o644);
+        if !self.synced.load(Ordering::Acquire) {
             self.tmp
                 .as_file()
-                .set_permissions(perms)
-                .with_context(|| format!("{}: cannot set permissions", dest.display()))?;
+                .sync_all()
+                .with_context(|| format!("{}: cannot sync", dest.display()))?;
         }
-        self.tmp
-            .as_file()
-            .sync_all()
-            .with_context(|| format!("{}: cannot sync", dest.display()))?;
         self.tmp.persist(&dest).map_err(|e| {
             anyhow::anyhow!("{}: cannot move into place: {}", dest.display(), e.error)
         })?;
