@@ -251,11 +251,39 @@ def check_cover(updates, run, vertices, tol, hull_tol):
     return size
 
 
+def check_detail_topics(run, merges, bodies, active):
+    """Per-round active sets with merges/full; per-merge boxes (pair, then the new body, whose
+    box is the merge event's AABB) with full only."""
+    detail = run["detail"]
+    want_active = int(run["rounds"]) if detail in ("merges", "full") else 0
+    if len(active) != want_active:
+        fail(f"/grouping/active holds {len(active)} messages, expected {want_active} ({detail})")
+    if detail != "full":
+        if bodies:
+            fail(f"/grouping/bodies written with detail {detail}")
+        return
+    if len(bodies) != len(merges):
+        fail(f"/grouping/bodies holds {len(bodies)} messages for {len(merges)} merges")
+    for i, (update, m) in enumerate(zip(bodies, merges)):
+        cubes = [c for e in update.entities for c in e.cubes]
+        if len(cubes) != 3:
+            fail(f"/grouping/bodies message {i} has {len(cubes)} boxes, expected 3")
+        new, lo, hi = cubes[2], (m.min_x, m.min_y, m.min_z), (m.max_x, m.max_y, m.max_z)
+        centre = (new.pose.position.x, new.pose.position.y, new.pose.position.z)
+        size = (new.size.x, new.size.y, new.size.z)
+        for k in range(3):
+            tol = 1e-9 * max(1.0, abs(lo[k]), abs(hi[k]))
+            if abs(centre[k] - (lo[k] + hi[k]) / 2) > tol or abs(size[k] - (hi[k] - lo[k])) > tol:
+                fail(f"/grouping/bodies message {i}: new body's box is not merge {i}'s AABB")
+
+
 def main():
     if len(sys.argv) != 3:
         fail("usage: mcap_check.py FILE.mcap N")
     path, n = sys.argv[1], int(sys.argv[2])
     merges = []
+    bodies = []
+    active = []
     levels = {}
     cover = []
     scene = None
@@ -278,6 +306,10 @@ def main():
                         fail(f"{topic}: embedded and official SceneUpdate schemas disagree")
                 if topic == "/grouping/merge":
                     merges.append(decoded)
+                elif topic == "/grouping/bodies":
+                    bodies.append(decoded)
+                elif topic == "/grouping/active":
+                    active.append(decoded)
                 elif topic == "/scene":
                     scene = decoded
                 elif topic.startswith("/levels/"):
@@ -299,6 +331,7 @@ def main():
     for i, m in enumerate(merges):
         if m.step != i or m.new != n + i or not (m.a < m.b < m.new):
             fail(f"merge {i} inconsistent: step {m.step}, {m.a} + {m.b} -> {m.new}")
+    check_detail_topics(run, merges, bodies, active)
     if scene is None or not scene.entities or not scene.entities[0].triangles:
         fail("/scene has no triangles")
     vertices = set()

@@ -31,7 +31,8 @@ pub enum Detail {
     /// Scene, merge events and series, round summaries and every tree level; no per-merge or
     /// per-round geometry.
     Levels,
-    /// Scene, merge events with per-merge boxes and each round's active bodies; no levels.
+    /// Scene, merge events, per-merge boxes (in the `.rrd` only) and each round's active bodies; no
+    /// levels.
     Merges,
     /// Everything.
     #[default]

@@ -14,7 +14,7 @@
 //! | `/grouping/merge` | `mergeevent.MergeEvent` | every merge: step, round, a, b, new, AABB, diameter, Fill, Balance, Cost, queue length, active | always |
 //! | `/grouping/finish` | `finishevent.FinishEvent` | root, rounds, merges | always, once |
 //! | `/grouping/active` | `foxglove.SceneUpdate` | entity `active`: one translucent green box per active body at each round start | `--detail merges` or `full` |
-//! | `/grouping/bodies` | `foxglove.SceneUpdate` | entity `merge`: the merged pair (red) and the new body (yellow) as boxes, per merge | `--detail merges` or `full` |
+//! | `/grouping/bodies` | `foxglove.SceneUpdate` | entity `merge`: the merged pair (red) and the new body (yellow) as boxes, per merge | `--detail full` (it repeats boxes the merge events already carry, and is the largest per-merge topic) |
 //! | `/grouping/dormant` | `dormantevent.DormantEvent` | round, body, diameter of each body going dormant | `--detail merges` or `full` |
 //! | `/levels/<d>` | `foxglove.SceneUpdate` | one snapshot of the cut at depth d (d = 0..=depth max), one entity per wrapper kind chosen with `--wrapper` for the cut's interior nodes: `spheres` (`SpherePrimitive`s, size = diameter), `hulls` (one indexed `TriangleListPrimitive` per hull; a segment hull is one degenerate triangle `[a, b, b]`, a point hull `[a, a, a]`), `boxes` (axis-aligned `CubePrimitive`s), `obbs` (`CubePrimitive`s with orientation); and entity `leaves` (the cut's leaves as one orange `TriangleListPrimitive`) | `--detail levels` or `full`, finished runs |
 //! | `/cover` | `foxglove.SceneUpdate` | the cover (`--cover-tolerance` or `--cover-budget`) as one more level: entities `spheres`, `boxes` (oriented ones with orientation), `hulls` (one indexed `TriangleListPrimitive` per hull) and `leaves` (one `TriangleListPrimitive` per leaf drawn as itself), only those used | with a cover, `--detail levels` or `full`, finished runs |
@@ -39,7 +39,7 @@ pub use read::{Recorded, read_recording};
 
 use crate::geom::Aabb;
 use crate::grouping::{Event, Observer};
-use crate::record::{Outcome, RunInfo};
+use crate::record::{Detail, Outcome, RunInfo};
 use anyhow::{Context, Result, anyhow, bail};
 use foxglove::Encode;
 use foxglove::messages::SceneUpdate;
@@ -73,8 +73,10 @@ struct Topics {
     round: Topic,
     merge: Topic,
     finish: Topic,
-    /// `/grouping/active`, `/grouping/bodies`, `/grouping/dormant` with per-merge detail.
-    detail: Option<[Topic; 3]>,
+    /// `/grouping/active` and `/grouping/dormant` with per-merge detail.
+    detail: Option<[Topic; 2]>,
+    /// `/grouping/bodies` with `--detail full`.
+    bodies: Option<Topic>,
 }
 
 /// Writes a grouping run to an `.mcap` file; feed it events as an [`Observer`], then call
@@ -169,9 +171,13 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
                 let dormant_schema = add_schema::<DormantEvent, W>(&mut w)?;
                 Some([
                     add_topic(&mut w, scene_update, "/grouping/active")?,
-                    add_topic(&mut w, scene_update, "/grouping/bodies")?,
                     add_topic(&mut w, dormant_schema, "/grouping/dormant")?,
                 ])
+            } else {
+                None
+            },
+            bodies: if info.detail == Detail::Full {
+                Some(add_topic(&mut w, scene_update, "/grouping/bodies")?)
             } else {
                 None
             },
@@ -241,6 +247,7 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
         let t = self.events * MS;
         let (w, buf) = (&mut self.writer, &mut self.buf);
         let detail = self.topics.detail.as_mut();
+        let bodies_topic = self.topics.bodies.as_mut();
         match *event {
             Event::RoundStart {
                 round,
@@ -261,7 +268,7 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
                     merges: 0,
                 };
                 emit(w, buf, &mut self.topics.round, t, &msg)?;
-                if let Some([active_topic, ..]) = detail {
+                if let Some([active_topic, _]) = detail {
                     let mut e = scene_msgs::entity("active", t);
                     let bodies = &self.bodies;
                     e.cubes = active
@@ -281,7 +288,7 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
                     self.bodies.resize(new + 1, Aabb::EMPTY);
                 }
                 self.bodies[new] = m.aabb;
-                if let Some([_, bodies_topic, _]) = detail {
+                if let Some(bodies_topic) = bodies_topic {
                     let mut e = scene_msgs::entity("merge", t);
                     let get =
                         |id: u32| self.bodies.get(id as usize).copied().unwrap_or(Aabb::EMPTY);
@@ -298,7 +305,7 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
                 body,
                 diameter,
             } => {
-                if let Some([_, _, dormant_topic]) = detail {
+                if let Some([_, dormant_topic]) = detail {
                     let msg = DormantEvent {
                         round,
                         body,
