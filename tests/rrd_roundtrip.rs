@@ -24,7 +24,8 @@ out = {"recordings": [[s.application_id, s.recording_id] for s in r.recordings()
        "blueprints": len(r.blueprints()), "entities": {}}
 for c in r.stream():
     e = out["entities"].setdefault(c.entity_path,
-        {"rows": 0, "static": False, "timelines": [], "merge": [], "level": [], "round": []})
+        {"rows": 0, "static": False, "timelines": [], "merge": [], "level": [], "round": [],
+         "lens": []})
     e["rows"] += c.num_rows
     e["static"] = e["static"] or c.is_static
     for t in c.timeline_names:
@@ -34,6 +35,9 @@ for c in r.stream():
     for t in ("merge", "level", "round"):
         if t in rb.schema.names:
             e[t] += rb.column(t).to_pylist()
+    for name in ("Scalars:scalars", "Boxes3D:centers"):
+        if name in rb.schema.names and not c.is_static:
+            e["lens"] += [len(v) for v in rb.column(name).to_pylist()]
 print(json.dumps(out))
 "#;
 
@@ -53,6 +57,8 @@ struct Entity {
     merge: Vec<i64>,
     level: Vec<i64>,
     round: Vec<i64>,
+    /// Per temporal row, the number of scalars (`Scalars`) or boxes (`Boxes3D`).
+    lens: Vec<usize>,
 }
 
 struct Run {
@@ -178,20 +184,13 @@ fn check(run: &Run, detail: Detail, kinds: &[WrapperKind]) {
         "/scene/primitives",
         "/log/doublings",
         "/series/cost",
-        "/series/diameter",
-        "/series/fill",
-        "/series/balance",
-        "/series/dlimit",
-        "/series/glimit",
+        "/series/limits",
+        "/series/fill_balance",
         "/series/queue_len",
     ]
     .into();
     if detail.merges() {
-        want.extend([
-            "/grouping/merge/pair",
-            "/grouping/merge/new",
-            "/grouping/active",
-        ]);
+        want.extend(["/grouping/merge", "/grouping/active"]);
     }
     if detail.levels() {
         want.insert("/levels/leaves");
@@ -222,16 +221,14 @@ fn check(run: &Run, detail: Detail, kinds: &[WrapperKind]) {
     );
 
     assert!(s.entities["/scene/primitives"].is_static);
-    for series in [
-        "cost",
-        "diameter",
-        "fill",
-        "balance",
-        "dlimit",
-        "glimit",
-        "queue_len",
+    for (series, k) in [
+        ("cost", 1),
+        ("limits", 3),
+        ("fill_balance", 2),
+        ("queue_len", 1),
     ] {
         let e = &s.entities[&format!("/series/{series}")];
+        assert_eq!(e.lens, vec![k; n - 1], "{series}: {k} scalars per row");
         let temporal = e.rows - usize::from(e.is_static);
         assert_eq!(temporal, n - 1, "{series}: one row per merge");
         assert_eq!(
@@ -246,12 +243,15 @@ fn check(run: &Run, detail: Detail, kinds: &[WrapperKind]) {
         run.log.rounds.len() + run.log.doublings.len() + 1
     );
     if detail.merges() {
-        for e in ["/grouping/merge/pair", "/grouping/merge/new"] {
-            let e = &s.entities[e];
-            assert_eq!(sorted(e.merge.clone()), range(n - 1));
-            let rounds: Vec<i64> = run.log.merges.iter().map(|m| m.round as i64).collect();
-            assert_eq!(sorted(e.round.clone()), sorted(rounds));
-        }
+        let e = &s.entities["/grouping/merge"];
+        assert_eq!(sorted(e.merge.clone()), range(n - 1));
+        assert_eq!(
+            e.lens,
+            vec![3; n - 1],
+            "the pair and the new body per merge"
+        );
+        let rounds: Vec<i64> = run.log.merges.iter().map(|m| m.round as i64).collect();
+        assert_eq!(sorted(e.round.clone()), sorted(rounds));
         let active = &s.entities["/grouping/active"];
         assert_eq!(
             sorted(active.round.clone()),

@@ -38,11 +38,8 @@ pub(super) fn layout(detail: Detail) -> Blueprint {
     };
     let plots = Grid::new([
         plot("Cost", &["cost"]),
-        plot(
-            "diameter, DLimit, GLimit",
-            &["diameter", "dlimit", "glimit"],
-        ),
-        plot("Fill, Balance", &["fill", "balance"]),
+        plot("diameter, DLimit, GLimit", &["limits"]),
+        plot("Fill, Balance", &["fill_balance"]),
         plot("MPairs length", &["queue_len"]),
     ])
     .with_grid_columns(2);

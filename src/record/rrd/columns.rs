@@ -13,15 +13,23 @@ use crate::grouping::Merge;
 /// Merges buffered before their columns are sent.
 pub(super) const BATCH: usize = 4096;
 
-/// Entity path and legend name of each per-merge series, in [`MergeColumns::push`] order.
-pub(super) const SERIES: [(&str, &str); 7] = [
-    ("series/cost", "Cost"),
-    ("series/diameter", "diameter"),
-    ("series/fill", "Fill"),
-    ("series/balance", "Balance"),
-    ("series/dlimit", "DLimit"),
-    ("series/glimit", "GLimit"),
-    ("series/queue_len", "MPairs length"),
+/// The per-merge series, one entity per plot of the blueprint: its path and the legend name of
+/// each scalar in its rows, in [`MergeColumns::push`] order. (One entity per plot rather than
+/// per series: every entity costs the SDK two chunks, a row-id column and a time column.)
+pub(super) const SERIES: [(&str, &[&str]); 4] = [
+    ("series/cost", &["Cost"]),
+    ("series/limits", &["diameter", "DLimit", "GLimit"]),
+    ("series/fill_balance", &["Fill", "Balance"]),
+    ("series/queue_len", &["MPairs length"]),
+];
+
+/// Line colours of [`SERIES`], one per name (scalars of one entity would otherwise share a
+/// hue).
+pub(super) const SERIES_COLORS: [&[u32]; 4] = [
+    &[0x2EB82EFF],
+    &[0xE6A700FF, 0xD62728FF, 0x1F77B4FF],
+    &[0x9467BDFF, 0x17BECFFF],
+    &[0xE377C2FF],
 ];
 
 /// Orange of the merged pair's boxes.
@@ -29,23 +37,19 @@ const PAIR_ORANGE: u32 = 0xFF8C00FF;
 /// Green of the new body's box.
 const NEW_GREEN: u32 = 0x2EB82EFF;
 
-/// Logs the static colours and line widths of the per-merge boxes.
+/// Logs the static colours and line widths of the per-merge boxes: the pair's two, then the new
+/// body's (Rerun pairs the i-th colour and radius with the i-th box of each row).
 pub(super) fn log_styles(rec: &RecordingStream) -> anyhow::Result<()> {
     use rerun::components::{FillMode, Radius};
-    for (path, color, radius) in [
-        ("grouping/merge/pair", PAIR_ORANGE, 2.0),
-        ("grouping/merge/new", NEW_GREEN, 2.5),
-    ] {
-        super::send_static(
-            rec,
-            path,
-            &rerun::Boxes3D::update_fields()
-                .with_colors([color])
-                .with_radii([Radius::new_ui_points(radius)])
-                .with_fill_mode(FillMode::MajorWireframe),
-        )?;
-    }
-    Ok(())
+    let (pair, new) = (Radius::new_ui_points(2.0), Radius::new_ui_points(2.5));
+    super::send_static(
+        rec,
+        "grouping/merge",
+        &rerun::Boxes3D::update_fields()
+            .with_colors([PAIR_ORANGE, PAIR_ORANGE, NEW_GREEN])
+            .with_radii([pair, pair, new])
+            .with_fill_mode(FillMode::MajorWireframe),
+    )
 }
 
 /// Column buffers of the merges not sent yet.
@@ -53,11 +57,11 @@ pub(super) fn log_styles(rec: &RecordingStream) -> anyhow::Result<()> {
 pub(super) struct MergeColumns {
     step: Vec<i64>,
     round: Vec<i64>,
-    series: [Vec<f64>; 7],
-    pair_centers: Vec<[f32; 3]>,
-    pair_halves: Vec<[f32; 3]>,
-    new_centers: Vec<[f32; 3]>,
-    new_halves: Vec<[f32; 3]>,
+    /// Per [`SERIES`] entity, its rows' scalars one after the other.
+    series: [Vec<f64>; 4],
+    /// Per merge, the pair's two boxes then the new body's.
+    box_centers: Vec<[f32; 3]>,
+    box_halves: Vec<[f32; 3]>,
     /// `log/doublings` rows: (merge, round) ticks, lines and levels.
     text_ticks: Vec<(i64, i64)>,
     text: Vec<String>,
@@ -80,25 +84,18 @@ impl MergeColumns {
     ) {
         self.step.push(m.step as i64);
         self.round.push(m.round as i64);
-        let values = [
-            m.cost,
-            m.diameter,
-            m.fill,
-            m.balance,
-            dlimit,
-            glimit,
-            m.queue_len as f64,
+        let values: [&[f64]; 4] = [
+            &[m.cost],
+            &[m.diameter, dlimit, glimit],
+            &[m.fill, m.balance],
+            &[m.queue_len as f64],
         ];
         for (column, v) in self.series.iter_mut().zip(values) {
-            column.push(v);
+            column.extend_from_slice(v);
         }
-        if let Some((pair, new)) = boxes {
-            for b in pair {
-                self.pair_centers.push(b.center);
-                self.pair_halves.push(b.half);
-            }
-            self.new_centers.push(new.center);
-            self.new_halves.push(new.half);
+        if let Some(([a, b], new)) = boxes {
+            self.box_centers.extend([a.center, b.center, new.center]);
+            self.box_halves.extend([a.half, b.half, new.half]);
         }
     }
 
@@ -134,10 +131,8 @@ impl MergeColumns {
         self.step.clear();
         self.round.clear();
         self.series.iter_mut().for_each(Vec::clear);
-        self.pair_centers.clear();
-        self.pair_halves.clear();
-        self.new_centers.clear();
-        self.new_halves.clear();
+        self.box_centers.clear();
+        self.box_halves.clear();
         self.text_ticks.clear();
         self.text.clear();
         self.text_levels.clear();
@@ -190,21 +185,17 @@ impl MergeColumns {
         }
         let merge = || TimeColumn::new_sequence("merge", self.step.iter().copied());
         let round = || TimeColumn::new_sequence("round", self.round.iter().copied());
-        for ((path, _), values) in SERIES.iter().zip(&self.series) {
-            let scalars = rerun::Scalars::new(values.iter().copied()).columns_of_unit_batches()?;
+        for ((path, names), values) in SERIES.iter().zip(&self.series) {
+            let scalars = rerun::Scalars::new(values.iter().copied())
+                .columns(std::iter::repeat_n(names.len(), k))?;
             rec.send_columns(*path, [merge()], scalars)?;
         }
-        if !self.new_centers.is_empty() {
-            let pair = rerun::Boxes3D::update_fields()
-                .with_centers(self.pair_centers.iter().copied())
-                .with_half_sizes(self.pair_halves.iter().copied())
-                .columns(std::iter::repeat_n(2, k))?;
-            rec.send_columns("grouping/merge/pair", [merge(), round()], pair)?;
-            let new = rerun::Boxes3D::update_fields()
-                .with_centers(self.new_centers.iter().copied())
-                .with_half_sizes(self.new_halves.iter().copied())
-                .columns(std::iter::repeat_n(1, k))?;
-            rec.send_columns("grouping/merge/new", [merge(), round()], new)?;
+        if !self.box_centers.is_empty() {
+            let boxes = rerun::Boxes3D::update_fields()
+                .with_centers(self.box_centers.iter().copied())
+                .with_half_sizes(self.box_halves.iter().copied())
+                .columns(std::iter::repeat_n(3, k))?;
+            rec.send_columns("grouping/merge", [merge(), round()], boxes)?;
         }
         Ok(())
     }

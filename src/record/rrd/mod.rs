@@ -30,12 +30,14 @@
 //! | `/` | `ViewCoordinates` | static | all | right-handed, Z up (the generated scenes' convention) |
 //! | `scene`, `grouping`, `levels` | `Transform3D` | static | all | translation by the scene origin |
 //! | `scene/primitives` | `Mesh3D` | static | all | every input primitive in one shaded mesh, light grey |
-//! | `grouping/merge/pair` | `Boxes3D` (2 boxes) | `merge`, `round` | merges, full | the AABBs of the two merged bodies (orange) |
-//! | `grouping/merge/new` | `Boxes3D` (1 box) | `merge`, `round` | merges, full | the AABB of the new body (green) |
+//! | `grouping/merge` | `Boxes3D` (3 boxes) | `merge`, `round` | merges, full | the AABBs of the two merged bodies (orange), then of the new body (green) |
 //! | `grouping/active` | `Boxes3D` | `round`, `merge` | merges, full | at each round start, the AABBs of all active bodies (blue) |
-//! | `series/cost`, `series/diameter`, `series/fill`, `series/balance` | `Scalars` | `merge` | all | Cost, diameter, Fill and Balance of each merge |
-//! | `series/dlimit`, `series/glimit` | `Scalars` | `merge` | all | DLimit and GLimit in force at each merge |
-//! | `series/queue_len` | `Scalars` | `merge` | all | MPairs entries left after each pop |
+//! | `series/cost` | `Scalars` (1) | `merge` | all | Cost of each merge |
+//! | `series/limits` | `Scalars` (3: diameter, DLimit, GLimit) | `merge` | all | each merge's diameter, and DLimit and GLimit in force at it |
+//! | `series/fill_balance` | `Scalars` (2: Fill, Balance) | `merge` | all | Fill and Balance of each merge |
+//! | `series/queue_len` | `Scalars` (1) | `merge` | all | MPairs entries left after each pop |
+//!
+//! Each series entity carries static `SeriesLines` names and colours, one per scalar of its rows.
 //! | `log/doublings` | `TextLog` | `merge`, `round` | all | one line per round start (DLimit, GLimit, active, dormant, pairs), per doubling and at the finish |
 //! | `levels/spheres` | `Ellipsoids3D` | `level` | levels, full | interior nodes of the cut at depth d, as translucent blue spheres (`--wrapper sphere`) |
 //! | `levels/hulls` | `Mesh3D` | `level` | levels, full | interior nodes' convex hulls, translucent green (`--wrapper hull`; every distinct hull vertex once at d = 0, then only the triangle indices of the cut's hulls) |
@@ -309,8 +311,11 @@ impl RrdRecorder {
                 .with_triangle_indices(mesh.all_tris().iter().copied())
                 .with_albedo_factor(SCENE_GREY),
         )?;
-        for (path, name) in columns::SERIES {
-            send_static(rec, path, &rerun::SeriesLines::new().with_names([name]))?;
+        for ((path, names), colors) in columns::SERIES.iter().zip(columns::SERIES_COLORS) {
+            let lines = rerun::SeriesLines::new()
+                .with_names(names.iter().copied())
+                .with_colors(colors.iter().copied());
+            send_static(rec, path, &lines)?;
         }
         if self.detail.merges() {
             columns::log_styles(rec)?;
