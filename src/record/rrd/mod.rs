@@ -114,6 +114,8 @@ pub struct RrdRecorder {
     merges: u32,
     /// The primitives' mesh, kept for the levels written by `finish`.
     mesh: Option<PrimMesh>,
+    /// The thread sending the blueprint (joined before the file is closed).
+    blueprint: Option<std::thread::JoinHandle<Result<(), rerun::RecordingStreamError>>>,
     error: Option<anyhow::Error>,
 }
 
@@ -196,7 +198,8 @@ fn send_at(
 }
 
 impl RrdRecorder {
-    /// Creates `path` (replacing it) and writes the blueprint, run metadata and the static scene.
+    /// Creates `path` (replacing it) and writes the run metadata and the static scene; the
+    /// blueprint is sent from a thread of its own.
     ///
     /// Fails when the file cannot be created or the first writes fail.
     pub fn new(path: &Path, info: &RunInfo<'_>) -> anyhow::Result<Self> {
@@ -207,11 +210,21 @@ impl RrdRecorder {
     /// a temporary `path` will be renamed to.
     pub fn with_name(path: &Path, name: &Path, info: &RunInfo<'_>) -> anyhow::Result<Self> {
         let scene = info.scene;
-        let builder = rerun::RecordingStreamBuilder::new("wraptree")
-            .recording_id(recording_id(info))
-            .with_blueprint(blueprint::layout(info.detail));
+        let builder =
+            rerun::RecordingStreamBuilder::new("wraptree").recording_id(recording_id(info));
         let rec = sink::save(builder, path)
             .map_err(|e| file_error(name, "cannot create the Rerun recording", e))?;
+        // The SDK builds a blueprint through a stream of its own (two threads, one chunk per
+        // view); a thread of ours does it while this one writes the header and the events.
+        let (layout, bp_rec) = (blueprint::layout(info.detail), rec.clone());
+        let activation = rerun::blueprint::BlueprintActivation {
+            make_active: true,
+            make_default: true,
+        };
+        let blueprint = std::thread::Builder::new()
+            .name("rrd-blueprint".into())
+            .spawn(move || layout.send(&bp_rec, activation))
+            .map_err(|e| file_error(name, "cannot start the blueprint thread", e))?;
 
         let bbox = scene.aabb();
         let center = bbox.center();
@@ -240,6 +253,7 @@ impl RrdRecorder {
             glimit: info.params.glimit0,
             merges: 0,
             mesh: None,
+            blueprint: Some(blueprint),
             error: None,
         };
         let mesh = PrimMesh::new(scene, &origin);
@@ -428,6 +442,12 @@ impl RrdRecorder {
             return Err(fail(err));
         }
         self.write_tail(outcome).map_err(fail)?;
+        if let Some(handle) = self.blueprint.take() {
+            match handle.join() {
+                Ok(sent) => sent.map_err(|e| fail(e.into()))?,
+                Err(_) => return Err(fail(anyhow!("the blueprint thread failed"))),
+            }
+        }
         let rec = self.rec.take().ok_or_else(closed).map_err(fail)?;
         sink::close(rec, &path).map_err(fail)
     }
