@@ -120,17 +120,7 @@ fn record(dir: &Path, detail: Detail, params: &Params, kinds: &[WrapperKind]) ->
 
 /// Checks `path` with `rerun rrd verify` and summarises it with the Python reader.
 fn summarize(path: &Path) -> Summary {
-    let verify = Command::new("rerun")
-        .args(["rrd", "verify"])
-        .arg(path)
-        .output()
-        .expect("the `rerun` CLI (PyPI rerun-sdk==0.36.3, installed by .ci/run) must be on PATH");
-    assert!(
-        verify.status.success(),
-        "rerun rrd verify {} failed:\n{}",
-        path.display(),
-        String::from_utf8_lossy(&verify.stderr)
-    );
+    common::assert_rrd_verifies(path);
     let out = Command::new("python3")
         .args(["-c", READER])
         .arg(path)

@@ -14,7 +14,7 @@ use crate::grouping::Merge;
 pub(super) const BATCH: usize = 4096;
 
 /// The per-merge series, one entity per plot of the blueprint: its path and the legend name of
-/// each scalar in its rows, in [`MergeColumns::push`] order. (One entity per plot rather than
+/// each scalar in its rows, in [`Columns::push`] order. (One entity per plot rather than
 /// per series: every entity costs the SDK two chunks, a row-id column and a time column.)
 pub(super) const SERIES: [(&str, &[&str]); 4] = [
     ("series/cost", &["Cost"]),
@@ -52,9 +52,9 @@ pub(super) fn log_styles(rec: &RecordingStream) -> anyhow::Result<()> {
     )
 }
 
-/// Column buffers of the merges not sent yet.
+/// Column buffers of the rows not sent yet: merges, text lines and active sets.
 #[derive(Default)]
-pub(super) struct MergeColumns {
+pub(super) struct Columns {
     step: Vec<i64>,
     round: Vec<i64>,
     /// Per [`SERIES`] entity, its rows' scalars one after the other.
@@ -72,7 +72,7 @@ pub(super) struct MergeColumns {
     active_halves: Vec<[f32; 3]>,
 }
 
-impl MergeColumns {
+impl Columns {
     /// Buffers one merge; `boxes` are the pair's and the new body's boxes when per-merge
     /// geometry is written.
     pub(super) fn push(

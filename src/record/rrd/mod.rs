@@ -87,7 +87,7 @@ use sha2::{Digest, Sha256};
 use crate::geom::{Aabb, P3};
 use crate::grouping::{Event, Observer};
 use crate::record::{Detail, Outcome, RunInfo};
-use columns::MergeColumns;
+use columns::Columns;
 use mesh::PrimMesh;
 
 /// Light grey of the input primitives.
@@ -106,7 +106,7 @@ pub struct RrdRecorder {
     origin: P3,
     /// Box of every body so far, relative to `origin` (only when per-merge geometry is written).
     boxes: Vec<BoxF32>,
-    columns: MergeColumns,
+    columns: Columns,
     round: u32,
     dlimit: f64,
     glimit: f64,
@@ -247,7 +247,7 @@ impl RrdRecorder {
             detail: info.detail,
             origin,
             boxes,
-            columns: MergeColumns::default(),
+            columns: Columns::default(),
             round: 0,
             dlimit: info.params.dlimit0,
             glimit: info.params.glimit0,
