@@ -54,6 +54,7 @@ fn arb_params() -> impl Strategy<Value = Params> {
             glimit,
             pset: PSet::Aabb,
             seed,
+            mode: Default::default(),
         })
 }
 

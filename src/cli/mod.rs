@@ -15,7 +15,7 @@ use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use wraptree::grouping::{PSet, Params, Weights};
+use wraptree::grouping::{CostMeasure, Mode, PSet, Params, Pregroup, Schedule, Weights};
 use wraptree::scene::{LoadOptions, Loaded};
 
 /// Build, record and inspect bounding-volume hierarchies with the bottom-up grouping phase of
@@ -123,6 +123,20 @@ pub struct GroupArgs {
     /// Break cost ties by seeded random tags instead of by id.
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Schedule: exact (the literal §2.2 run) or partitioned (the same step inside the chunks
+    /// of a Morton split, bottom-up, in parallel).
+    #[arg(long, value_enum, default_value_t = Schedule::Exact)]
+    pub schedule: Schedule,
+    /// Components grouped on their own first: none, objects (the file's o/g), connected
+    /// (primitives sharing welded vertices).
+    #[arg(long, value_enum, default_value_t = Pregroup::None)]
+    pub pregroup: Pregroup,
+    /// Rigid copies of a component reuse its Subset Tree shape (with --pregroup).
+    #[arg(long)]
+    pub instancing: bool,
+    /// Size measure in the Cost: diameter (the paper's) or area (surface area of the box).
+    #[arg(long, value_enum, default_value_t = CostMeasure::Diameter)]
+    pub cost: CostMeasure,
 }
 
 impl GroupArgs {
@@ -147,6 +161,12 @@ impl GroupArgs {
             glimit: self.glimit,
             pset: self.pset,
             seed: self.seed,
+            mode: Mode {
+                schedule: self.schedule,
+                pregroup: self.pregroup,
+                instancing: self.instancing,
+                cost: self.cost,
+            },
         })
     }
 }

@@ -41,9 +41,84 @@ fn ser_aabb<S: serde::Serializer>(b: &Aabb, s: S) -> Result<S::Ok, S::Error> {
     [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z].serialize(s)
 }
 
+/// What a [`Part`] of a grouping run groups.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum PartKind {
+    /// A chunk of the partitioned schedule: a set of bodies at `level` of the top-down split
+    /// (0 = the whole scene), grouped until at most `keep` of them remain.
+    Chunk {
+        /// Depth of the chunk in the split (0 = the top).
+        level: u32,
+        /// Bodies left ungrouped for the level above (1 at the top).
+        keep: u32,
+    },
+    /// A component (pre-grouping): its primitives are grouped on their own.
+    Component {
+        /// Index of the component in the documented component order.
+        index: u32,
+    },
+    /// A rigid copy of component `of` (instancing): it takes the representative's Subset Tree
+    /// shape; `rotation` (row-major 3×3) and `translation` map the representative onto it.
+    Copy {
+        /// Index of the component this one copies.
+        of: u32,
+        /// Row-major rotation matrix.
+        rotation: [f64; 9],
+        /// Translation applied after the rotation.
+        translation: [f64; 3],
+    },
+    /// The top level: the roots of the parts (and any bodies left out of parts) grouped together.
+    Top,
+}
+
+/// A part of a grouping run: the merges that follow it, up to the next `Part` or `Finish`,
+/// group the bodies of this part (a chunk of the partitioned schedule, a component, a copy, or
+/// the top level).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Part {
+    /// 0-based index of the part in the run, in event order.
+    pub id: u32,
+    /// What the part groups.
+    pub kind: PartKind,
+    /// Number of bodies the part starts from.
+    pub bodies: u32,
+    /// Merge step of the part's first merge (= merges made before it).
+    pub first_step: u32,
+}
+
+impl std::fmt::Display for Part {
+    /// One log line, e.g. `part 3: chunk at level 2 (12 bodies → 4) from merge 57`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "part {}: ", self.id)?;
+        match self.kind {
+            PartKind::Chunk { level, keep } => write!(
+                f,
+                "chunk at level {level} ({} bodies → {keep})",
+                self.bodies
+            )?,
+            PartKind::Component { index } => {
+                write!(f, "component {index} ({} primitives)", self.bodies)?
+            }
+            PartKind::Copy {
+                of, translation, ..
+            } => write!(
+                f,
+                "copy of component {of} ({} primitives, moved by [{:.4}, {:.4}, {:.4}])",
+                self.bodies, translation[0], translation[1], translation[2]
+            )?,
+            PartKind::Top => write!(f, "top level ({} bodies)", self.bodies)?,
+        }
+        write!(f, " from merge {}", self.first_step)
+    }
+}
+
 /// A step of the grouping phase.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Event<'a> {
+    /// A part of the run starts (partitioned schedule, pre-grouping, instancing); the plain
+    /// §2.2 run emits none.
+    Part(Part),
     /// Step 2–3: a round starts with these limits and sets.
     RoundStart {
         /// Round index (0 for the first).
@@ -145,6 +220,8 @@ pub struct EventLog {
     pub doublings: Vec<(u32, u32, f64, f64)>,
     /// Root id once finished.
     pub root: Option<u32>,
+    /// Every part announced, in order.
+    pub parts: Vec<Part>,
 }
 
 impl Observer for EventLog {
@@ -169,6 +246,7 @@ impl Observer for EventLog {
                 glimit,
             } => self.doublings.push((round, merges, dlimit, glimit)),
             Event::Finish { root, .. } => self.root = Some(root),
+            Event::Part(p) => self.parts.push(p),
         }
     }
 }

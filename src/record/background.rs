@@ -43,6 +43,7 @@ impl Owned {
                 active: active.to_vec(),
             },
             Event::Merge(m) => Owned::plain(Event::Merge(m)),
+            Event::Part(p) => Owned::plain(Event::Part(p)),
             Event::Dormant {
                 round,
                 body,

@@ -4,7 +4,7 @@
 //! Every value is a string; numbers use Rust's shortest round-trip formatting, so parsing
 //! them gives back the exact `f64`.
 
-use crate::grouping::{PSet, ResolvedParams, Weights};
+use crate::grouping::{Mode, PSet, ResolvedParams, Weights};
 use crate::record::{Detail, Outcome, RunInfo};
 use anyhow::{Context, Result, anyhow};
 use clap::ValueEnum;
@@ -26,6 +26,10 @@ pub const KEYS: &[&str] = &[
     "glimit0",
     "pset",
     "seed",
+    "schedule",
+    "pregroup",
+    "instancing",
+    "cost",
     "detail",
     "scene",
     "scene_file",
@@ -92,6 +96,10 @@ pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String,
     put("glimit0", p.glimit0.to_string());
     put("pset", value_name(&p.pset));
     put("seed", p.seed.map_or("none".to_string(), |s| s.to_string()));
+    put("schedule", value_name(&p.mode.schedule));
+    put("pregroup", value_name(&p.mode.pregroup));
+    put("instancing", p.mode.instancing.to_string());
+    put("cost", value_name(&p.mode.cost));
     put("detail", value_name(&info.detail));
     put("scene", info.scene.name.clone());
     put("scene_file", info.source.file_name.clone());
@@ -165,11 +173,36 @@ pub fn params(m: &BTreeMap<String, String>) -> Result<ResolvedParams> {
         glimit0: parse(m, "glimit0")?,
         pset: parse_enum::<PSet>(m, "pset")?,
         seed,
+        mode: mode(m)?,
     };
     params
         .check()
         .map_err(|e| anyhow::anyhow!("metadata parameter {e}"))?;
     Ok(params)
+}
+
+/// The run's [`Mode`]; recordings made before modes existed lack the keys and were made in
+/// the default mode.
+fn mode(m: &BTreeMap<String, String>) -> Result<Mode> {
+    let d = Mode::default();
+    Ok(Mode {
+        schedule: match m.contains_key("schedule") {
+            true => parse_enum(m, "schedule")?,
+            false => d.schedule,
+        },
+        pregroup: match m.contains_key("pregroup") {
+            true => parse_enum(m, "pregroup")?,
+            false => d.pregroup,
+        },
+        instancing: match m.contains_key("instancing") {
+            true => parse(m, "instancing")?,
+            false => d.instancing,
+        },
+        cost: match m.contains_key("cost") {
+            true => parse_enum(m, "cost")?,
+            false => d.cost,
+        },
+    })
 }
 
 /// Why the recorded run stopped before the root: `None` for a complete recording,

@@ -400,6 +400,7 @@ impl RrdRecorder {
                 }
             }
             Event::Dormant { .. } => {}
+            Event::Part(p) => self.text(self.round, p.to_string()),
             Event::Doubling {
                 round,
                 merges,
