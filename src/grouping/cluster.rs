@@ -55,19 +55,29 @@ pub(super) fn run<O: Observer>(
     budget: &Budget<'_>,
 ) -> Result<Grouping, Stopped> {
     assert!(!scene.is_empty(), "grouping needs at least one primitive");
+    let boxes = (0..scene.len()).map(|i| scene.prim_aabb(i)).collect();
     match params.pset {
-        PSet::Aabb => {
-            let diameters = (0..scene.len())
-                .map(|i| scene.prim_aabb(i).diameter())
-                .collect();
-            Clusterer::new(scene, params, AabbBodies, diameters, observer).run(budget)
-        }
+        PSet::Aabb => run_boxes(boxes, params, observer, budget),
         PSet::Hull => {
             let bodies = HullBodies::new(scene);
             let diameters = bodies.leaf_diameters();
-            Clusterer::new(scene, params, bodies, diameters, observer).run(budget)
+            Clusterer::new(boxes, params, bodies, diameters, observer).run(budget)
         }
     }
+}
+
+/// Runs the grouping phase with the AABB p-set on bodies given by their boxes (leaf `i` has
+/// box `boxes[i]`; its diameter is the box diagonal): the primitives of a scene, or the roots
+/// of groupings made before (components, chunks). Merge ids are local: leaves `0..boxes.len()`.
+pub(crate) fn run_boxes<O: Observer>(
+    boxes: Vec<Aabb>,
+    params: &ResolvedParams,
+    observer: O,
+    budget: &Budget<'_>,
+) -> Result<Grouping, Stopped> {
+    assert!(!boxes.is_empty(), "grouping needs at least one body");
+    let diameters = boxes.iter().map(Aabb::diameter).collect();
+    Clusterer::new(boxes, params, AabbBodies, diameters, observer).run(budget)
 }
 
 /// The budget as the round-start scans see it: pairs left before `max_pairs` is exceeded,
@@ -159,16 +169,15 @@ struct Clusterer<P, O> {
 
 impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
     fn new(
-        scene: &Scene,
+        mut aabb: Vec<Aabb>,
         params: &ResolvedParams,
         pset: P,
         diameter: Vec<f64>,
         observer: O,
     ) -> Self {
-        let n = scene.len();
+        let n = aabb.len();
         let total = 2 * n - 1;
-        let mut aabb = Vec::with_capacity(total);
-        aabb.extend((0..n).map(|i| scene.prim_aabb(i)));
+        aabb.reserve(total - n);
         let mut d = diameter;
         d.reserve(total - n);
         let bounds = aabb.iter().fold(Aabb::EMPTY, |b, x| b.merge(x));
