@@ -77,6 +77,7 @@ impl Recorded {
             dormant: self.dormant.clone(),
             doublings: self.doublings.clone(),
             root: self.root,
+            parts: Vec::new(),
         }
     }
 }
