@@ -1,5 +1,6 @@
-//! Scene loading and generation: the bundled scenes, the bad-input corpus in `tests/data/bad/`,
-//! the polygon and polyhedra rules, determinism, the generators and OBJ round trips.
+//! Scene loading and generation: the committed generated scenes, the bad-input corpus in
+//! `tests/data/bad/`, the polygon and polyhedra rules, determinism, the generators and OBJ round
+//! trips. Every bundled scene's load and count is in `bundled_scenes.rs`.
 
 use std::path::{Path, PathBuf};
 
@@ -20,20 +21,6 @@ const STRICT: LoadOptions = LoadOptions {
     polyhedra: true,
     strict: true,
 };
-
-/// Every file in `scenes/`: (name, loaded as polyhedra, primitives). Keep in sync with
-/// `scenes/README.md`.
-const BUNDLED: &[(&str, bool, usize)] = &[
-    ("franka-link0.obj", false, 200),
-    ("kuka-link0.obj", false, 3038),
-    ("mug.obj", false, 729),
-    ("random-urdf-000.obj", true, 5),
-    ("random-urdf-350.obj", true, 34),
-    ("random-urdf-782.obj", true, 127),
-    ("robot-base.obj", false, 276),
-    ("lamp.obj", false, 626),
-    ("lamps5.obj", false, 3130),
-];
 
 fn repo(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
@@ -73,36 +60,6 @@ fn obj_text(s: &Scene) -> Vec<u8> {
     let mut out = Vec::new();
     s.write_obj(&mut out).unwrap();
     out
-}
-
-#[test]
-fn every_bundled_scene_loads_with_its_primitive_count() {
-    let mut on_disk: Vec<String> = std::fs::read_dir(repo("scenes"))
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".obj"))
-        .collect();
-    on_disk.sort();
-    let mut listed: Vec<String> = BUNDLED.iter().map(|b| b.0.to_string()).collect();
-    listed.sort();
-    assert_eq!(on_disk, listed, "scenes/*.obj and BUNDLED differ");
-    for &(name, polyhedra, count) in BUNDLED {
-        let opts = LoadOptions {
-            polyhedra,
-            strict: polyhedra,
-        };
-        let l =
-            load_path(&repo(&format!("scenes/{name}")), &opts).unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!(l.scene.len(), count, "{name}");
-        let kind = [PrimitiveKind::Polygon, PrimitiveKind::Polyhedron][polyhedra as usize];
-        assert_eq!(l.scene.kind, Some(kind), "{name}");
-        assert!(all_finite(&l.scene), "{name}");
-        assert_eq!(l.source.file_name, name);
-        assert_eq!(l.scene.name, name.trim_end_matches(".obj"));
-        if polyhedra {
-            assert_eq!(l.scene.labels.len(), count, "{name}");
-        }
-    }
 }
 
 #[test]
