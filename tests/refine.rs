@@ -22,24 +22,35 @@ fn check_valid(scene: &Scene, t: &SubsetTree) {
     let mut seen = vec![0u32; t.len()];
     for (i, &[a, b]) in t.children.iter().enumerate() {
         let x = n + i;
-        assert!((a as usize) < x && (b as usize) < x, "children precede parent");
+        assert!(
+            (a as usize) < x && (b as usize) < x,
+            "children precede parent"
+        );
         seen[a as usize] += 1;
         seen[b as usize] += 1;
         let u = t.aabb[a as usize].merge(&t.aabb[b as usize]);
         assert_eq!(t.aabb[x], u, "node {x} box is its children's union");
     }
     for (x, c) in seen.iter().enumerate() {
-        assert_eq!(*c, u32::from(x != 2 * n - 2), "node {x} is a child {c} times");
+        assert_eq!(
+            *c,
+            u32::from(x != 2 * n - 2),
+            "node {x} is a child {c} times"
+        );
     }
     let mut leaves = t.leaves_under(t.root());
     leaves.sort();
     assert_eq!(leaves, (0..n as u32).collect::<Vec<_>>());
     for leaf in 0..n {
-        assert_eq!(t.aabb[leaf], scene.prim_aabb(leaf), "leaf {leaf} in input order");
+        assert_eq!(
+            t.aabb[leaf],
+            scene.prim_aabb(leaf),
+            "leaf {leaf} in input order"
+        );
     }
 }
 
-fn refined(scene: &Scene, tree: &SubsetTree) -> (Refined, EventLog) {
+fn refined(tree: &SubsetTree) -> (Refined, EventLog) {
     let mut log = EventLog::default();
     let r = refine(tree, &RefineParams::default(), &mut log);
     (r, log)
@@ -47,9 +58,14 @@ fn refined(scene: &Scene, tree: &SubsetTree) -> (Refined, EventLog) {
 
 /// Checks a refinement of `tree` over `scene`: valid, SAH not above, events consistent.
 fn check_refinement(scene: &Scene, tree: &SubsetTree) -> Refined {
-    let (r, log) = refined(scene, tree);
+    let (r, log) = refined(tree);
     check_valid(scene, &r.tree);
-    assert!(r.sah_after <= r.sah_before, "{} > {}", r.sah_after, r.sah_before);
+    assert!(
+        r.sah_after <= r.sah_before,
+        "{} > {}",
+        r.sah_after,
+        r.sah_before
+    );
     assert_eq!(r.sah_before, sah(tree));
     assert_eq!(r.sah_after, sah(&r.tree));
     assert_eq!(log.refine.len(), r.steps as usize);
@@ -108,7 +124,7 @@ fn refinement_is_deterministic_and_thread_count_independent() {
             .num_threads(threads)
             .build()
             .unwrap();
-        pool.install(|| refined(&scene, &g.tree))
+        pool.install(|| refined(&g.tree))
     };
     let (r1, log1) = run(1);
     let (r2, log2) = run(2);
@@ -129,14 +145,14 @@ fn optimal_trees_of_two_and_three_primitives_are_unchanged() {
     // Two primitives: one tree.
     let two = tri_scene(&[[0.0, 0.0, 0.0], [5.0, 0.0, 0.0]]);
     let g = group(&two, &Params::default(), ());
-    let (r, log) = refined(&two, &g.tree);
+    let (r, log) = refined(&g.tree);
     assert_eq!(r.tree, g.tree);
     assert!(log.refine.is_empty());
     // Three in a row, the two close ones paired first: the SAH-optimal tree.
     let three = tri_scene(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [9.0, 0.0, 0.0]]);
     let g = group(&three, &Params::default(), ());
     assert_eq!(g.tree.children[0], [0, 1]);
-    let (r, log) = refined(&three, &g.tree);
+    let (r, log) = refined(&g.tree);
     assert_eq!(r.tree, g.tree);
     assert!(log.refine.is_empty());
     // The same three paired badly ((0, 2), 1) is fixed by one move.
@@ -162,10 +178,14 @@ fn degenerate_scenes_are_returned_unchanged() {
     for _ in 0..5 {
         let b = s.points.len() as u32;
         s.points.extend([P3::new(1.0, 2.0, 3.0); 3]);
-        s.push(PrimitiveKind::Polygon, &[b, b + 1, b + 2], &[[b, b + 1, b + 2]]);
+        s.push(
+            PrimitiveKind::Polygon,
+            &[b, b + 1, b + 2],
+            &[[b, b + 1, b + 2]],
+        );
     }
     let g = group(&s, &Params::default(), ());
-    let (r, log) = refined(&s, &g.tree);
+    let (r, log) = refined(&g.tree);
     assert_eq!(r.tree, g.tree);
     assert!(log.refine.is_empty());
 }
@@ -182,8 +202,16 @@ fn arb_scene() -> impl Strategy<Value = Scene> {
         for (c, u) in tris {
             let b = s.points.len() as u32;
             let c = P3::new(c[0], c[1], c[2]);
-            s.points.extend([c, c + nalgebra::Vector3::from(u), c + nalgebra::Vector3::new(u[1], u[2], u[0])]);
-            s.push(PrimitiveKind::Polygon, &[b, b + 1, b + 2], &[[b, b + 1, b + 2]]);
+            s.points.extend([
+                c,
+                c + nalgebra::Vector3::from(u),
+                c + nalgebra::Vector3::new(u[1], u[2], u[0]),
+            ]);
+            s.push(
+                PrimitiveKind::Polygon,
+                &[b, b + 1, b + 2],
+                &[[b, b + 1, b + 2]],
+            );
         }
         s
     })
@@ -218,7 +246,11 @@ fn area_cost_gives_valid_trees_that_differ_from_the_diameter_cost() {
         ..Params::default()
     };
     let mut differed = 0;
-    for scene in [generate::soup(2000, 3), generate::robot_base(), generate::lamp()] {
+    for scene in [
+        generate::soup(2000, 3),
+        generate::robot_base(),
+        generate::lamp(),
+    ] {
         let (ga, log) = common::run(&scene, &area);
         common::check_tree(&scene, &ga, &log);
         let gd = group(&scene, &Params::default(), ());
@@ -228,8 +260,15 @@ fn area_cost_gives_valid_trees_that_differ_from_the_diameter_cost() {
             let t = &ga.tree;
             let s = |x: u32| wraptree::metrics::area(&t.aabb[x as usize]);
             let fill = s(m.new) / (s(m.a) + s(m.b));
-            assert!((m.fill - fill).abs() <= 1e-12 * fill, "{} vs {fill}", m.fill);
-            assert_eq!(m.diameter, t.diameter[m.new as usize], "DLimit stays a length");
+            assert!(
+                (m.fill - fill).abs() <= 1e-12 * fill,
+                "{} vs {fill}",
+                m.fill
+            );
+            assert_eq!(
+                m.diameter, t.diameter[m.new as usize],
+                "DLimit stays a length"
+            );
         }
     }
     assert!(differed >= 2, "the area Cost changes the merge order");
@@ -241,10 +280,23 @@ fn replay_verifies_a_refined_recording() {
     let prefix = dir.path().join("lamp");
     let p = prefix.to_str().unwrap();
     let out = common::wraptree(
-        &["record", LAMP, "--refine", "--detail", "levels", "--reproducible", "-o", p],
+        &[
+            "record",
+            LAMP,
+            "--refine",
+            "--detail",
+            "levels",
+            "--reproducible",
+            "-o",
+            p,
+        ],
         dir.path(),
     );
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let mcap = format!("{p}.mcap");
     let rec = wraptree::record::mcap::read_recording(std::path::Path::new(&mcap)).unwrap();
     let r = rec.refine.expect("the metadata names the refinement");
@@ -252,13 +304,25 @@ fn replay_verifies_a_refined_recording() {
     assert!(r.steps > 0 && r.sah_after < r.sah_before);
     assert_eq!(rec.refine_steps.len(), r.steps as usize);
     // The levels are the refined tree's: its depth is recorded.
-    let loaded = wraptree::scene::load_bytes(&rec.scene_file_name, rec.scene_bytes.clone(), &rec.load_options).unwrap();
+    let loaded = wraptree::scene::load_bytes(
+        &rec.scene_file_name,
+        rec.scene_bytes.clone(),
+        &rec.load_options,
+    )
+    .unwrap();
     let t = refine(&rec.tree(&loaded.scene).unwrap(), &r.params, ()).tree;
     assert_eq!(rec.metadata["depth_max"], t.depth_max().to_string());
     let out = common::wraptree(&["replay", &mcap, "--verify"], dir.path());
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
-    assert!(stdout.contains("the refinement's moves are identical"), "{stdout}");
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("the refinement's moves are identical"),
+        "{stdout}"
+    );
     common::assert_rrd_verifies(&std::path::Path::new(&format!("{p}.rrd")));
 }
 

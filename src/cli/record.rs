@@ -484,7 +484,10 @@ impl RecordCmd {
             );
         }
         if !(self.refine_batch > 0.0 && self.refine_batch <= 1.0) {
-            bail!("--refine-batch must be in (0, 1], got {}", self.refine_batch);
+            bail!(
+                "--refine-batch must be in (0, 1], got {}",
+                self.refine_batch
+            );
         }
         let loaded = self.scene.load()?;
         let params = self.group.params()?.resolve(&loaded.scene);

@@ -11,8 +11,8 @@ use wraptree::grouping::{
     Event, EventLog, Merge, Observer, ResolvedParams, Stopped, SubsetTree, Weights, group_within,
 };
 use wraptree::record::Detail;
-use wraptree::refine;
 use wraptree::record::mcap::{Recorded, metadata, read_recording};
+use wraptree::refine;
 use wraptree::scene::{Loaded, load_bytes};
 use wraptree::wrap::WrapperKind;
 

@@ -452,7 +452,11 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         let d = self.pset.merge(a, b, new, &merged);
         let (size, sa, sb) = if self.params.mode.cost == super::CostMeasure::Area {
             let ext = |x: u32| self.aabb[x as usize].max - self.aabb[x as usize].min;
-            (box_area(&(merged.max - merged.min)), box_area(&ext(a)), box_area(&ext(b)))
+            (
+                box_area(&(merged.max - merged.min)),
+                box_area(&ext(a)),
+                box_area(&ext(b)),
+            )
         } else {
             (d, self.diameter[a as usize], self.diameter[b as usize])
         };

@@ -121,7 +121,12 @@ mod tests {
                 (1.0, 1.0, 2.0)
             ]
         );
-        let both = grid(&[1.0], &[1.0], &[0.0], &[CostMeasure::Diameter, CostMeasure::Area]);
+        let both = grid(
+            &[1.0],
+            &[1.0],
+            &[0.0],
+            &[CostMeasure::Diameter, CostMeasure::Area],
+        );
         assert_eq!(both.len(), 2);
         assert_eq!(both[1].cost, CostMeasure::Area);
     }

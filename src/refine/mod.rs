@@ -3,8 +3,9 @@
 //! (Bittner, Hapala and Havran 2013) in the parallel form of Meister and Bittner 2018
 //! ([`reinsert`]).
 //!
-//! A run is a sequence of passes. Pass k (0-based) ranks the non-root nodes by box area and
-//! searches the best reinsertion of the first ⌈batch × (2N − 2) / (2k + 1)⌉ of them, in
+//! A run is a sequence of passes. Pass k (0-based) ranks the non-root nodes by how badly their
+//! parent fits them ([`reinsert::candidates`]) and searches the best reinsertion of the first
+//! ⌈batch × (2N − 2) / (2k + 1)⌉ of them, in
 //! parallel on the tree as it stands; the moves found are then applied one at a time, best
 //! first, each re-checked against the current tree and kept only if it lowers the SAH by more
 //! than 10⁻¹² of the root's area (else undone). The shrinking batches (1, 1/3, 1/5, …, as obvhs
@@ -47,12 +48,13 @@ pub struct RefineParams {
 }
 
 impl Default for RefineParams {
-    /// 8 passes, first batch = every node (see the README's refinement section for the
+    /// 6 passes, first batch = a tenth of the nodes: refinement within about one obvhs PLOC
+    /// build time on the bench scenes (see the README's refinement section for the
     /// measurements behind it).
     fn default() -> Self {
         RefineParams {
-            passes: 8,
-            batch: 1.0,
+            passes: 6,
+            batch: 0.1,
         }
     }
 }

@@ -43,7 +43,13 @@ pub fn subset_tree(w: &WorkTree, input: &SubsetTree) -> Result<SubsetTree, Strin
             order.len()
         ));
     }
-    let id = |c: u32| if w.is_leaf(c) { c } else { new_id[(c as usize) - n] };
+    let id = |c: u32| {
+        if w.is_leaf(c) {
+            c
+        } else {
+            new_id[(c as usize) - n]
+        }
+    };
     let mut aabb = w.aabb[..n].to_vec();
     let mut diameter = input.diameter[..n].to_vec();
     let mut children = Vec::with_capacity(slots);

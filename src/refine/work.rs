@@ -140,7 +140,11 @@ impl WorkTree {
             self.refit(g);
         }
         self.refit(p);
-        Moved { sibling: s, old_grandparent: g, parent: p }
+        Moved {
+            sibling: s,
+            old_grandparent: g,
+            parent: p,
+        }
     }
 
     /// Marks the slots whose leaf set the move `m` changed (their diameters are recomputed):

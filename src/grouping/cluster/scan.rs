@@ -39,10 +39,10 @@
 
 use super::{Clusterer, PSetBodies, ScanLimit, box_area, fill_balance};
 use crate::geom::{Aabb, P3, V3};
-use crate::grouping::{CostMeasure, Weights};
 use crate::grouping::events::Observer;
 use crate::grouping::mpairs::{K_MAX, List, Top};
 use crate::grouping::voxel_hash::CellBounds;
+use crate::grouping::{CostMeasure, Weights};
 
 /// The last AABB search (see the module doc): the bits of its searcher's box and diameter and
 /// the voxel hash version, and the first `K_MAX + 1` partners in key order of all stored bodies,

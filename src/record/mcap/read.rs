@@ -278,7 +278,11 @@ fn interpret(raw: Raw) -> Result<Recorded> {
     let refine = metadata::refine(&m)?;
     let steps_named = refine.map_or(0, |r| r.steps as usize);
     if raw.refine.len() != steps_named
-        || raw.refine.iter().enumerate().any(|(i, s)| s.step as usize != i)
+        || raw
+            .refine
+            .iter()
+            .enumerate()
+            .any(|(i, s)| s.step as usize != i)
     {
         bail!(
             "the recording holds {} refinement steps, its metadata says {steps_named}",
