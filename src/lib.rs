@@ -11,6 +11,7 @@ pub mod metrics;
 pub mod peers;
 pub mod query;
 pub mod record;
+pub mod refine;
 pub mod render;
 pub mod scene;
 pub mod wrap;

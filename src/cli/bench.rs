@@ -202,6 +202,7 @@ impl BenchCmd {
             "peak MB"
         );
         let params = Params::default();
+        let mut refined = Vec::new();
         for scene in &cases {
             let n = scene.len();
             let repeat = if n >= 1_000_000 {
@@ -210,7 +211,7 @@ impl BenchCmd {
                 self.repeat
             };
             let workload = Workload::standard(scene, 1);
-            let run = |m: Method| -> Result<(f64, f64, f64, u32)> {
+            let run = |m: Method| -> Result<(f64, f64, f64, u32, f64)> {
                 let mut best: Option<peers::Built> = None;
                 for _ in 0..repeat.max(1) {
                     let b = peers::build(m, scene, &params).map_err(|e| anyhow!(e))?;
@@ -221,11 +222,25 @@ impl BenchCmd {
                 let b = best.expect("ran at least once");
                 let q = query::measure(&b.tree, scene, Bv::Aabb, &workload);
                 let tests = wraptree::metrics::compare::query_values(&q)[6];
-                Ok((b.seconds, metrics::sah(&b.tree), tests, b.tree.depth_max()))
+                Ok((
+                    b.seconds,
+                    metrics::sah(&b.tree),
+                    tests,
+                    b.tree.depth_max(),
+                    b.refine_seconds,
+                ))
             };
-            let (t, sah, qc, depth) = run(Method::Grouping)?;
+            let (t, sah, qc, depth, _) = run(Method::Grouping)?;
             let (tp, ..) = run(Method::ObvhsPloc)?;
-            let (tb, sah_b, qc_b, _) = run(Method::ParryBinned)?;
+            let (tb, sah_b, qc_b, ..) = run(Method::ParryBinned)?;
+            let (_, sah_r, qc_r, _, t_ref) = run(Method::GroupingRefine)?;
+            let (_, sah_o, qc_o, ..) = run(Method::ObvhsPlocReinsert)?;
+            refined.push((
+                scene.name.clone(),
+                t_ref / tp,
+                sah_r / sah_b.min(sah_o),
+                qc_r / qc_b.min(qc_o),
+            ));
             println!(
                 "{:<18} {:>8} {:>9.2} {:>9.2} {:>7.2} {:>9.2} {:>7.2} {:>8.3} {:>8.3} {:>6} {:>8.0}",
                 scene.name,
@@ -247,6 +262,19 @@ impl BenchCmd {
             "workload) of the grouping tree / parry Binned's. Goal: t/PLOC <= 1 and qry/bin <= 1."
         );
         println!("peak MB = process peak RSS after the case (cases run in increasing size).");
+        println!();
+        println!(
+            "{:<18} {:>10} {:>9} {:>9}",
+            "scene", "ref/PLOC", "SAH/best", "qry/best"
+        );
+        for (name, t, s, q) in &refined {
+            println!("{name:<18} {t:>10.2} {s:>9.3} {q:>9.3}");
+        }
+        println!("grouping+refine: ref/PLOC = refinement time alone / obvhs PLOC build time;");
+        println!(
+            "SAH/best, qry/best = its SAH and node tests per query / the best of parry Binned"
+        );
+        println!("and obvhs PLOC + reinsertion. Goal: all three <= 1.");
         Ok(ExitCode::SUCCESS)
     }
 

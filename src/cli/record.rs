@@ -16,6 +16,7 @@ use wraptree::record::mcap::McapRecorder;
 use wraptree::record::output::Pending;
 use wraptree::record::rrd::RrdRecorder;
 use wraptree::record::{CoverLevel, Detail, Outcome, RunInfo, background};
+use wraptree::refine::RefineParams;
 use wraptree::scene::{Scene, SceneSource};
 use wraptree::wrap::cover::export::{self, WrapperRecord};
 use wraptree::wrap::cover::{Cover, Fits};
@@ -55,6 +56,16 @@ pub struct RecordCmd {
     /// Wrapper kinds the cover chooses from, comma-separated: sphere, box (or aabb), obb, hull.
     #[arg(long, default_value = "sphere,box,hull", value_delimiter = ',', value_parser = WrapperKind::parse)]
     cover_kinds: Vec<WrapperKind>,
+    /// Refine the finished tree (reinsertion, see the README) and record each move on the
+    /// `refine` timeline / `/refine/step` topic; the levels are then the refined tree's.
+    #[arg(long)]
+    refine: bool,
+    /// Most refinement passes (with --refine).
+    #[arg(long, default_value_t = RefineParams::default().passes, requires = "refine")]
+    refine_passes: u32,
+    /// Fraction of the nodes searched in the first refinement pass, in (0, 1] (with --refine).
+    #[arg(long, default_value_t = RefineParams::default().batch, requires = "refine")]
+    refine_batch: f64,
 }
 
 /// How a recording is made, besides what it holds.
@@ -66,6 +77,8 @@ pub struct Options {
     pub reproducible: bool,
     /// Limits on the grouping (Ctrl-C/SIGTERM always stop it).
     pub limits: BudgetArgs,
+    /// Refine the finished tree with these parameters, recording each move.
+    pub refine: Option<RefineParams>,
 }
 
 /// How the logged cover is bounded.
@@ -172,6 +185,7 @@ pub fn record(
             force,
             reproducible,
             limits: BudgetArgs::default(),
+            refine: None,
         },
         Logged {
             kinds: &kinds,
@@ -198,6 +212,7 @@ pub fn record_with(
         force,
         reproducible,
         limits,
+        refine,
     } = opts;
     if logged.cover.is_some() && !detail.levels() {
         bail!(
@@ -250,12 +265,17 @@ pub fn record_with(
         // start drops its worker (the grouping stops sending to it) and its error is reported
         // after the grouping, like a write error during the run. Missing or unwritable
         // destinations were already refused by `Pending::create`.
-        let result = grouping::group_within(
+        let mut result = grouping::group_within(
             scene,
             params,
             Tee(&mut events, progress),
             &limits.budget(Some(&stop)),
         );
+        // The refinement's events follow the grouping's on the same channels; the levels
+        // below are the refined tree's.
+        if let (Ok(g), Some(rp)) = (&mut result, &refine) {
+            g.tree = wraptree::refine::refine(&g.tree, rp, &mut events).tree;
+        }
         events.close();
         let seconds = start.elapsed().as_secs_f64();
         let (grouping, stopped, merges, rounds) = match result {
@@ -463,6 +483,12 @@ impl RecordCmd {
                 "--cover-tolerance/--cover-budget need --detail levels or full (the cover is a level)"
             );
         }
+        if !(self.refine_batch > 0.0 && self.refine_batch <= 1.0) {
+            bail!(
+                "--refine-batch must be in (0, 1], got {}",
+                self.refine_batch
+            );
+        }
         let loaded = self.scene.load()?;
         let params = self.group.params()?.resolve(&loaded.scene);
         let prefix = output_prefix(self.output.as_deref(), &loaded.source.file_name, "")?;
@@ -476,6 +502,10 @@ impl RecordCmd {
                 force: self.force,
                 reproducible: self.reproducible,
                 limits: self.limits,
+                refine: self.refine.then_some(RefineParams {
+                    passes: self.refine_passes,
+                    batch: self.refine_batch,
+                }),
             },
             Logged {
                 kinds: &self.wrapper,

@@ -12,6 +12,7 @@ use wraptree::grouping::{
 };
 use wraptree::record::Detail;
 use wraptree::record::mcap::{Recorded, metadata, read_recording};
+use wraptree::refine;
 use wraptree::scene::{Loaded, load_bytes};
 use wraptree::wrap::WrapperKind;
 
@@ -213,8 +214,15 @@ impl ReplayCmd {
             rec.scene_name, p.weights.a, p.weights.b, p.weights.c, p.dlimit0, p.glimit0, p.pset
         );
         if rec.complete {
-            let t = tree_of(&rec, &loaded)
+            let mut t = tree_of(&rec, &loaded)
                 .with_context(|| format!("{name}: the merge events do not form a tree"))?;
+            if let Some(r) = &rec.refine {
+                t = refine::refine(&t, &r.params, ()).tree;
+                println!(
+                    "refined ({} passes at most, first batch {}): {} moves, SAH {:.6} -> {:.6}",
+                    r.params.passes, r.params.batch, r.steps, r.sah_before, r.sah_after
+                );
+            }
             println!(
                 "replayed {} merges in {} rounds: root {}, depth max {} ({} levels), mean {:.2}",
                 rec.merges.len(),
@@ -273,6 +281,25 @@ impl ReplayCmd {
                     return Ok(ExitCode::FAILURE);
                 }
             }
+            if let (Some(r), true) = (&rec.refine, rec.complete) {
+                let t = tree_of(&rec, &loaded)?;
+                let mut steps = EventLog::default();
+                refine::refine(&t, &r.params, &mut steps);
+                match (0..rec.refine_steps.len().max(steps.refine.len()))
+                    .find(|&i| rec.refine_steps.get(i) != steps.refine.get(i))
+                {
+                    None => println!(
+                        "verified: the refinement's moves are identical ({} moves)",
+                        steps.refine.len()
+                    ),
+                    Some(i) => {
+                        println!("first refinement divergence at step {i}:");
+                        println!("  recorded: {:?}", rec.refine_steps.get(i));
+                        println!("  re-run:   {:?}", steps.refine.get(i));
+                        return Ok(ExitCode::FAILURE);
+                    }
+                }
+            }
         }
         if self.a.is_some() || self.b.is_some() || self.c.is_some() {
             return self.reweight(&rec, &loaded);
@@ -309,6 +336,7 @@ impl ReplayCmd {
                 force: self.force,
                 reproducible: false,
                 limits: self.limits,
+                refine: rec.refine.map(|r| r.params),
             },
             logged,
         )?;

@@ -1,11 +1,11 @@
-//! `wraptree sweep`: the A/B/C grid of the grouping phase's Cost on one scene, as a table,
+//! `wraptree sweep`: the A/B/C × size-measure grid of the grouping phase's Cost on one scene, as a table,
 //! `sweep.csv`, heat maps and one `.rrd` with every setting side by side.
 
 use anyhow::{Result, anyhow};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use wraptree::grouping::{PSet, Params};
+use wraptree::grouping::{CostMeasure, PSet, Params};
 use wraptree::metrics::report::{SweepRrd, setting_name, sweep_table, write_sweep};
 use wraptree::metrics::sweep::{grid, sweep};
 
@@ -23,6 +23,10 @@ pub struct SweepCmd {
     /// Values of the Balance weight C (comma list).
     #[arg(long, value_delimiter = ',', default_values_t = [0.0, 1.0], allow_negative_numbers = true)]
     c: Vec<f64>,
+    /// Size measures in the Cost (comma list): diameter (the paper's), area (surface area of
+    /// the merged box).
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [CostMeasure::Diameter, CostMeasure::Area])]
+    cost: Vec<CostMeasure>,
     /// P-set wrapper for every setting.
     #[arg(long, value_enum, default_value_t = PSet::Aabb)]
     pset: PSet,
@@ -42,9 +46,9 @@ impl SweepCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         let scene = super::bench::scene_spec(&self.scene)?;
-        let settings = grid(&self.a, &self.b, &self.c);
-        for w in &settings {
-            w.check().map_err(|e| anyhow!("--{e}"))?;
+        let settings = grid(&self.a, &self.b, &self.c, &self.cost);
+        for s in &settings {
+            s.weights.check().map_err(|e| anyhow!("--{e}"))?;
         }
         let dir = super::bench::output_dir(
             self.output.as_deref(),

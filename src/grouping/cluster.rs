@@ -112,6 +112,12 @@ impl ScanLimit<'_> {
     }
 }
 
+/// Surface area of a box with extents `e` (the size measure of `--cost area`).
+#[inline(always)]
+pub(super) fn box_area(e: &crate::geom::V3) -> f64 {
+    2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+}
+
 /// Fill and Balance of a would-be parent of diameter `d` over children of diameters `dx`, `dy`.
 ///
 /// Point-like children (diameter 0) get documented fallbacks: Fill = 1 when both children are
@@ -444,9 +450,18 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             self.partners.close(x);
         }
         let d = self.pset.merge(a, b, new, &merged);
-        let (da, db) = (self.diameter[a as usize], self.diameter[b as usize]);
-        let (fill, balance) = fill_balance(d, da, db);
-        let cost = self.params.weights.cost(d, fill, balance);
+        let (size, sa, sb) = if self.params.mode.cost == super::CostMeasure::Area {
+            let ext = |x: u32| self.aabb[x as usize].max - self.aabb[x as usize].min;
+            (
+                box_area(&(merged.max - merged.min)),
+                box_area(&ext(a)),
+                box_area(&ext(b)),
+            )
+        } else {
+            (d, self.diameter[a as usize], self.diameter[b as usize])
+        };
+        let (fill, balance) = fill_balance(size, sa, sb);
+        let cost = self.params.weights.cost(size, fill, balance);
         self.aabb.push(merged);
         self.diameter.push(d);
         self.children.push([a, b]);

@@ -156,6 +156,16 @@ pub enum Event<'a> {
         /// New GLimit.
         glimit: f64,
     },
+    /// A refinement run of the finished tree starts (`record --refine`, see
+    /// [`crate::refine`]); comes after `Finish`.
+    RefineStart {
+        /// Its parameters.
+        params: crate::refine::RefineParams,
+        /// SAH of the tree before refinement.
+        sah: f64,
+    },
+    /// The refinement kept one move; one per kept move, after `RefineStart`.
+    Refine(crate::refine::Step),
     /// The root exists; grouping is over.
     Finish {
         /// Root body id.
@@ -222,6 +232,10 @@ pub struct EventLog {
     pub root: Option<u32>,
     /// Every part announced, in order.
     pub parts: Vec<Part>,
+    /// The refinement's parameters and starting SAH, if one ran.
+    pub refine_start: Option<(crate::refine::RefineParams, f64)>,
+    /// Every refinement step, in order.
+    pub refine: Vec<crate::refine::Step>,
 }
 
 impl Observer for EventLog {
@@ -247,6 +261,8 @@ impl Observer for EventLog {
             } => self.doublings.push((round, merges, dlimit, glimit)),
             Event::Finish { root, .. } => self.root = Some(root),
             Event::Part(p) => self.parts.push(p),
+            Event::RefineStart { params, sah } => self.refine_start = Some((params, sah)),
+            Event::Refine(s) => self.refine.push(s),
         }
     }
 }

@@ -7,12 +7,16 @@
 //! - [`parry_bvh`]: parry3d's `Bvh`, binned SAH or PLOC, as published;
 //! - [`obvhs_ploc`]: obvhs's PLOC, with or without its reinsertion optimiser, as published;
 //! - [`median_split`]: a top-down median split;
-//! - [`goldsmith_salmon`]: Goldsmith–Salmon incremental insertion.
+//! - [`goldsmith_salmon`]: Goldsmith–Salmon incremental insertion;
+//! - `…+refine` ([`Method::is_refined`]): a builder's tree then [`crate::refine`] with default
+//!   parameters (grouping, parry Binned, obvhs PLOC).
 //!
 //! A peer's reported time covers its own build only, from primitive boxes (`f32` relative to the
 //! scene centre for parry and obvhs, `f64` for ours) to its native tree; reading its topology
 //! into a Subset Tree ([`topology`]) is not timed. Box computation per primitive is shared and
-//! not timed either. Every method is single-threaded.
+//! not timed either. Every builder is single-threaded; the refinement pass searches on rayon's
+//! threads (2 on the bench machine) and its time is added to the builder's: a refined method's
+//! time is the total, [`Built::refine_seconds`] the refinement's part.
 
 pub mod goldsmith_salmon;
 pub mod median_split;
@@ -21,6 +25,7 @@ pub mod parry_bvh;
 pub mod topology;
 
 use crate::grouping::{self, PSet, Params, Stats, SubsetTree};
+use crate::refine::{self, RefineParams};
 use crate::scene::Scene;
 use parry3d::partitioning::BvhBuildStrategy;
 use std::time::Instant;
@@ -44,12 +49,19 @@ pub enum Method {
     MedianSplit,
     /// Goldsmith–Salmon incremental insertion.
     GoldsmithSalmon,
+    /// [`Method::Grouping`] then the refinement pass.
+    GroupingRefine,
+    /// [`Method::ParryBinned`] then the refinement pass.
+    ParryBinnedRefine,
+    /// [`Method::ObvhsPloc`] then the refinement pass.
+    ObvhsPlocRefine,
 }
 
 impl Method {
     /// Every method, ours first.
-    pub const ALL: [Method; 8] = [
+    pub const ALL: [Method; 11] = [
         Method::Grouping,
+        Method::GroupingRefine,
         Method::GroupingHull,
         Method::ParryBinned,
         Method::ParryPloc,
@@ -57,6 +69,8 @@ impl Method {
         Method::ObvhsPlocReinsert,
         Method::MedianSplit,
         Method::GoldsmithSalmon,
+        Method::ParryBinnedRefine,
+        Method::ObvhsPlocRefine,
     ];
 
     /// Short name used in tables, CSV and on the command line.
@@ -70,6 +84,9 @@ impl Method {
             Method::ObvhsPlocReinsert => "obvhs-ploc-reinsert",
             Method::MedianSplit => "median-split",
             Method::GoldsmithSalmon => "goldsmith-salmon",
+            Method::GroupingRefine => "grouping+refine",
+            Method::ParryBinnedRefine => "parry-binned+refine",
+            Method::ObvhsPlocRefine => "obvhs-ploc+refine",
         }
     }
 
@@ -84,9 +101,27 @@ impl Method {
             })
     }
 
-    /// Whether this is the paper's grouping phase.
+    /// Whether this is the paper's grouping phase (refined or not).
     pub fn is_grouping(self) -> bool {
-        matches!(self, Method::Grouping | Method::GroupingHull)
+        matches!(
+            self,
+            Method::Grouping | Method::GroupingHull | Method::GroupingRefine
+        )
+    }
+
+    /// Whether the builder's tree goes through [`crate::refine`].
+    pub fn is_refined(self) -> bool {
+        self.base() != self
+    }
+
+    /// The builder without refinement.
+    pub fn base(self) -> Method {
+        match self {
+            Method::GroupingRefine => Method::Grouping,
+            Method::ParryBinnedRefine => Method::ParryBinned,
+            Method::ObvhsPlocRefine => Method::ObvhsPloc,
+            m => m,
+        }
     }
 }
 
@@ -101,17 +136,35 @@ pub struct Built {
     pub seconds: f64,
     /// Grouping work counters (grouping methods only).
     pub stats: Option<Stats>,
+    /// Seconds of `seconds` spent refining (0 for an unrefined method).
+    pub refine_seconds: f64,
 }
 
 /// Builds `method`'s hierarchy over `scene`; `params` is used by the grouping methods (the hull
 /// variant overrides the p-set). Fails only if a peer's tree is malformed (a bug).
 pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, String> {
+    let base = method.base();
+    let mut built = build_base(base, scene, params)?;
+    if method.is_refined() {
+        let t = Instant::now();
+        let r = refine::refine(&built.tree, &RefineParams::default(), ());
+        built.refine_seconds = t.elapsed().as_secs_f64();
+        built.seconds += built.refine_seconds;
+        built.tree = r.tree;
+        built.method = method;
+    }
+    Ok(built)
+}
+
+/// Builds an unrefined method's hierarchy (see [`build`]).
+fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, String> {
     let t = Instant::now();
     let done = |tree: SubsetTree, stats: Option<Stats>, seconds: f64| Built {
         method,
         tree,
         seconds,
         stats,
+        refine_seconds: 0.0,
     };
     if method.is_grouping() {
         let p = Params {
@@ -163,6 +216,9 @@ pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, St
             (nodes, root, t.elapsed().as_secs_f64())
         }
         Method::Grouping | Method::GroupingHull => unreachable!("handled above"),
+        Method::GroupingRefine | Method::ParryBinnedRefine | Method::ObvhsPlocRefine => {
+            unreachable!("refined methods are built from their base")
+        }
     };
     let tree = topology::subset_tree(scene, &nodes, root)
         .map_err(|e| format!("{}: malformed tree: {e}", method.name()))?;

@@ -44,6 +44,8 @@ impl Owned {
             },
             Event::Merge(m) => Owned::plain(Event::Merge(m)),
             Event::Part(p) => Owned::plain(Event::Part(p)),
+            Event::Refine(s) => Owned::plain(Event::Refine(s)),
+            Event::RefineStart { params, sah } => Owned::plain(Event::RefineStart { params, sah }),
             Event::Dormant {
                 round,
                 body,

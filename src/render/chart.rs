@@ -39,6 +39,8 @@ pub struct Series {
     pub label: String,
     /// `(x, y)` points; non-finite points (and non-positive ones on a log axis) are skipped.
     pub points: Vec<(f64, f64)>,
+    /// Draw the points as rings instead of dots (`bench` marks refined methods so).
+    pub hollow: bool,
 }
 
 /// A scatter (or line) chart.
@@ -166,11 +168,16 @@ impl Scatter {
                         .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
                         .map_err(err)?;
                 }
+                let style = if self.series[k].hollow {
+                    c.stroke_width(2)
+                } else {
+                    c.filled()
+                };
                 chart
-                    .draw_series(pts.iter().map(|&p| Circle::new(p, 4, c.filled())))
+                    .draw_series(pts.iter().map(|&p| Circle::new(p, 4, style)))
                     .map_err(err)?
                     .label(&self.series[k].label)
-                    .legend(move |(x, y)| Circle::new((x + 8, y), 4, c.filled()));
+                    .legend(move |(x, y)| Circle::new((x + 8, y), 4, style));
             }
             if self.pareto && all.len() > 1 {
                 let front: Vec<(f64, f64)> =
@@ -347,6 +354,7 @@ mod tests {
             series: vec![Series {
                 label: "a".into(),
                 points: vec![(1e-3, 2.0), (1e-1, 1.0), (0.0, 1.0)],
+                hollow: false,
             }],
             ..Scatter::default()
         };

@@ -93,6 +93,7 @@ pub fn print_table(rows: &[Row]) {
 pub fn sweep_chart(sweep: &[(f64, Row)], title: String, x_label: &str, r: f64) -> Scatter {
     let series = |label: String, split: bool, f: fn(&Row) -> Option<f64>| Series {
         label,
+        hollow: false,
         points: sweep
             .iter()
             .filter(|(_, row)| row.split_r.is_some() == split)

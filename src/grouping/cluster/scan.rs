@@ -29,15 +29,20 @@
 //! is left out. The last result is kept ([`Memo`]) until the voxel hash changes, so N coincident
 //! bodies re-searching between two merges cost one scan, not N.
 //!
+//! With `--cost area` ([`CostMeasure::Area`]) the Cost's three sizes are the surface areas of
+//! the merged box and of the two bodies' boxes ([`measures`]); the diameter-based bound and the
+//! `sqrt`-free filter do not hold for areas, so those searches visit every reachable cell
+//! (measured in the README: the scans cost more, the trees stay exact best-partner trees).
+//!
 //! With C = 0 and B > 0 the pair Cost skips Balance (then weighted by zero), bit for bit the
 //! same value. Other p-sets search every candidate for the single best partner, as in the paper.
 
-use super::{Clusterer, PSetBodies, ScanLimit, fill_balance};
+use super::{Clusterer, PSetBodies, ScanLimit, box_area, fill_balance};
 use crate::geom::{Aabb, P3, V3};
-use crate::grouping::Weights;
 use crate::grouping::events::Observer;
 use crate::grouping::mpairs::{K_MAX, List, Top};
 use crate::grouping::voxel_hash::CellBounds;
+use crate::grouping::{CostMeasure, Weights};
 
 /// The last AABB search (see the module doc): the bits of its searcher's box and diameter and
 /// the voxel hash version, and the first `K_MAX + 1` partners in key order of all stored bodies,
@@ -65,6 +70,19 @@ fn pair_cost<const A: u8>(w: &Weights, d: f64, dx: f64, dy: f64) -> f64 {
     }
     let (fill, balance) = fill_balance(d, dx, dy);
     w.cost_scaled(scale, fill, balance)
+}
+
+/// The Cost's size measures of a pair whose merged box has extents `e`: its diagonal and the
+/// bodies' diameters `dx`, `dy`, or with `area` the surface areas of the merged box and of the
+/// bodies' boxes `xa`, `ya`.
+#[inline(always)]
+fn measures(area: bool, e: &V3, xa: &Aabb, dx: f64, ya: &Aabb, dy: f64) -> (f64, f64, f64) {
+    if area {
+        let ex = |b: &Aabb| b.max - b.min;
+        (box_area(e), box_area(&ex(xa)), box_area(&ex(ya)))
+    } else {
+        (e.norm(), dx, dy)
+    }
 }
 
 /// The extents of `a ∪ b`: the values of `a.merge(b).extents()` up to the sign of zeros (which
@@ -218,7 +236,8 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
     /// the scan short).
     fn pairs_once<const A: u8>(&mut self, glimit: f64, limit: &mut ScanLimit<'_>) -> u64 {
         let (k, w, finite) = (self.k, self.params.weights, self.finite);
-        let quick = Quick::new(&w, self.quick);
+        let area = self.params.mode.cost == CostMeasure::Area;
+        let quick = Quick::new(&w, self.quick && !area);
         let mut pairs = 0u64;
         let mut candidates = 0u64;
         let mut near: Vec<u32> = Vec::with_capacity(27);
@@ -276,7 +295,8 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                                 continue;
                             }
                         }
-                        let cost = pair_cost::<A>(&w, e.norm(), dx, yr.diameter);
+                        let (d, sx_, sy_) = measures(area, &e, &xa, dx, &yr.aabb, yr.diameter);
+                        let cost = pair_cost::<A>(&w, d, sx_, sy_);
                         lists[sx].offer(k, cost, yr.id, tags);
                         lists[sy].offer(k, cost, x, tags);
                     }
@@ -307,7 +327,8 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             return;
         }
         let (lo, hi) = self.query(&xa, glimit);
-        let prune = self.prune;
+        let area = self.params.mode.cost == CostMeasure::Area;
+        let prune = self.prune && !area;
         let mut cells: [(f64, u32); 64] = [(0.0, 0); 64];
         let mut n = 0;
         let mut overflow: Vec<(f64, u32)> = Vec::new();
@@ -364,7 +385,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             overflow.iter_mut().for_each(|c| c.0 = f64::NEG_INFINITY);
             &mut overflow
         };
-        let quick = Quick::new(&w, self.quick);
+        let quick = Quick::new(&w, self.quick && !area);
         for &(bound, cell) in cells.iter() {
             let mut bar = list.bar(wide);
             if bound > bar {
@@ -381,7 +402,8 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                 {
                     continue;
                 }
-                let cost = pair_cost::<A>(&w, e.norm(), dx, r.diameter);
+                let (d, sx, sy) = measures(area, &e, &xa, dx, &r.aabb, r.diameter);
+                let cost = pair_cost::<A>(&w, d, sx, sy);
                 list.offer(wide, cost, r.id, tags);
                 bar = list.bar(wide);
             }
@@ -399,6 +421,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         let dx = self.diameter[x as usize];
         let (lo, hi) = self.query(&xa, glimit);
         let (hash, pset, tags, w) = (&self.hash, &self.pset, &self.tag, self.params.weights);
+        let area = self.params.mode.cost == CostMeasure::Area;
         let mut list = List::EMPTY;
         let mut eligible = 0u32;
         let mut candidates = 0u64;
@@ -413,7 +436,13 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                     continue;
                 };
                 eligible += 1;
-                let (fill, balance) = fill_balance(d, dx, r.diameter);
+                let (d, sx, sy) = if area {
+                    let e = merged.max - merged.min;
+                    measures(true, &e, &xa, dx, &r.aabb, r.diameter)
+                } else {
+                    (d, dx, r.diameter)
+                };
+                let (fill, balance) = fill_balance(d, sx, sy);
                 list.offer(k, w.cost(d, fill, balance), r.id, tags);
             }
         });

@@ -5,7 +5,7 @@ use super::{QUERY_COLUMNS, SIZE, opt, query_fields, series_by, write_chart};
 use crate::metrics::compare::{Row, query_values};
 use crate::record::output::write_atomic;
 use crate::record::rrd::SeriesFile;
-use crate::render::chart::{Scatter, pareto_front};
+use crate::render::chart::{Scatter, Series, pareto_front};
 use anyhow::{Result, anyhow};
 use rerun::EntityPath;
 use rerun::blueprint::{
@@ -63,7 +63,14 @@ pub fn bench_charts(scene: &str, rows: &[Row]) -> Result<Vec<(String, String)>> 
             let q = r.query.as_ref()?;
             let y = query_values(q)[6];
             Some((r.method.to_string(), (r.build_s + r.wrapper_s, y)))
-        })),
+        }))
+        .into_iter()
+        .map(|s| Series {
+            // Refined methods (`…+refine`) as rings beside their builders' dots.
+            hollow: s.label.ends_with("+refine"),
+            ..s
+        })
+        .collect(),
         ..Scatter::default()
     };
     let tight = Scatter {

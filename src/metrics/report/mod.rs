@@ -62,6 +62,7 @@ pub(super) fn series_by<'a>(rows: impl Iterator<Item = (String, (f64, f64))> + '
             None => out.push(Series {
                 label,
                 points: vec![p],
+                hollow: false,
             }),
         }
     }

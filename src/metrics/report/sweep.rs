@@ -2,9 +2,9 @@
 //! series side by side.
 
 use super::{QUERY_COLUMNS, query_fields, write_chart};
-use crate::grouping::{Merge, Weights};
+use crate::grouping::{CostMeasure, Merge};
 use crate::metrics::compare::query_values;
-use crate::metrics::sweep::SweepRow;
+use crate::metrics::sweep::{Setting, SweepRow};
 use crate::record::output::write_atomic;
 use crate::record::rrd::SeriesFile;
 use crate::render::chart::HeatMap;
@@ -21,16 +21,17 @@ use std::path::{Path, PathBuf};
 /// The sweep rows as CSV.
 pub fn sweep_csv(rows: &[SweepRow]) -> String {
     let mut s = format!(
-        "a,b,c,build_s,rounds,sah,depth_max,depth_mean,structural_balance,spatial_balance,{QUERY_COLUMNS}\n"
+        "a,b,c,cost,build_s,rounds,sah,depth_max,depth_mean,structural_balance,spatial_balance,{QUERY_COLUMNS}\n"
     );
     for r in rows {
         let (w, q) = (&r.weights, &r.quality);
         let _ = writeln!(
             s,
-            "{},{},{},{:.6e},{},{:.6e},{},{:.4},{:.4},{:.4},{}",
+            "{},{},{},{},{:.6e},{},{:.6e},{},{:.4},{:.4},{:.4},{}",
             w.a,
             w.b,
             w.c,
+            measure_name(r.cost),
             r.build_s,
             r.rounds,
             q.sah,
@@ -47,16 +48,24 @@ pub fn sweep_csv(rows: &[SweepRow]) -> String {
 /// A sweep measure: file stem, title and how to read it from a row.
 type Measure = (&'static str, &'static str, fn(&SweepRow) -> f64);
 
-/// Heat maps of the sweep: rows are A values, columns the (B, C) pairs.
+/// `diameter` or `area`.
+fn measure_name(c: CostMeasure) -> &'static str {
+    match c {
+        CostMeasure::Diameter => "diameter",
+        CostMeasure::Area => "area",
+    }
+}
+
+/// Heat maps of the sweep: rows are A values, columns the (B, C, size measure) triples.
 pub fn sweep_heat_maps(scene: &str, rows: &[SweepRow]) -> Vec<(String, HeatMap)> {
     let mut a_vals: Vec<f64> = Vec::new();
-    let mut bc_vals: Vec<(f64, f64)> = Vec::new();
+    let mut bc_vals: Vec<(f64, f64, CostMeasure)> = Vec::new();
     for r in rows {
         if !a_vals.contains(&r.weights.a) {
             a_vals.push(r.weights.a);
         }
-        if !bc_vals.contains(&(r.weights.b, r.weights.c)) {
-            bc_vals.push((r.weights.b, r.weights.c));
+        if !bc_vals.contains(&(r.weights.b, r.weights.c, r.cost)) {
+            bc_vals.push((r.weights.b, r.weights.c, r.cost));
         }
     }
     let metrics: [Measure; 4] = [
@@ -75,19 +84,30 @@ pub fn sweep_heat_maps(scene: &str, rows: &[SweepRow]) -> Vec<(String, HeatMap)>
                 .map(|&a| {
                     bc_vals
                         .iter()
-                        .map(|&(b, c)| {
+                        .map(|&(b, c, m)| {
                             rows.iter()
-                                .find(|r| r.weights.a == a && r.weights.b == b && r.weights.c == c)
+                                .find(|r| {
+                                    r.weights.a == a
+                                        && r.weights.b == b
+                                        && r.weights.c == c
+                                        && r.cost == m
+                                })
                                 .map_or(f64::NAN, f)
                         })
                         .collect()
                 })
                 .collect();
             let map = HeatMap {
-                title: format!("{scene}: {title} over Cost = d^A (B·Fill + C·Balance)"),
-                x_label: "B, C".into(),
+                title: format!("{scene}: {title} over Cost = size^A (B·Fill + C·Balance)"),
+                x_label: "B, C, size".into(),
                 y_label: "A".into(),
-                x_ticks: bc_vals.iter().map(|(b, c)| format!("B{b} C{c}")).collect(),
+                x_ticks: bc_vals
+                    .iter()
+                    .map(|&(b, c, m)| match m {
+                        CostMeasure::Diameter => format!("B{b} C{c}"),
+                        CostMeasure::Area => format!("B{b} C{c} area"),
+                    })
+                    .collect(),
                 y_ticks: a_vals.iter().map(|a| format!("A{a}")).collect(),
                 values,
             };
@@ -137,7 +157,10 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
         let _ = writeln!(
             md,
             "| {k} | {} | {:.2} | {} | {} | {:.3} | {:.3} | {:.1} |",
-            setting_name(&r.weights),
+            setting_name(&Setting {
+                weights: r.weights,
+                cost: r.cost
+            }),
             r.build_s * 1e3,
             r.rounds,
             r.quality.depth_max,
@@ -149,15 +172,19 @@ pub fn sweep_table(rows: &[SweepRow]) -> String {
     md
 }
 
-/// Entity name of one setting.
-pub fn setting_name(w: &Weights) -> String {
-    format!("A{}_B{}_C{}", w.a, w.b, w.c)
+/// Entity name of one setting: `A1_B1_C0` with the diameter, `A1_B1_C0_area` with the area.
+pub fn setting_name(s: &Setting) -> String {
+    let w = &s.weights;
+    match s.cost {
+        CostMeasure::Diameter => format!("A{}_B{}_C{}", w.a, w.b, w.c),
+        CostMeasure::Area => format!("A{}_B{}_C{}_area", w.a, w.b, w.c),
+    }
 }
 
 impl SweepRrd {
     /// Starts the file (moved into place by [`SweepRrd::finish`]) for `settings`; it opens on
     /// one plot per merge series with every setting in it, and the summary over `setting`.
-    pub fn create(path: &Path, settings: &[Weights], force: bool) -> Result<SweepRrd> {
+    pub fn create(path: &Path, settings: &[Setting], force: bool) -> Result<SweepRrd> {
         let names: Vec<String> = settings.iter().map(setting_name).collect();
         let plot = |series: &str| -> ContainerLike {
             TimeSeriesView::new(format!("{series} (timeline merge)"))
@@ -191,7 +218,7 @@ impl SweepRrd {
     }
 
     /// Logs one setting's merges as columns.
-    pub fn setting(&self, w: &crate::grouping::Weights, merges: &[Merge]) -> Result<()> {
+    pub fn setting(&self, w: &Setting, merges: &[Merge]) -> Result<()> {
         let rec = self.0.rec();
         let base = EntityPath::from(vec!["sweep".into(), setting_name(w).as_str().into()]);
         let steps: Vec<i64> = merges.iter().map(|m| m.step as i64).collect();

@@ -229,6 +229,105 @@ flat_message! {
     }
 }
 
+flat_message! {
+    /// One kept move of the refinement (`record --refine`), on `/refine/step`: every field of
+    /// [`crate::refine::Step`].
+    RefineStepEvent {
+        /// 0-based step index.
+        step: u32,
+        /// Pass.
+        pass: u32,
+        /// The moved subtree.
+        node: u32,
+        /// Its parent slot, moved with it.
+        parent: u32,
+        /// Its old sibling.
+        sibling: u32,
+        /// Its new sibling.
+        target: u32,
+        /// Moved subtree's box, lower corner x.
+        min_x: f64,
+        /// Lower corner y.
+        min_y: f64,
+        /// Lower corner z.
+        min_z: f64,
+        /// Upper corner x.
+        max_x: f64,
+        /// Upper corner y.
+        max_y: f64,
+        /// Upper corner z.
+        max_z: f64,
+        /// New parent's box, lower corner x.
+        parent_min_x: f64,
+        /// Lower corner y.
+        parent_min_y: f64,
+        /// Lower corner z.
+        parent_min_z: f64,
+        /// Upper corner x.
+        parent_max_x: f64,
+        /// Upper corner y.
+        parent_max_y: f64,
+        /// Upper corner z.
+        parent_max_z: f64,
+        /// SAH before the step.
+        sah_before: f64,
+        /// SAH after the step.
+        sah: f64,
+    }
+}
+
+impl From<&crate::refine::Step> for RefineStepEvent {
+    fn from(s: &crate::refine::Step) -> Self {
+        let (a, p) = (&s.aabb, &s.parent_aabb);
+        RefineStepEvent {
+            step: s.step,
+            pass: s.pass,
+            node: s.node,
+            parent: s.parent,
+            sibling: s.sibling,
+            target: s.target,
+            min_x: a.min.x,
+            min_y: a.min.y,
+            min_z: a.min.z,
+            max_x: a.max.x,
+            max_y: a.max.y,
+            max_z: a.max.z,
+            parent_min_x: p.min.x,
+            parent_min_y: p.min.y,
+            parent_min_z: p.min.z,
+            parent_max_x: p.max.x,
+            parent_max_y: p.max.y,
+            parent_max_z: p.max.z,
+            sah_before: s.sah_before,
+            sah: s.sah,
+        }
+    }
+}
+
+impl From<&RefineStepEvent> for crate::refine::Step {
+    fn from(e: &RefineStepEvent) -> Self {
+        let b = |lo: [f64; 3], hi: [f64; 3]| Aabb {
+            min: P3::new(lo[0], lo[1], lo[2]),
+            max: P3::new(hi[0], hi[1], hi[2]),
+        };
+        crate::refine::Step {
+            step: e.step,
+            pass: e.pass,
+            node: e.node,
+            parent: e.parent,
+            sibling: e.sibling,
+            target: e.target,
+            aabb: b([e.min_x, e.min_y, e.min_z], [e.max_x, e.max_y, e.max_z]),
+            parent_aabb: b(
+                [e.parent_min_x, e.parent_min_y, e.parent_min_z],
+                [e.parent_max_x, e.parent_max_y, e.parent_max_z],
+            ),
+            sah_before: e.sah_before,
+            sah: e.sah,
+        }
+    }
+}
+
 impl From<&Merge> for MergeEvent {
     fn from(m: &Merge) -> Self {
         MergeEvent {

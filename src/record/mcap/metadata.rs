@@ -6,6 +6,7 @@
 
 use crate::grouping::{Mode, PSet, ResolvedParams, Weights};
 use crate::record::{Detail, Outcome, RunInfo};
+use crate::refine::RefineParams;
 use anyhow::{Context, Result, anyhow};
 use clap::ValueEnum;
 use std::collections::BTreeMap;
@@ -61,8 +62,72 @@ pub const COVER_KEYS: &[&str] = &[
     "cover_max_error",
 ];
 
+/// Keys the `wraptree` record adds when the tree was refined (`record --refine`): `refine` =
+/// `reinsert` (the method), its `refine_passes` and `refine_batch` (what `replay --verify`
+/// re-runs), the moves kept (`refine_steps`) and the SAH before and after. `depth_max` and
+/// `depth_mean` and the levels are then the refined tree's.
+pub const REFINE_KEYS: &[&str] = &[
+    "refine",
+    "refine_passes",
+    "refine_batch",
+    "refine_steps",
+    "refine_sah_before",
+    "refine_sah_after",
+];
+
+/// What the metadata says about a refinement run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RefineSummary {
+    /// Its parameters.
+    pub params: RefineParams,
+    /// Moves kept.
+    pub steps: u32,
+    /// SAH of the grouping's tree.
+    pub sah_before: f64,
+    /// SAH of the refined tree.
+    pub sah_after: f64,
+}
+
+/// Adds the [`REFINE_KEYS`] of `r` to a `wraptree` record.
+pub fn put_refine(m: &mut BTreeMap<String, String>, r: &RefineSummary) {
+    for (k, v) in [
+        ("refine", "reinsert".to_string()),
+        ("refine_passes", r.params.passes.to_string()),
+        ("refine_batch", r.params.batch.to_string()),
+        ("refine_steps", r.steps.to_string()),
+        ("refine_sah_before", r.sah_before.to_string()),
+        ("refine_sah_after", r.sah_after.to_string()),
+    ] {
+        m.insert(k.to_string(), v);
+    }
+}
+
+/// The refinement the record names, if any (a recording without the `refine` key was not
+/// refined).
+pub fn refine(m: &BTreeMap<String, String>) -> Result<Option<RefineSummary>> {
+    match m.get("refine").map(String::as_str) {
+        None => Ok(None),
+        Some("reinsert") => {
+            let params = RefineParams {
+                passes: parse(m, "refine_passes")?,
+                batch: parse(m, "refine_batch")?,
+            };
+            params
+                .check()
+                .map_err(|e| anyhow!("metadata parameter {e}"))?;
+            Ok(Some(RefineSummary {
+                params,
+                steps: parse(m, "refine_steps")?,
+                sah_before: parse(m, "refine_sah_before")?,
+                sah_after: parse(m, "refine_sah_after")?,
+            }))
+        }
+        Some(v) => Err(anyhow!("`{RUN}` metadata has a bad `refine`: {v:?}")),
+    }
+}
+
 /// How log times map to grouping steps (also stored under `log_time`).
-pub const LOG_TIME: &str = "scene and attachment at 0 ms; the k-th grouping event (k = 1, 2, ...) at k ms; \
+pub const LOG_TIME: &str = "scene and attachment at 0 ms; the k-th grouping or refinement event (k = 1, 2, ...) at k ms; \
      /levels/<d> at (events + 1 + d) ms; /cover at (events + 2 + depth_max) ms";
 
 fn value_name<T: ValueEnum>(v: &T) -> String {

@@ -13,10 +13,11 @@
 //! | `/grouping/round` | `roundevent.RoundEvent` | each round start (DLimit, GLimit, active, dormant, eligible pairs) and each DLimit doubling (`doubling = true`, merges of the ended round, new limits) | always |
 //! | `/grouping/merge` | `mergeevent.MergeEvent` | every merge: step, round, a, b, new, AABB, diameter, Fill, Balance, Cost, queue length, active | always |
 //! | `/grouping/finish` | `finishevent.FinishEvent` | root, rounds, merges | always, once |
+//! | `/refine/step` | `refinestepevent.RefineStepEvent` | every kept move of the refinement: step, pass, moved node, its parent slot, old and new sibling, the moved subtree's and new parent's boxes, SAH before and after | `record --refine` |
 //! | `/grouping/active` | `foxglove.SceneUpdate` | entity `active`: one translucent green box per active body at each round start | `--detail merges` or `full` |
 //! | `/grouping/bodies` | `foxglove.SceneUpdate` | entity `merge`: the merged pair (red) and the new body (yellow) as boxes, per merge | `--detail full` (it repeats boxes the merge events already carry, and is the largest per-merge topic) |
 //! | `/grouping/dormant` | `dormantevent.DormantEvent` | round, body, diameter of each body going dormant | `--detail merges` or `full` |
-//! | `/levels/<d>` | `foxglove.SceneUpdate` | one snapshot of the cut at depth d (d = 0..=depth max), one entity per wrapper kind chosen with `--wrapper` for the cut's interior nodes: `spheres` (`SpherePrimitive`s, size = diameter), `hulls` (one indexed `TriangleListPrimitive` per hull; a segment hull is one degenerate triangle `[a, b, b]`, a point hull `[a, a, a]`), `boxes` (axis-aligned `CubePrimitive`s), `obbs` (`CubePrimitive`s with orientation); and entity `leaves` (the cut's leaves as one orange `TriangleListPrimitive`) | `--detail levels` or `full`, finished runs |
+//! | `/levels/<d>` | `foxglove.SceneUpdate` | one snapshot of the cut at depth d of the finished tree (the refined one with `record --refine`) (d = 0..=depth max), one entity per wrapper kind chosen with `--wrapper` for the cut's interior nodes: `spheres` (`SpherePrimitive`s, size = diameter), `hulls` (one indexed `TriangleListPrimitive` per hull; a segment hull is one degenerate triangle `[a, b, b]`, a point hull `[a, a, a]`), `boxes` (axis-aligned `CubePrimitive`s), `obbs` (`CubePrimitive`s with orientation); and entity `leaves` (the cut's leaves as one orange `TriangleListPrimitive`) | `--detail levels` or `full`, finished runs |
 //! | `/cover` | `foxglove.SceneUpdate` | the cover (`--cover-tolerance` or `--cover-budget`) as one more level: entities `spheres`, `boxes` (oriented ones with orientation), `hulls` (one indexed `TriangleListPrimitive` per hull) and `leaves` (one `TriangleListPrimitive` per leaf drawn as itself), only those used | with a cover, `--detail levels` or `full`, finished runs |
 //!
 //! The input scene file is attached (name = its file name, media type `model/obj`, log time 0),
@@ -27,7 +28,7 @@
 //!
 //! **Log times** are synthetic and monotonic, never wall-clock: the scene at 0; the k-th grouping
 //! event (k = 1, 2, …, counting every event, written at this detail or not: round starts,
-//! merges, dormant bodies, doublings, the finish) at k ms; the level snapshots after the last event at consecutive milliseconds,
+//! merges, dormant bodies, doublings, the finish, then the refinement's start and steps) at k ms; the level snapshots after the last event at consecutive milliseconds,
 //! `/levels/<d>` at (events + 1 + d) ms, then `/cover` at (events + 2 + depth max) ms. Sequence numbers count up from 0 on each channel.
 
 pub mod messages;
@@ -43,7 +44,7 @@ use crate::record::{Detail, Outcome, RunInfo};
 use anyhow::{Context, Result, anyhow, bail};
 use foxglove::Encode;
 use foxglove::messages::SceneUpdate;
-use messages::{DormantEvent, FinishEvent, MergeEvent, RoundEvent};
+use messages::{DormantEvent, FinishEvent, MergeEvent, RefineStepEvent, RoundEvent};
 use scene_msgs::SceneMesh;
 use std::collections::BTreeMap;
 use std::io::{Seek, Write};
@@ -94,6 +95,8 @@ pub struct McapRecorder<'a, W: Write + Seek> {
     /// AABB of every body seen so far, indexed by body id.
     bodies: Vec<Aabb>,
     events: u64,
+    /// The refinement seen so far (`record --refine`) and its `/refine/step` channel.
+    refine: Option<(metadata::RefineSummary, Topic)>,
     reproducible: bool,
     error: Option<anyhow::Error>,
     buf: Vec<u8>,
@@ -192,6 +195,7 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             scene_update,
             bodies,
             events: 0,
+            refine: None,
             reproducible: false,
             error: None,
             buf: Vec::new(),
@@ -334,6 +338,26 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             }
             // Parts are written by the partitioned schedule's recorder support (in progress).
             Event::Part(_) => {}
+            Event::RefineStart { params, sah } => {
+                let schema = add_schema::<RefineStepEvent, W>(w)?;
+                let topic = add_topic(w, schema, "/refine/step")?;
+                let summary = metadata::RefineSummary {
+                    params,
+                    steps: 0,
+                    sah_before: sah,
+                    sah_after: sah,
+                };
+                self.refine = Some((summary, topic));
+            }
+            Event::Refine(step) => {
+                let (summary, topic) = self
+                    .refine
+                    .as_mut()
+                    .ok_or_else(|| anyhow!("refinement step before its start"))?;
+                emit(w, buf, topic, t, &RefineStepEvent::from(&step))?;
+                summary.steps = step.step + 1;
+                summary.sah_after = step.sah;
+            }
             Event::Finish {
                 root,
                 rounds,
@@ -445,9 +469,13 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
         if self.info.detail.levels() {
             self.write_levels(outcome)?;
         }
+        let mut run = metadata::run_record(&self.info, outcome);
+        if let Some((summary, _)) = &self.refine {
+            metadata::put_refine(&mut run, summary);
+        }
         self.writer.write_metadata(&mcap::records::Metadata {
             name: metadata::RUN.to_string(),
-            metadata: metadata::run_record(&self.info, outcome),
+            metadata: run,
         })?;
         if !self.reproducible {
             self.writer.write_metadata(&mcap::records::Metadata {

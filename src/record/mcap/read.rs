@@ -5,7 +5,7 @@
 //! data-section and summary CRC checks and a record length limit), so truncated or corrupted
 //! files give an error, never a panic, and no index offset from the file is trusted.
 
-use super::messages::{DormantEvent, FinishEvent, MergeEvent, RoundEvent};
+use super::messages::{DormantEvent, FinishEvent, MergeEvent, RefineStepEvent, RoundEvent};
 use super::metadata;
 use crate::geom::Aabb;
 use crate::grouping::{EventLog, Merge, ResolvedParams, SubsetTree};
@@ -53,6 +53,10 @@ pub struct Recorded {
     pub dormant: Vec<(u32, u32)>,
     /// Root body id, once finished.
     pub root: Option<u32>,
+    /// The refinement's parameters and outcome, when the tree was refined (`record --refine`).
+    pub refine: Option<metadata::RefineSummary>,
+    /// Every refinement step, in order.
+    pub refine_steps: Vec<crate::refine::Step>,
 }
 
 impl Recorded {
@@ -77,7 +81,9 @@ impl Recorded {
             dormant: self.dormant.clone(),
             doublings: self.doublings.clone(),
             root: self.root,
-            parts: Vec::new(),
+            refine_start: self.refine.map(|r| (r.params, r.sah_before)),
+            refine: self.refine_steps.clone(),
+            ..EventLog::default()
         }
     }
 }
@@ -93,6 +99,7 @@ struct Raw {
     rounds: Vec<RoundEvent>,
     dormant: Vec<DormantEvent>,
     finish: Option<FinishEvent>,
+    refine: Vec<crate::refine::Step>,
 }
 
 /// The schema each decoded topic must carry.
@@ -101,6 +108,7 @@ const TYPED_TOPICS: &[(&str, &str)] = &[
     ("/grouping/round", "roundevent.RoundEvent"),
     ("/grouping/dormant", "dormantevent.DormantEvent"),
     ("/grouping/finish", "finishevent.FinishEvent"),
+    ("/refine/step", "refinestepevent.RefineStepEvent"),
 ];
 
 impl Raw {
@@ -124,6 +132,9 @@ impl Raw {
                 .push(Merge::from(&MergeEvent::decode(data).map_err(bad)?)),
             "/grouping/round" => self.rounds.push(RoundEvent::decode(data).map_err(bad)?),
             "/grouping/dormant" => self.dormant.push(DormantEvent::decode(data).map_err(bad)?),
+            "/refine/step" => self.refine.push(crate::refine::Step::from(
+                &RefineStepEvent::decode(data).map_err(bad)?,
+            )),
             _ => self.finish = Some(FinishEvent::decode(data).map_err(bad)?),
         }
         Ok(())
@@ -264,6 +275,20 @@ fn interpret(raw: Raw) -> Result<Recorded> {
     let complete = metadata::parse::<bool>(&m, "complete")?;
     let primitives = metadata::parse::<u32>(&m, "primitives")?;
     check_merges(&raw.merges, primitives, complete).map_err(|e| anyhow!(e))?;
+    let refine = metadata::refine(&m)?;
+    let steps_named = refine.map_or(0, |r| r.steps as usize);
+    if raw.refine.len() != steps_named
+        || raw
+            .refine
+            .iter()
+            .enumerate()
+            .any(|(i, s)| s.step as usize != i)
+    {
+        bail!(
+            "the recording holds {} refinement steps, its metadata says {steps_named}",
+            raw.refine.len()
+        );
+    }
     let round_starts = raw.rounds.iter().filter(|r| !r.doubling);
     let rounds = match m.get("rounds") {
         Some(_) => metadata::parse(&m, "rounds")?,
@@ -294,6 +319,8 @@ fn interpret(raw: Raw) -> Result<Recorded> {
             .collect(),
         dormant: raw.dormant.iter().map(|d| (d.round, d.body)).collect(),
         root: raw.finish.map(|f| f.root),
+        refine,
+        refine_steps: raw.refine,
         metadata: m,
         timing,
     })

@@ -3,7 +3,8 @@
 //! Left: a 3D view of the scene and the grouping boxes (scrub the `merge` or `round`
 //! timeline); beside it, when levels are written, a 3D view of the tree levels and the cover,
 //! if any (scrub `level`).
-//! Right: four plots of the merge series above the text log of rounds and doublings. The time
+//! Right: four plots of the merge series and the refinement's SAH (`record --refine`) above the
+//! text log of rounds, doublings and refinement. The time
 //! panel opens expanded on the `merge` timeline.
 
 use rerun::blueprint::components::PanelState;
@@ -19,7 +20,7 @@ pub(super) fn layout(detail: Detail) -> Blueprint {
     let mut views: Vec<ContainerLike> = vec![
         Spatial3DView::new("Grouping (timelines merge, round)")
             .with_origin("/")
-            .with_contents(["+ /scene/**", "+ /grouping/**"])
+            .with_contents(["+ /scene/**", "+ /grouping/**", "+ /refine/**"])
             .into(),
     ];
     if detail.levels() {
@@ -41,11 +42,12 @@ pub(super) fn layout(detail: Detail) -> Blueprint {
         plot("diameter, DLimit, GLimit", &["limits"]),
         plot("Fill, Balance", &["fill_balance"]),
         plot("MPairs length", &["queue_len"]),
+        plot("SAH (timeline refine)", &["refine_sah"]),
     ])
     .with_grid_columns(2);
     let side = Vertical::new([
         plots.into(),
-        TextLogView::new("Rounds and doublings")
+        TextLogView::new("Rounds, doublings, refinement")
             .with_origin("/log")
             .into(),
     ])

@@ -12,11 +12,12 @@
 //! | `merge`  | sequence | merge (tick = merge step, 0..N−1) |
 //! | `round`  | sequence | DLimit round (0 = first round) |
 //! | `level`  | sequence | Subset Tree depth d, 0..=depth max; then the cover, if any, at depth max + 1 |
+//! | `refine` | sequence | with `record --refine`: 0 = the grouping's tree, k = after the k-th kept move of the refinement |
 //!
 //! The wall-clock `log_time` timeline is switched off with
 //! `RecordingStream::set_log_time_enabled(false)`, and every temporal row is sent with
 //! `send_columns`, which never injects `log_time`/`log_tick`; the file is therefore indexed only
-//! by the three timelines above. (The blueprint, a separate store in the same file, is written by
+//! by the timelines above. (The blueprint, a separate store in the same file, is written by
 //! the SDK's own blueprint stream and carries `log_time`; it holds no recorded data.)
 //!
 //! # Entities
@@ -49,6 +50,10 @@
 //! | `cover/summary` | `TextLog` | static | levels, full | tolerance (and budget), size and largest error of the cover |
 //! | `levels` | `Clear` (recursive) | `level` (depth max + 1) | with a cover | hides the last level under the cover |
 //!
+//! With `record --refine`, the refinement's `series/refine_sah`, `refine/move` and `log/refine`
+//! are written on the `refine` timeline (see `refine.rs`), and the levels are those of the
+//! *refined* tree.
+//!
 //! Each `cover/*` geometry entity exists only when the cover uses that kind; `cover` carries the
 //! same static origin translation as `levels`.
 //!
@@ -72,6 +77,7 @@ mod blueprint;
 mod columns;
 mod levels;
 mod mesh;
+mod refine;
 mod series_file;
 mod sink;
 
@@ -107,6 +113,8 @@ pub struct RrdRecorder {
     /// Box of every body so far, relative to `origin` (only when per-merge geometry is written).
     boxes: Vec<BoxF32>,
     columns: Columns,
+    /// The refinement's rows (`record --refine`).
+    refine: refine::RefineColumns,
     round: u32,
     dlimit: f64,
     glimit: f64,
@@ -248,6 +256,7 @@ impl RrdRecorder {
             origin,
             boxes,
             columns: Columns::default(),
+            refine: refine::RefineColumns::default(),
             round: 0,
             dlimit: info.params.dlimit0,
             glimit: info.params.glimit0,
@@ -309,7 +318,7 @@ impl RrdRecorder {
                 ),
         )?;
         let o = self.origin;
-        for root in ["scene", "grouping", "levels"] {
+        for root in ["scene", "grouping", "levels", "refine"] {
             send_static(
                 rec,
                 root,
@@ -400,6 +409,23 @@ impl RrdRecorder {
                 }
             }
             Event::Dormant { .. } => {}
+            Event::RefineStart { params, sah } => {
+                let rec = self.rec.as_ref().ok_or_else(closed)?;
+                self.refine.start(rec, &params, sah, self.detail.merges())?;
+            }
+            Event::Refine(s) => {
+                let boxes = self.detail.merges().then(|| {
+                    [
+                        BoxF32::new(&s.aabb, &self.origin),
+                        BoxF32::new(&s.parent_aabb, &self.origin),
+                    ]
+                });
+                self.refine.push(&s, boxes);
+                if self.refine.len() >= columns::BATCH {
+                    let rec = self.rec.as_ref().ok_or_else(closed)?;
+                    self.refine.flush(rec)?;
+                }
+            }
             Event::Part(p) => self.text(self.round, p.to_string()),
             Event::Doubling {
                 round,
@@ -459,6 +485,7 @@ impl RrdRecorder {
         }
         let rec = self.rec.as_ref().ok_or_else(closed)?;
         self.columns.flush(rec)?;
+        self.refine.finish(rec)?;
         if let (Some(mesh), Some(grouping), Some(spheres)) =
             (&self.mesh, outcome.grouping, outcome.spheres)
         {

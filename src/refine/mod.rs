@@ -1,0 +1,205 @@
+//! Refinement of a finished Subset Tree (the grouping's or any peer's): subtrees are moved to
+//! where they lower the SAH ([`crate::metrics::sah`]) most, by insertion-based optimisation
+//! (Bittner, Hapala and Havran 2013) in the parallel form of Meister and Bittner 2018
+//! ([`reinsert`]).
+//!
+//! A run is a sequence of passes. Pass k (0-based) ranks the non-root nodes by how badly their
+//! parent fits them ([`reinsert::candidates`]) and searches the best reinsertion of the first
+//! ⌈batch × (2N − 2) / (2k + 1)⌉ of them, in
+//! parallel on the tree as it stands; the moves found are then applied one at a time, best
+//! first, each re-checked against the current tree and kept only if it lowers the SAH by more
+//! than 10⁻¹² of the root's area (else undone). The shrinking batches (1, 1/3, 1/5, …, as obvhs
+//! does) spend the later passes on the large nodes near the top. A pass that keeps no move
+//! ends the run early.
+//!
+//! What holds for every input ([`refine`]):
+//! - the result is a Subset Tree: leaves `0..N` in input order, interior nodes renumbered so
+//!   that children precede parents, keeping the input's order where it still holds
+//!   ([`renumber`]); a tree no move improves is returned unchanged (every id kept);
+//! - SAH never above the input's: every kept move lowers it (and a final check against
+//!   [`crate::metrics::sah`] guards rounding);
+//! - deterministic: the same tree and parameters give the same moves, the same events and the
+//!   same result for any number of rayon threads (searches are pure functions of the frozen
+//!   tree, collected in candidate order; moves apply sequentially, ties broken by node id);
+//! - interior nodes whose leaf set changed take their box diagonal as diameter (the AABB
+//!   p-set's measure); the others keep the input's.
+//!
+//! Each kept move is a [`Step`] event (`Event::Refine`) for recorders: which subtree moved,
+//! from where to where, and the SAH after it. A tree whose root box has no area (all
+//! primitives in one point, or on one line) has nothing to gain and is returned unchanged.
+
+pub mod reinsert;
+pub mod renumber;
+pub mod work;
+
+use crate::geom::Aabb;
+use crate::grouping::{Event, Observer, SubsetTree};
+use crate::metrics::{self, area};
+use work::WorkTree;
+
+/// Parameters of a refinement run.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RefineParams {
+    /// Most passes run (a pass that keeps no move ends the run sooner).
+    pub passes: u32,
+    /// Fraction of the non-root nodes searched in the first pass (pass k searches
+    /// batch / (2k + 1) of them); in (0, 1].
+    pub batch: f64,
+}
+
+impl Default for RefineParams {
+    /// 6 passes, first batch = a tenth of the nodes: refinement within about one obvhs PLOC
+    /// build time on the bench scenes (see the README's refinement section for the
+    /// measurements behind it).
+    fn default() -> Self {
+        RefineParams {
+            passes: 6,
+            batch: 0.1,
+        }
+    }
+}
+
+impl RefineParams {
+    /// Checks that `batch` is in (0, 1]; the error names the parameter.
+    pub fn check(&self) -> Result<(), String> {
+        if !(self.batch > 0.0 && self.batch <= 1.0) {
+            return Err(format!(
+                "refine batch must be in (0, 1], got {}",
+                self.batch
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// One kept move of a refinement run.
+///
+/// Ids are the input tree's: leaves are primitives; an interior id names the input's node
+/// *slot*, which a move can hang elsewhere (the final renumbering to merge order happens after
+/// the last step, see [`renumber`]).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Step {
+    /// 0-based index of the step in the run.
+    pub step: u32,
+    /// Pass the step belongs to.
+    pub pass: u32,
+    /// The subtree that moved.
+    pub node: u32,
+    /// Its parent slot, which moved with it: before, parent of `node` and `sibling`; after,
+    /// parent of `node` and `target`.
+    pub parent: u32,
+    /// Its old sibling, which took the parent's old place.
+    pub sibling: u32,
+    /// Its new sibling.
+    pub target: u32,
+    /// Box of the moved subtree.
+    #[serde(serialize_with = "ser_aabb")]
+    pub aabb: Aabb,
+    /// Box of the parent slot after the move (`node` ∪ `target`).
+    #[serde(serialize_with = "ser_aabb")]
+    pub parent_aabb: Aabb,
+    /// SAH before the step.
+    pub sah_before: f64,
+    /// SAH after the step.
+    pub sah: f64,
+}
+
+fn ser_aabb<S: serde::Serializer>(b: &Aabb, s: S) -> Result<S::Ok, S::Error> {
+    use serde::Serialize;
+    [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z].serialize(s)
+}
+
+/// The outcome of a refinement run.
+#[derive(Clone, Debug)]
+pub struct Refined {
+    /// The refined tree (the input itself when no move was kept).
+    pub tree: SubsetTree,
+    /// SAH of the input.
+    pub sah_before: f64,
+    /// SAH of the result.
+    pub sah_after: f64,
+    /// Moves kept.
+    pub steps: u32,
+    /// Passes run.
+    pub passes: u32,
+}
+
+/// Refines `tree` (see the module doc), reporting the start ([`Event::RefineStart`]) and each
+/// kept move ([`Event::Refine`]) to `observer`.
+pub fn refine<O: Observer>(tree: &SubsetTree, params: &RefineParams, mut observer: O) -> Refined {
+    let sah_before = metrics::sah(tree);
+    observer.on_event(&Event::RefineStart {
+        params: *params,
+        sah: sah_before,
+    });
+    let unchanged = |passes| Refined {
+        tree: tree.clone(),
+        sah_before,
+        sah_after: sah_before,
+        steps: 0,
+        passes,
+    };
+    let root_area = area(&tree.aabb[tree.root() as usize]);
+    if tree.leaves() < 3 || !(root_area.is_finite() && root_area > 0.0) {
+        return unchanged(0);
+    }
+    let leaves: f64 = tree.aabb[..tree.leaves()].iter().map(area).sum();
+    let min_gain = root_area * 1e-12;
+    let mut w = WorkTree::of(tree);
+    let nodes = w.parent.len() - 1;
+    let (mut steps, mut passes) = (0u32, 0u32);
+    for pass in 0..params.passes {
+        passes += 1;
+        let count = ((nodes as f64 * params.batch) / (2 * pass + 1) as f64).ceil() as usize;
+        let candidates = reinsert::candidates(&w, count.max(1));
+        let mut moves = reinsert::find_all(&w, &candidates, min_gain);
+        reinsert::sort_best_first(&mut moves);
+        let mut kept = 0;
+        for m in &moves {
+            if !reinsert::still_valid(&w, m) {
+                continue;
+            }
+            let before = w.interior;
+            let sah_before = w.sah(leaves, root_area);
+            let moved = w.reinsert(m.node, m.target);
+            if before - w.interior <= min_gain {
+                w.reinsert(m.node, moved.sibling);
+                w.interior = before;
+                continue;
+            }
+            w.mark_changed(&moved);
+            observer.on_event(&Event::Refine(Step {
+                step: steps,
+                pass,
+                node: m.node,
+                parent: moved.parent,
+                sibling: moved.sibling,
+                target: m.target,
+                aabb: w.aabb[m.node as usize],
+                parent_aabb: w.aabb[moved.parent as usize],
+                sah_before,
+                sah: w.sah(leaves, root_area),
+            }));
+            steps += 1;
+            kept += 1;
+        }
+        if kept == 0 {
+            break;
+        }
+    }
+    if steps == 0 {
+        return unchanged(passes);
+    }
+    let refined = renumber::subset_tree(&w, tree).expect("moves keep one binary tree");
+    let sah_after = metrics::sah(&refined);
+    if sah_after > sah_before {
+        return unchanged(passes);
+    }
+    Refined {
+        tree: refined,
+        sah_before,
+        sah_after,
+        steps,
+        passes,
+    }
+}

@@ -1,0 +1,68 @@
+//! Back to the Subset Tree's numbering after moves: leaves keep `0..N`; interior slots get ids
+//! `N..2N−1` in a topological order (children before parents) that keeps the input's order
+//! wherever it still holds — among the slots whose children are all numbered, the smallest
+//! input id comes next. An unmoved tree keeps every id.
+
+use super::work::WorkTree;
+use crate::grouping::SubsetTree;
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+/// The Subset Tree of `w`: interior slots renumbered (see the module doc), boxes as refitted,
+/// and the diameter of `input` for every node whose leaf set is unchanged, the box diagonal for
+/// the others.
+pub fn subset_tree(w: &WorkTree, input: &SubsetTree) -> Result<SubsetTree, String> {
+    let n = w.n as usize;
+    let slots = w.children.len();
+    // Children of a slot not yet numbered: 0, 1 or 2.
+    let mut waiting = vec![0u8; slots];
+    let mut ready = BinaryHeap::new();
+    for (i, k) in w.children.iter().enumerate() {
+        waiting[i] = k.iter().filter(|&&c| !w.is_leaf(c)).count() as u8;
+        if waiting[i] == 0 {
+            ready.push(Reverse(i as u32));
+        }
+    }
+    let mut new_id = vec![0u32; slots];
+    let mut order = Vec::with_capacity(slots);
+    while let Some(Reverse(i)) = ready.pop() {
+        new_id[i as usize] = (n + order.len()) as u32;
+        order.push(i);
+        let p = w.parent[n + i as usize];
+        if p != crate::grouping::NONE {
+            let j = p as usize - n;
+            waiting[j] -= 1;
+            if waiting[j] == 0 {
+                ready.push(Reverse(j as u32));
+            }
+        }
+    }
+    if order.len() != slots {
+        return Err(format!(
+            "refined tree is not one tree: {} of {slots} interior nodes reachable",
+            order.len()
+        ));
+    }
+    let id = |c: u32| {
+        if w.is_leaf(c) {
+            c
+        } else {
+            new_id[(c as usize) - n]
+        }
+    };
+    let mut aabb = w.aabb[..n].to_vec();
+    let mut diameter = input.diameter[..n].to_vec();
+    let mut children = Vec::with_capacity(slots);
+    for &i in &order {
+        let x = n + i as usize;
+        aabb.push(w.aabb[x]);
+        diameter.push(if w.changed[i as usize] {
+            w.aabb[x].diameter()
+        } else {
+            input.diameter[x]
+        });
+        let [a, b] = w.children[i as usize];
+        children.push([id(a), id(b)]);
+    }
+    SubsetTree::new(aabb, diameter, children)
+}
