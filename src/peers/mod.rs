@@ -4,6 +4,9 @@
 //!
 //! - [`Method::Grouping`], [`Method::GroupingHull`]: the paper's grouping phase (§2.2) with AABB
 //!   or convex-hull p-sets;
+//! - [`Method::GroupingPregroup`], [`Method::GroupingInstanced`]: the same with the paper's
+//!   §1.3 speed-ups ([`crate::grouping::pregroup`]): connected components grouped first, in
+//!   parallel on the current rayon pool, and rigid copies copy-moved;
 //! - [`parry_bvh`]: parry3d's `Bvh`, binned SAH or PLOC, as published;
 //! - [`obvhs_ploc`]: obvhs's PLOC, with or without its reinsertion optimiser, as published;
 //! - [`median_split`]: a top-down median split;
@@ -12,7 +15,9 @@
 //! A peer's reported time covers its own build only, from primitive boxes (`f32` relative to the
 //! scene centre for parry and obvhs, `f64` for ours) to its native tree; reading its topology
 //! into a Subset Tree ([`topology`]) is not timed. Box computation per primitive is shared and
-//! not timed either. Every method is single-threaded.
+//! not timed either. Every method is single-threaded except the pre-grouped ones, which use the
+//! current rayon pool (run them inside `ThreadPool::install` to choose the thread count); their
+//! time includes finding the components and the copies.
 
 pub mod goldsmith_salmon;
 pub mod median_split;
@@ -20,7 +25,7 @@ pub mod obvhs_ploc;
 pub mod parry_bvh;
 pub mod topology;
 
-use crate::grouping::{self, PSet, Params, Stats, SubsetTree};
+use crate::grouping::{self, PSet, Params, Pregroup, Stats, SubsetTree};
 use crate::scene::Scene;
 use parry3d::partitioning::BvhBuildStrategy;
 use std::time::Instant;
@@ -32,6 +37,10 @@ pub enum Method {
     Grouping,
     /// The grouping phase with convex-hull p-sets.
     GroupingHull,
+    /// The grouping phase with connected components pre-grouped (AABB p-set).
+    GroupingPregroup,
+    /// The grouping phase with connected components pre-grouped and rigid copies copy-moved.
+    GroupingInstanced,
     /// parry3d `Bvh`, binned SAH strategy.
     ParryBinned,
     /// parry3d `Bvh`, PLOC strategy.
@@ -48,9 +57,11 @@ pub enum Method {
 
 impl Method {
     /// Every method, ours first.
-    pub const ALL: [Method; 8] = [
+    pub const ALL: [Method; 10] = [
         Method::Grouping,
         Method::GroupingHull,
+        Method::GroupingPregroup,
+        Method::GroupingInstanced,
         Method::ParryBinned,
         Method::ParryPloc,
         Method::ObvhsPloc,
@@ -64,6 +75,8 @@ impl Method {
         match self {
             Method::Grouping => "grouping",
             Method::GroupingHull => "grouping-hull",
+            Method::GroupingPregroup => "grouping-pregroup",
+            Method::GroupingInstanced => "grouping-instanced",
             Method::ParryBinned => "parry-binned",
             Method::ParryPloc => "parry-ploc",
             Method::ObvhsPloc => "obvhs-ploc",
@@ -86,7 +99,13 @@ impl Method {
 
     /// Whether this is the paper's grouping phase.
     pub fn is_grouping(self) -> bool {
-        matches!(self, Method::Grouping | Method::GroupingHull)
+        matches!(
+            self,
+            Method::Grouping
+                | Method::GroupingHull
+                | Method::GroupingPregroup
+                | Method::GroupingInstanced
+        )
     }
 }
 
@@ -114,7 +133,7 @@ pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, St
         stats,
     };
     if method.is_grouping() {
-        let p = Params {
+        let mut p = Params {
             pset: if method == Method::GroupingHull {
                 PSet::Hull
             } else {
@@ -122,6 +141,11 @@ pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, St
             },
             ..params.clone()
         };
+        if matches!(method, Method::GroupingPregroup | Method::GroupingInstanced) {
+            p.pset = PSet::Aabb;
+            p.mode.pregroup = Pregroup::Connected;
+            p.mode.instancing = method == Method::GroupingInstanced;
+        }
         let g = grouping::group(scene, &p, ());
         let seconds = t.elapsed().as_secs_f64();
         return Ok(done(g.tree, Some(g.stats), seconds));
@@ -162,7 +186,10 @@ pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, St
             let (nodes, root) = goldsmith_salmon::build(&boxes);
             (nodes, root, t.elapsed().as_secs_f64())
         }
-        Method::Grouping | Method::GroupingHull => unreachable!("handled above"),
+        Method::Grouping
+        | Method::GroupingHull
+        | Method::GroupingPregroup
+        | Method::GroupingInstanced => unreachable!("handled above"),
     };
     let tree = topology::subset_tree(scene, &nodes, root)
         .map_err(|e| format!("{}: malformed tree: {e}", method.name()))?;
