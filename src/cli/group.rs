@@ -166,6 +166,7 @@ impl GroupCmd {
                 "seconds": seconds,
                 "params": g.params,
                 "stats": g.stats,
+                "pregrouping": g.pregrouping,
                 "peak_rss_bytes": super::peak_rss_bytes(),
                 "parent": t.parent_i64(),
             });
@@ -181,6 +182,9 @@ impl GroupCmd {
                 g.params.glimit0,
                 g.params.pset
             );
+            if let Some(p) = &g.pregrouping {
+                println!("{}", pregrouping_lines(p));
+            }
             println!("rounds      {}", g.rounds);
             println!(
                 "depth       max {} ({} levels), mean {:.2}, 2·log2 N = {:.1}",
@@ -193,4 +197,31 @@ impl GroupCmd {
         }
         Ok(ExitCode::SUCCESS)
     }
+}
+
+/// What pre-grouping found, as the lines `wraptree group` prints.
+fn pregrouping_lines(p: &grouping::Pregrouping) -> String {
+    let kind = match p.pregroup {
+        grouping::Pregroup::None => "none",
+        grouping::Pregroup::Objects => "objects",
+        grouping::Pregroup::Connected => "connected",
+    };
+    let mut out = format!(
+        "pregroup    {kind}: {} components, {} grouped on their own (>= {} primitives), {} \
+         primitives of smaller ones and {} part roots at the top level ({} bodies), {} threads",
+        p.components,
+        p.parts - p.copies,
+        grouping::pregroup::MIN_PART,
+        p.loose,
+        p.parts,
+        p.top_bodies,
+        p.threads
+    );
+    if p.instancing {
+        out.push_str(&format!(
+            "\ninstancing  {} classes with copies, {} copies, {} primitives not grouped",
+            p.classes, p.copies, p.primitives_saved
+        ));
+    }
+    out
 }

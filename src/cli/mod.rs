@@ -155,18 +155,20 @@ impl GroupArgs {
                 anyhow::bail!("{name} must be a finite number > 0, got {v}");
             }
         }
+        let mode = Mode {
+            schedule: self.schedule,
+            pregroup: self.pregroup,
+            instancing: self.instancing,
+            cost: self.cost,
+        };
+        mode.check(self.pset).map_err(anyhow::Error::msg)?;
         Ok(Params {
             weights,
             dlimit: self.dlimit,
             glimit: self.glimit,
             pset: self.pset,
             seed: self.seed,
-            mode: Mode {
-                schedule: self.schedule,
-                pregroup: self.pregroup,
-                instancing: self.instancing,
-                cost: self.cost,
-            },
+            mode,
         })
     }
 }

@@ -39,10 +39,12 @@ mod cluster;
 pub mod events;
 mod hull_pset;
 pub mod mpairs;
+pub mod pregroup;
 pub mod subset_tree;
 pub mod voxel_hash;
 
 pub use events::{Event, EventLog, Merge, Observer, Part, PartKind, Tee};
+pub use pregroup::Pregrouping;
 pub use subset_tree::{NONE, SubsetTree};
 
 use crate::scene::Scene;
@@ -199,6 +201,25 @@ pub struct Mode {
     pub cost: CostMeasure,
 }
 
+impl Mode {
+    /// Checks that the settings fit together with the p-set `pset`: instancing needs
+    /// pre-grouping (copies are found among components), and pre-grouping needs the AABB p-set.
+    /// The errors name the CLI flags.
+    pub fn check(&self, pset: PSet) -> Result<(), String> {
+        if self.instancing && self.pregroup == Pregroup::None {
+            return Err(
+                "--instancing needs --pregroup objects or --pregroup connected (copies are \
+                 found among components)"
+                    .to_string(),
+            );
+        }
+        if self.pregroup != Pregroup::None && pset != PSet::Aabb {
+            return Err("--pregroup needs --pset aabb (parts are grouped as boxes)".to_string());
+        }
+        Ok(())
+    }
+}
+
 /// User-facing parameters; `None` limits are derived from the scene by [`Params::resolve`].
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Params {
@@ -260,6 +281,7 @@ impl ResolvedParams {
     /// [`Params::resolve`] always pass; ones read from a file may not.
     pub fn check(&self) -> Result<(), String> {
         self.weights.check()?;
+        self.mode.check(self.pset)?;
         for (name, v) in [("dlimit0", self.dlimit0), ("glimit0", self.glimit0)] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(format!("{name} must be a finite number > 0, got {v}"));
@@ -348,6 +370,8 @@ pub struct Grouping {
     pub params: ResolvedParams,
     /// Work counters.
     pub stats: Stats,
+    /// What pre-grouping found and did, when the mode pre-groups ([`pregroup`]).
+    pub pregrouping: Option<Pregrouping>,
 }
 
 /// Limits on one run of the grouping phase; a run that exceeds one stops with [`Stopped`].
@@ -490,5 +514,8 @@ fn run<O: Observer>(
     observer: O,
     budget: &Budget<'_>,
 ) -> Result<Grouping, Stopped> {
+    if params.mode.pregroup != Pregroup::None && params.pset == PSet::Aabb {
+        return pregroup::run(scene, params, observer, budget);
+    }
     cluster::run(scene, params, observer, budget)
 }

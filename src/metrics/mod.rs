@@ -64,6 +64,28 @@ pub fn sah(tree: &SubsetTree) -> f64 {
     (C_TRAV * interior + C_PRIM * leaves) / root
 }
 
+/// Volumes of the cut at depth `d` (the paper's Figure 3 shows "the 8-node level", d = 3):
+/// the summed volumes of its interior nodes' AABBs and of the convex hulls of their primitives'
+/// vertices (leaves in the cut are drawn as themselves and add nothing).
+pub fn level_volume(tree: &SubsetTree, scene: &crate::scene::Scene, d: u32) -> (f64, f64) {
+    let mut boxes = 0.0;
+    let mut hulls = 0.0;
+    for x in tree.level(d) {
+        if tree.is_leaf(x) {
+            continue;
+        }
+        let e = tree.aabb[x as usize].extents();
+        boxes += e.x * e.y * e.z;
+        let points: Vec<_> = tree
+            .leaves_under(x)
+            .iter()
+            .flat_map(|&l| scene.prim_vertices(l as usize).copied())
+            .collect();
+        hulls += crate::geom::hull::hull_of(points).0.volume();
+    }
+    (boxes, hulls)
+}
+
 /// Every quality measure of `tree`.
 pub fn quality(tree: &SubsetTree) -> Quality {
     let n = tree.leaves();

@@ -4,6 +4,9 @@
 //!
 //! - [`Method::Grouping`], [`Method::GroupingHull`]: the paper's grouping phase (§2.2) with AABB
 //!   or convex-hull p-sets;
+//! - [`Method::GroupingPregroup`], [`Method::GroupingInstanced`]: the same with the paper's
+//!   §1.3 speed-ups ([`crate::grouping::pregroup`]): connected components grouped first, in
+//!   parallel on the current rayon pool, and rigid copies copy-moved;
 //! - [`parry_bvh`]: parry3d's `Bvh`, binned SAH or PLOC, as published;
 //! - [`obvhs_ploc`]: obvhs's PLOC, with or without its reinsertion optimiser, as published;
 //! - [`median_split`]: a top-down median split;
@@ -14,9 +17,11 @@
 //! A peer's reported time covers its own build only, from primitive boxes (`f32` relative to the
 //! scene centre for parry and obvhs, `f64` for ours) to its native tree; reading its topology
 //! into a Subset Tree ([`topology`]) is not timed. Box computation per primitive is shared and
-//! not timed either. Every builder is single-threaded; the refinement pass searches on rayon's
-//! threads (2 on the bench machine) and its time is added to the builder's: a refined method's
-//! time is the total, [`Built::refine_seconds`] the refinement's part.
+//! not timed either. Every builder is single-threaded except the pre-grouped ones, which use the
+//! current rayon pool (run them inside `ThreadPool::install` to choose the thread count; their
+//! time includes finding the components and the copies). The refinement pass searches on
+//! rayon's threads and its time is added to the builder's: a refined method's time is the
+//! total, [`Built::refine_seconds`] the refinement's part.
 
 pub mod goldsmith_salmon;
 pub mod median_split;
@@ -24,7 +29,7 @@ pub mod obvhs_ploc;
 pub mod parry_bvh;
 pub mod topology;
 
-use crate::grouping::{self, PSet, Params, Stats, SubsetTree};
+use crate::grouping::{self, PSet, Params, Pregroup, Stats, SubsetTree};
 use crate::refine::{self, RefineParams};
 use crate::scene::Scene;
 use parry3d::partitioning::BvhBuildStrategy;
@@ -37,6 +42,10 @@ pub enum Method {
     Grouping,
     /// The grouping phase with convex-hull p-sets.
     GroupingHull,
+    /// The grouping phase with connected components pre-grouped (AABB p-set).
+    GroupingPregroup,
+    /// The grouping phase with connected components pre-grouped and rigid copies copy-moved.
+    GroupingInstanced,
     /// parry3d `Bvh`, binned SAH strategy.
     ParryBinned,
     /// parry3d `Bvh`, PLOC strategy.
@@ -59,10 +68,12 @@ pub enum Method {
 
 impl Method {
     /// Every method, ours first.
-    pub const ALL: [Method; 11] = [
+    pub const ALL: [Method; 13] = [
         Method::Grouping,
         Method::GroupingRefine,
         Method::GroupingHull,
+        Method::GroupingPregroup,
+        Method::GroupingInstanced,
         Method::ParryBinned,
         Method::ParryPloc,
         Method::ObvhsPloc,
@@ -78,6 +89,8 @@ impl Method {
         match self {
             Method::Grouping => "grouping",
             Method::GroupingHull => "grouping-hull",
+            Method::GroupingPregroup => "grouping-pregroup",
+            Method::GroupingInstanced => "grouping-instanced",
             Method::ParryBinned => "parry-binned",
             Method::ParryPloc => "parry-ploc",
             Method::ObvhsPloc => "obvhs-ploc",
@@ -105,7 +118,11 @@ impl Method {
     pub fn is_grouping(self) -> bool {
         matches!(
             self,
-            Method::Grouping | Method::GroupingHull | Method::GroupingRefine
+            Method::Grouping
+                | Method::GroupingHull
+                | Method::GroupingRefine
+                | Method::GroupingPregroup
+                | Method::GroupingInstanced
         )
     }
 
@@ -167,7 +184,7 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
         refine_seconds: 0.0,
     };
     if method.is_grouping() {
-        let p = Params {
+        let mut p = Params {
             pset: if method == Method::GroupingHull {
                 PSet::Hull
             } else {
@@ -175,6 +192,11 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
             },
             ..params.clone()
         };
+        if matches!(method, Method::GroupingPregroup | Method::GroupingInstanced) {
+            p.pset = PSet::Aabb;
+            p.mode.pregroup = Pregroup::Connected;
+            p.mode.instancing = method == Method::GroupingInstanced;
+        }
         let g = grouping::group(scene, &p, ());
         let seconds = t.elapsed().as_secs_f64();
         return Ok(done(g.tree, Some(g.stats), seconds));
@@ -215,7 +237,10 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
             let (nodes, root) = goldsmith_salmon::build(&boxes);
             (nodes, root, t.elapsed().as_secs_f64())
         }
-        Method::Grouping | Method::GroupingHull => unreachable!("handled above"),
+        Method::Grouping
+        | Method::GroupingHull
+        | Method::GroupingPregroup
+        | Method::GroupingInstanced => unreachable!("handled above"),
         Method::GroupingRefine | Method::ParryBinnedRefine | Method::ObvhsPlocRefine => {
             unreachable!("refined methods are built from their base")
         }

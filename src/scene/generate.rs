@@ -208,7 +208,8 @@ pub fn random_rotation(rng: &mut ChaCha8Rng) -> UnitQuaternion<f64> {
 
 /// `copies` copies of `scene`, each but the first randomly rotated about its box centre and
 /// moved within a cube of side 0.6 × diameter × copies^(1/3), so that neighbours overlap
-/// somewhat. Named `{name}s{copies}` (e.g. `lamps5`); labels get a `#k` copy suffix.
+/// somewhat. Named `{name}s{copies}` (e.g. `lamps5`); labels get a `#k` copy suffix and the
+/// primitives of copy `k` have object id `k` (so `--pregroup objects` finds the copies).
 pub fn replicate(scene: &Scene, copies: usize, seed: u64) -> Scene {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let bbox = scene.aabb();
@@ -243,6 +244,8 @@ pub fn replicate(scene: &Scene, copies: usize, seed: u64) -> Scene {
             .extend(scene.tri_start[1..].iter().map(|s| s + tp));
         out.labels
             .extend(scene.labels.iter().map(|l| format!("{l}#{k}")));
+        out.objects
+            .extend(std::iter::repeat_n(k as u32, scene.len()));
     }
     out
 }

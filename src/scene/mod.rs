@@ -10,6 +10,7 @@
 //! - [`pathological`] makes the seeded scenes that stress builders (spaghetti, slabs, …);
 //! - [`split`] cuts long thin polygons into pieces of limited aspect (§4).
 
+pub mod components;
 pub mod generate;
 pub mod obj;
 pub mod pathological;
@@ -48,6 +49,11 @@ pub struct Scene {
     pub tris: Vec<[u32; 3]>,
     /// Optional per-primitive label (OBJ group name for polyhedra).
     pub labels: Vec<String>,
+    /// Per-primitive object id: the OBJ `o`/`g` object the primitive came from (ids in order of
+    /// first appearance, objects of the same name sharing one id), or the copy index of a
+    /// generated replica. Empty when unknown: every primitive is then in object 0. What
+    /// `--pregroup objects` takes as components.
+    pub objects: Vec<u32>,
 }
 
 impl Scene {
@@ -78,6 +84,11 @@ impl Scene {
         self.prim_start.push(self.prim_points.len() as u32);
         self.tris.extend_from_slice(tris);
         self.tri_start.push(self.tris.len() as u32);
+    }
+
+    /// Object id of primitive `i` (0 when the scene has no object ids).
+    pub fn object(&self, i: usize) -> u32 {
+        self.objects.get(i).copied().unwrap_or(0)
     }
 
     /// Vertex indices of primitive `i`.
@@ -111,7 +122,10 @@ impl Scene {
     }
 
     /// Writes the scene as Wavefront OBJ: one face per polygon, one `o` block per polyhedron
-    /// (its hull triangles as faces). Loading the output gives the same primitives.
+    /// (its hull triangles as faces). Polygons of a scene with object ids get an `o obj<id>`
+    /// line wherever the object changes. Loading the output gives the same primitives and, when
+    /// the ids are in order of first appearance (as loaders and generators make them), the same
+    /// object ids.
     pub fn write_obj(&self, mut out: impl std::io::Write) -> std::io::Result<()> {
         writeln!(
             out,
@@ -124,6 +138,10 @@ impl Scene {
         }
         let poly = self.kind == Some(PrimitiveKind::Polyhedron);
         for i in 0..self.len() {
+            if !poly && !self.objects.is_empty() && (i == 0 || self.object(i) != self.object(i - 1))
+            {
+                writeln!(out, "o obj{}", self.object(i))?;
+            }
             if poly {
                 let label = self.labels.get(i).map(String::as_str).unwrap_or("");
                 if label.is_empty() {

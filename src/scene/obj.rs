@@ -14,7 +14,9 @@
 //!
 //! Then, in polygon mode (default) every face becomes one `PrimitiveKind::Polygon` by the
 //! rules of [`polygon`]; with [`LoadOptions::polyhedra`] every OBJ object/group becomes one
-//! `PrimitiveKind::Polyhedron` by the rules of [`polyhedron`]. Vertices with bit-identical
+//! `PrimitiveKind::Polyhedron` by the rules of [`polyhedron`]. Every primitive records the
+//! object id of its group ([`Scene::objects`]; groups of the same name share one id, in order
+//! of first appearance). Vertices with bit-identical
 //! positions are merged; everything is deterministic, so loading the same bytes twice gives
 //! the same scene.
 
@@ -181,12 +183,22 @@ pub fn load_bytes(
     let groups = collect_groups(&models, &scanned.coords, &mut scene.points)
         .map_err(|p| err(LoadErrorKind::Malformed, p))?;
     let mut warnings = Vec::new();
+    // Object ids by group name, in order of first appearance.
+    let mut object_ids = std::collections::HashMap::<&str, u32>::new();
+    let group_ids: Vec<u32> = groups
+        .iter()
+        .map(|g| {
+            let next = object_ids.len() as u32;
+            *object_ids.entry(g.name.as_str()).or_insert(next)
+        })
+        .collect();
     if opts.polyhedra {
         let mut stats = PolyhedronStats::default();
-        for g in &groups {
+        for (g, &id) in groups.iter().zip(&group_ids) {
             let faces: Vec<&[u32]> = g.faces().collect();
             polyhedron::add(&mut scene, &g.name, &faces, opts.strict, &mut stats)
                 .map_err(|p| err(LoadErrorKind::NotConvex, p))?;
+            scene.objects.resize(scene.len(), id);
         }
         warnings.extend(
             stats
@@ -201,8 +213,11 @@ pub fn load_bytes(
             ..PolygonStats::default()
         };
         let mut scratch = polygon::Scratch::default();
-        for face in groups.iter().flat_map(Group::faces) {
-            polygon::add(&mut scene, face, diag, &mut stats, &mut scratch);
+        for (g, &id) in groups.iter().zip(&group_ids) {
+            for face in g.faces() {
+                polygon::add(&mut scene, face, diag, &mut stats, &mut scratch);
+            }
+            scene.objects.resize(scene.len(), id);
         }
         warnings.extend(
             stats

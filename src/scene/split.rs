@@ -128,6 +128,9 @@ pub fn split_aspect_stats(scene: &Scene, r: f64) -> (Scene, Vec<u32>, SplitStats
             .map(|&i| labels.get(i as usize).cloned().unwrap_or_default())
             .collect();
     }
+    if !scene.objects.is_empty() {
+        out.objects = map.iter().map(|&i| scene.object(i as usize)).collect();
+    }
     (out, map, stats)
 }
 

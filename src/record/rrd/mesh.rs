@@ -16,6 +16,8 @@ pub(super) struct PrimMesh {
     pub(super) normals: Vec<[f32; 3]>,
     /// Offsets into `tris`, length N + 1.
     tri_start: Vec<u32>,
+    /// Offsets into `positions`, length N + 1.
+    vert_start: Vec<u32>,
     /// Triangles as indices into `positions`.
     tris: Vec<[u32; 3]>,
 }
@@ -28,8 +30,10 @@ impl PrimMesh {
             normals: Vec::with_capacity(scene.vertex_refs()),
             tri_start: Vec::with_capacity(scene.len() + 1),
             tris: Vec::with_capacity(scene.tris.len()),
+            vert_start: Vec::with_capacity(scene.len() + 1),
         };
         m.tri_start.push(0);
+        m.vert_start.push(0);
         let mut local: Vec<(u32, V3)> = Vec::new();
         for i in 0..scene.len() {
             let base = m.positions.len() as u32;
@@ -60,8 +64,20 @@ impl PrimMesh {
                 m.normals.push([n.x as f32, n.y as f32, n.z as f32]);
             }
             m.tri_start.push(m.tris.len() as u32);
+            m.vert_start.push(m.positions.len() as u32);
         }
         m
+    }
+
+    /// One colour per vertex: primitive `i` in the colour of its component `component[i]`,
+    /// hues spread by the golden angle so neighbouring indices differ.
+    pub(super) fn component_colors(&self, component: &[u32]) -> Vec<[u8; 4]> {
+        let mut out = Vec::with_capacity(self.positions.len());
+        for (i, w) in self.vert_start.windows(2).enumerate() {
+            let c = hue_color(component.get(i).copied().unwrap_or(0));
+            out.extend(std::iter::repeat_n(c, (w[1] - w[0]) as usize));
+        }
+        out
     }
 
     /// Every triangle.
@@ -73,4 +89,20 @@ impl PrimMesh {
     pub(super) fn prim_tris(&self, i: u32) -> &[[u32; 3]] {
         &self.tris[self.tri_start[i as usize] as usize..self.tri_start[i as usize + 1] as usize]
     }
+}
+
+/// A light, saturated colour for index `k` (hue = k × the golden angle).
+fn hue_color(k: u32) -> [u8; 4] {
+    let h = (k as f64 * 0.618_033_988_749_895).fract() * 6.0;
+    let x = 1.0 - ((h % 2.0) - 1.0).abs();
+    let (r, g, b) = match h as u32 {
+        0 => (1.0, x, 0.0),
+        1 => (x, 1.0, 0.0),
+        2 => (0.0, 1.0, x),
+        3 => (0.0, x, 1.0),
+        4 => (x, 0.0, 1.0),
+        _ => (1.0, 0.0, x),
+    };
+    let v = |c: f64| (90.0 + 150.0 * c) as u8;
+    [v(r), v(g), v(b), 255]
 }

@@ -30,7 +30,7 @@
 //! |--------|-----------|------|------------|---------|
 //! | `/` | `ViewCoordinates` | static | all | right-handed, Z up (the generated scenes' convention) |
 //! | `scene`, `grouping`, `levels` | `Transform3D` | static | all | translation by the scene origin |
-//! | `scene/primitives` | `Mesh3D` | static | all | every input primitive in one shaded mesh, light grey |
+//! | `scene/primitives` | `Mesh3D` | static | all | every input primitive in one shaded mesh, light grey (with `--pregroup`: one colour per component) |
 //! | `grouping/merge` | `Boxes3D` (3 boxes) | `merge`, `round` | merges, full | the AABBs of the two merged bodies (orange), then of the new body (green) |
 //! | `grouping/active` | `Boxes3D` | `round`, `merge` | merges, full | at each round start, the AABBs of all active bodies (blue) |
 //! | `series/cost` | `Scalars` (1) | `merge` | all | Cost of each merge |
@@ -91,8 +91,10 @@ use rerun::{AsComponents, RecordingStream, SerializedComponentColumn, TimeColumn
 use sha2::{Digest, Sha256};
 
 use crate::geom::{Aabb, P3};
+use crate::grouping::Pregroup;
 use crate::grouping::{Event, Observer};
 use crate::record::{Detail, Outcome, RunInfo};
+use crate::scene::components;
 use columns::Columns;
 use mesh::PrimMesh;
 
@@ -326,14 +328,19 @@ impl RrdRecorder {
             )?;
         }
         send_static(rec, "/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
-        send_static(
-            rec,
-            "scene/primitives",
-            &rerun::Mesh3D::new(mesh.positions.iter().copied())
-                .with_vertex_normals(mesh.normals.iter().copied())
-                .with_triangle_indices(mesh.all_tris().iter().copied())
-                .with_albedo_factor(SCENE_GREY),
-        )?;
+        let primitives = rerun::Mesh3D::new(mesh.positions.iter().copied())
+            .with_vertex_normals(mesh.normals.iter().copied())
+            .with_triangle_indices(mesh.all_tris().iter().copied());
+        // With pre-grouping, each component in its own colour.
+        let primitives = match info.params.mode.pregroup {
+            Pregroup::None => primitives.with_albedo_factor(SCENE_GREY),
+            Pregroup::Objects => {
+                primitives.with_vertex_colors(mesh.component_colors(&components::objects(scene).of))
+            }
+            Pregroup::Connected => primitives
+                .with_vertex_colors(mesh.component_colors(&components::connected(scene).of)),
+        };
+        send_static(rec, "scene/primitives", &primitives)?;
         for ((path, names), colors) in columns::SERIES.iter().zip(columns::SERIES_COLORS) {
             let lines = rerun::SeriesLines::new()
                 .with_names(names.iter().copied())
