@@ -70,7 +70,11 @@ impl Observer for Buffer {
                 dlimit,
                 glimit,
             },
-            Event::Part(_) | Event::Finish { .. } => return,
+            // A part's own parts, finish and refinement (never inside a grouping) are not replayed.
+            Event::Part(_)
+            | Event::Finish { .. }
+            | Event::RefineStart { .. }
+            | Event::Refine(_) => return,
         };
         self.0.push(owned);
     }
@@ -230,7 +234,10 @@ impl<O: Observer> Observer for Remap<'_, O> {
                 dlimit,
                 glimit,
             }),
-            Event::Part(_) | Event::Finish { .. } => {}
+            Event::Part(_)
+            | Event::Finish { .. }
+            | Event::RefineStart { .. }
+            | Event::Refine(_) => {}
         }
     }
 
