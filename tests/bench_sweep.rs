@@ -1,6 +1,6 @@
 //! `bench SCENE… -o DIR` and `sweep`: the CSV has one row per method × wrapper (or setting), the
 //! charts are real PNGs, and the `.rrd` passes `rerun rrd verify` with the expected entities
-//! (PyPI `rerun-sdk==0.36.3`, installed by `.ci/run`; a missing tool fails the test).
+//! (PyPI `rerun-sdk==0.36.3`, provisioned by the tests, `common::readers`).
 
 mod common;
 
@@ -21,11 +21,11 @@ print(json.dumps(sorted({c.entity_path for c in r.stream()})))
 
 fn entities(path: &Path) -> BTreeSet<String> {
     common::assert_rrd_verifies(path);
-    let out = Command::new("python3")
+    let out = common::python()
         .args(["-c", ENTITIES])
         .arg(path)
         .output()
-        .expect("python3");
+        .expect("the readers' Python runs");
     assert!(
         out.status.success(),
         "{}",

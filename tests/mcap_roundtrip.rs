@@ -2,7 +2,7 @@
 //! reproducible recordings are byte-identical, bad files give one clear error line, and an
 //! independent Python reader (`tests/mcap_check.py`, PyPI `mcap` + `mcap-protobuf-support` +
 //! `foxglove-schemas-protobuf`) decodes every message and checks every level covers the scene.
-//! A missing `python3` or module makes the test fail, never pass.
+//! The readers are provisioned by the tests (`common::readers`); failing that fails the test.
 
 mod common;
 
@@ -92,12 +92,12 @@ fn record(
 /// Runs the independent Python checker; returns (success, stdout + stderr).
 fn python_check(path: &Path, n: usize) -> (bool, String) {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/mcap_check.py");
-    let out = Command::new("python3")
+    let out = common::python()
         .arg(&script)
         .arg(path)
         .arg(n.to_string())
         .output()
-        .unwrap_or_else(|e| panic!("cannot run python3 ({e}); install python3 with mcap, mcap-protobuf-support and foxglove-schemas-protobuf"));
+        .expect("the readers' Python runs");
     let text = format!(
         "{}{}",
         String::from_utf8_lossy(&out.stdout),

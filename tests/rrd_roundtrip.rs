@@ -1,5 +1,5 @@
 //! The `.rrd` recorder, read back by independent readers from PyPI's `rerun-sdk==0.36.3`
-//! (installed by `.ci/run`): `rerun rrd verify` must accept each file, and the package's
+//! (provisioned by the tests, `common::readers`): `rerun rrd verify` must accept each file, and the package's
 //! `rerun.experimental.RrdReader` lists its stores, entities, timelines and time values.
 //! Missing tools make these tests fail, never pass.
 
@@ -121,14 +121,14 @@ fn record(dir: &Path, detail: Detail, params: &Params, kinds: &[WrapperKind]) ->
 /// Checks `path` with `rerun rrd verify` and summarises it with the Python reader.
 fn summarize(path: &Path) -> Summary {
     common::assert_rrd_verifies(path);
-    let out = Command::new("python3")
+    let out = common::python()
         .args(["-c", READER])
         .arg(path)
         .output()
-        .expect("python3 with rerun-sdk==0.36.3 (installed by .ci/run) must be on PATH");
+        .expect("the readers' Python runs");
     assert!(
         out.status.success(),
-        "the Python reader (needs `pip install rerun-sdk==0.36.3`) failed on {}:\n{}",
+        "the Python reader failed on {}:\n{}",
         path.display(),
         String::from_utf8_lossy(&out.stderr)
     );

@@ -1,6 +1,10 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod readers;
+
+pub use readers::{python, rerun};
+
 use wraptree::geom::P3;
 use wraptree::grouping::{EventLog, Grouping, Params, SubsetTree, group};
 use wraptree::scene::{PrimitiveKind, Scene};
@@ -142,14 +146,13 @@ pub fn fuzz_runner(salt: u64, default: u32) -> (u32, proptest::test_runner::Test
     (cases, TestRunner::new_with_rng(config, rng))
 }
 
-/// Asserts that `rerun rrd verify` (PyPI `rerun-sdk==0.36.3`, installed by `.ci/run`) accepts
-/// `path`; a missing CLI fails the test.
+/// Asserts that `rerun rrd verify` (PyPI `rerun-sdk`, see [`readers`]) accepts `path`.
 pub fn assert_rrd_verifies(path: &std::path::Path) {
-    let verify = std::process::Command::new("rerun")
+    let verify = rerun()
         .args(["rrd", "verify"])
         .arg(path)
         .output()
-        .expect("the rerun CLI (pip install rerun-sdk==0.36.3) must be on PATH");
+        .expect("the rerun CLI runs");
     assert!(
         verify.status.success(),
         "rerun rrd verify {}: {}",

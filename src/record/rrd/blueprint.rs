@@ -1,16 +1,22 @@
 //! The layout the `.rrd` file opens on (a Rerun blueprint, sent with `with_blueprint`).
 //!
-//! Left: a 3D view of the scene and the grouping boxes (scrub the `merge` or `round`
-//! timeline); beside it, when levels are written, a 3D view of the tree levels and the cover,
-//! if any (scrub `level`).
-//! Right: four plots of the merge series and the refinement's SAH (`record --refine`) above the
-//! text log of rounds, doublings and refinement. The time
-//! panel opens expanded on the `merge` timeline.
+//! Top, side by side (wide views, so the scene is framed whole at 1280×720): a 3D view of the
+//! scene and the grouping boxes (scrub the `merge` or `round` timeline) and, when levels are
+//! written, a 3D view of the tree levels and the cover, if any (scrub `level`).
+//! Bottom: the plots of the merge series (and the refinement's SAH, `record --refine`, on the
+//! `refine` timeline) in a grid of two columns beside the text log of rounds, doublings and
+//! refinement.
+//!
+//! Every view shows something when the file is opened: the time panel opens collapsed (the play
+//! bar alone) on the `merge` timeline, following, so the cursor stands at the last merge; there
+//! the Grouping view shows the scene with the root's merge, the plots and the log the whole run,
+//! and the Levels view the preview level, which is also on the `merge` and `round` timelines
+//! (see `levels.rs`). The blueprint and selection panels open collapsed.
 
-use rerun::blueprint::components::PanelState;
+use rerun::blueprint::components::{PanelState, PlayState};
 use rerun::blueprint::{
-    Blueprint, ContainerLike, Grid, Horizontal, Spatial3DView, TextLogView, TimePanel,
-    TimeSeriesView, Vertical,
+    Blueprint, BlueprintPanel, ContainerLike, Grid, Horizontal, SelectionPanel, Spatial3DView,
+    TextLogView, TimePanel, TimeSeriesView, Vertical,
 };
 
 use crate::record::Detail;
@@ -45,18 +51,22 @@ pub(super) fn layout(detail: Detail) -> Blueprint {
         plot("SAH (timeline refine)", &["refine_sah"]),
     ])
     .with_grid_columns(2);
-    let side = Vertical::new([
+    let bottom = Horizontal::new([
         plots.into(),
         TextLogView::new("Rounds, doublings, refinement")
             .with_origin("/log")
             .into(),
     ])
-    .with_row_shares([2.0, 1.0]);
-    let shares: Vec<f32> = std::iter::repeat_n(2.0, views.len()).chain([2.0]).collect();
-    views.push(side.into());
-    Blueprint::new(Horizontal::new(views).with_column_shares(shares)).with_time_panel(
-        TimePanel::new()
-            .with_state(PanelState::Expanded)
-            .with_timeline("merge"),
-    )
+    .with_column_shares([3.0, 2.0]);
+    let top = Horizontal::new(views);
+    let root = Vertical::new([top.into(), bottom.into()]).with_row_shares([3.0, 2.0]);
+    Blueprint::new(root)
+        .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
+        .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
+        .with_time_panel(
+            TimePanel::new()
+                .with_state(PanelState::Collapsed)
+                .with_timeline("merge")
+                .with_play_state(PlayState::Following),
+        )
 }

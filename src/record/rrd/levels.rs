@@ -4,12 +4,17 @@
 //! (`record --wrapper`): spheres (`levels/spheres`), convex hulls (`levels/hulls`),
 //! axis-aligned boxes (`levels/boxes`) and oriented boxes (`levels/obbs`).
 //!
-//! Meshes are logged the way `levels/leaves` is: the vertices once, at d = 0, later levels send
-//! only the triangle indices of the shapes in their cut (a partial `Mesh3D` update). The leaves'
-//! vertices (positions and normals, see [`PrimMesh`]) are per primitive; the hulls' vertices are
-//! input points, shared by a node's hull and its ancestors' hulls, so each distinct point is
-//! logged once and without normals (the hulls are drawn translucent and unshaded). Each level
-//! costs 12 bytes per drawn triangle, 16 bytes per sphere, 24 per box and 40 per oriented box.
+//! Each leaf is logged once: `levels/leaves/<k>` holds the leaves at depth k (vertices,
+//! normals, see [`PrimMesh`], and triangles) at tick k, and stays, so tick d shows the leaves of
+//! depth ≤ d, which are the cut's leaves. The hulls' vertices are input points, shared by a
+//! node's hull and its ancestors' hulls, so each distinct point is logged once, at d = 0, and
+//! without normals (the hulls are drawn translucent and unshaded); later levels send only the
+//! triangle indices of the cut's hulls (a partial `Mesh3D` update). Each level costs 12 bytes
+//! per hull triangle, 16 bytes per sphere, 24 per box and 40 per oriented box.
+//!
+//! So that the Levels view shows something whatever timeline is selected, one level, the
+//! *preview* (the shallowest whose cut has at least 64 nodes), is also logged at tick 0 of the
+//! `merge` and `round` timelines.
 //!
 //! A cover (`record --cover-tolerance`/`--cover-budget`) is one more level at tick
 //! `depth_max + 1` under `cover/*` ([`log_cover`]); its meshes are sent whole.
@@ -102,9 +107,21 @@ fn nonempty(mut tris: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
     tris
 }
 
+/// The preview level is the shallowest whose cut has at least this many nodes.
+const PREVIEW_NODES: usize = 64;
+
+/// Times of the rows that show the preview level on the `merge` and `round` timelines.
+const PREVIEW: [(&str, i64); 2] = [("merge", 0), ("round", 0)];
+
 /// Logs every level of `tree` with the leaves drawn from `mesh`; `spheres` holds one sphere
 /// per node, or none (levels without spheres: `levels/spheres` stays empty); the hulls, boxes
 /// and oriented boxes of `wrappers` (its spheres are ignored) are logged when present.
+///
+/// Leaves are logged once each: `levels/leaves/<k>` holds the leaves at depth k at level tick k
+/// and is never cleared, so at tick d the view shows the leaves of depth ≤ d, the cut's leaves.
+/// The preview level (the shallowest whose cut has at least 64 nodes, else the deepest) is also
+/// on the `merge` and `round` timelines at tick 0: its wrappers in one more row per entity, its
+/// leaves by giving the rows of depth ≤ preview those times too.
 pub(super) fn log_levels(
     rec: &RecordingStream,
     mesh: &PrimMesh,
@@ -122,9 +139,30 @@ pub(super) fn log_levels(
     check_len("boxes", w.boxes.as_ref().map(Vec::len), tree)?;
     check_len("oriented boxes", w.obbs.as_ref().map(Vec::len), tree)?;
     let hull_mesh = w.hulls.as_deref().map(|h| HullMesh::new(tree, h, origin));
+    let mut leaves_by_depth = vec![Vec::new(); tree.depth_max() as usize + 1];
+    for x in 0..tree.leaves() as u32 {
+        leaves_by_depth[tree.depth[x as usize] as usize].push(x);
+    }
+    let mut preview = None;
     for d in 0..=tree.depth_max() {
-        let times = [("level", d as i64)];
         let cut = tree.level(d);
+        let in_preview = preview.is_none();
+        if in_preview && (cut.len() >= PREVIEW_NODES || d == tree.depth_max()) {
+            preview = Some(d);
+        }
+        let level = ("level", d as i64);
+        let times: Vec<_> = if in_preview && d == 0 {
+            [level].into_iter().chain(PREVIEW).collect()
+        } else {
+            vec![level]
+        };
+        let send = |entity: &str, arch: &dyn rerun::AsComponents| -> anyhow::Result<()> {
+            send_at(rec, entity, &times, arch)?;
+            if preview == Some(d) {
+                send_at(rec, entity, &PREVIEW, arch)?;
+            }
+            Ok(())
+        };
         let interior: Vec<u32> = cut.iter().copied().filter(|&x| !tree.is_leaf(x)).collect();
         if !spheres.is_empty() || w.trees().is_empty() {
             let (centers, radii): (Vec<_>, Vec<_>) = interior
@@ -138,7 +176,7 @@ pub(super) fn log_levels(
             let arch = rerun::Ellipsoids3D::from_centers_and_radii(centers, radii)
                 .with_colors([SPHERE_BLUE])
                 .with_fill_mode(FillMode::TransparentFillMajorWireframe);
-            send_at(rec, "levels/spheres", &times, &arch)?;
+            send("levels/spheres", &arch)?;
         }
         if let Some(hm) = &hull_mesh {
             let tris = interior.iter().flat_map(|&x| hm.node_tris(x)).copied();
@@ -148,7 +186,7 @@ pub(super) fn log_levels(
                 rerun::Mesh3D::update_fields()
             }
             .with_triangle_indices(nonempty(tris.collect()));
-            send_at(rec, "levels/hulls", &times, &arch)?;
+            send("levels/hulls", &arch)?;
         }
         if let Some(b) = &w.boxes {
             let (centers, halves): (Vec<_>, Vec<_>) = interior
@@ -165,7 +203,7 @@ pub(super) fn log_levels(
             let arch = rerun::Boxes3D::from_centers_and_half_sizes(centers, halves)
                 .with_colors([BOX_VIOLET])
                 .with_fill_mode(FillMode::TransparentFillMajorWireframe);
-            send_at(rec, "levels/boxes", &times, &arch)?;
+            send("levels/boxes", &arch)?;
         }
         if let Some(b) = &w.obbs {
             let mut centers = Vec::with_capacity(interior.len());
@@ -187,19 +225,22 @@ pub(super) fn log_levels(
             .with_quaternions(rotations)
             .with_colors([OBB_VIOLET])
             .with_fill_mode(FillMode::TransparentFillMajorWireframe);
-            send_at(rec, "levels/obbs", &times, &arch)?;
+            send("levels/obbs", &arch)?;
         }
-        let tris = cut.iter().filter(|&&x| tree.is_leaf(x));
-        let tris = tris.flat_map(|&x| mesh.prim_tris(x)).copied().collect();
-        let leaves = if d == 0 {
-            rerun::Mesh3D::new(mesh.positions.iter().copied())
-                .with_vertex_normals(mesh.normals.iter().copied())
-                .with_albedo_factor(LEAF_ORANGE)
-        } else {
-            rerun::Mesh3D::update_fields()
+        let new_leaves = &leaves_by_depth[d as usize];
+        if !new_leaves.is_empty() {
+            let m = mesh.subset(new_leaves);
+            let arch = rerun::Mesh3D::new(m.positions.iter().copied())
+                .with_vertex_normals(m.normals.iter().copied())
+                .with_triangle_indices(nonempty(m.all_tris().to_vec()))
+                .with_albedo_factor(LEAF_ORANGE);
+            let leaf_times: Vec<_> = if in_preview {
+                [level].into_iter().chain(PREVIEW).collect()
+            } else {
+                vec![level]
+            };
+            send_at(rec, &format!("levels/leaves/{d}"), &leaf_times, &arch)?;
         }
-        .with_triangle_indices(nonempty(tris));
-        send_at(rec, "levels/leaves", &times, &leaves)?;
     }
     Ok(())
 }

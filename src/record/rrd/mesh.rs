@@ -14,6 +14,8 @@ pub(super) struct PrimMesh {
     pub(super) positions: Vec<[f32; 3]>,
     /// Unit vertex normals.
     pub(super) normals: Vec<[f32; 3]>,
+    /// Offsets into `positions` and `normals` per primitive, length N + 1.
+    vert_start: Vec<u32>,
     /// Offsets into `tris`, length N + 1.
     tri_start: Vec<u32>,
     /// Offsets into `positions`, length N + 1.
@@ -28,10 +30,12 @@ impl PrimMesh {
         let mut m = PrimMesh {
             positions: Vec::with_capacity(scene.vertex_refs()),
             normals: Vec::with_capacity(scene.vertex_refs()),
+            vert_start: Vec::with_capacity(scene.len() + 1),
             tri_start: Vec::with_capacity(scene.len() + 1),
             tris: Vec::with_capacity(scene.tris.len()),
             vert_start: Vec::with_capacity(scene.len() + 1),
         };
+        m.vert_start.push(0);
         m.tri_start.push(0);
         m.vert_start.push(0);
         let mut local: Vec<(u32, V3)> = Vec::new();
@@ -63,6 +67,32 @@ impl PrimMesh {
                 let n = if len > 0.0 { n / len } else { V3::z() };
                 m.normals.push([n.x as f32, n.y as f32, n.z as f32]);
             }
+            m.vert_start.push(m.positions.len() as u32);
+            m.tri_start.push(m.tris.len() as u32);
+        }
+        m
+    }
+
+    /// The mesh of the primitives `prims` alone: their vertices, normals and triangles, the
+    /// triangles indexing the returned vertices.
+    pub(super) fn subset(&self, prims: &[u32]) -> PrimMesh {
+        let mut m = PrimMesh {
+            positions: Vec::new(),
+            normals: Vec::new(),
+            vert_start: vec![0],
+            tri_start: vec![0],
+            tris: Vec::new(),
+        };
+        for &i in prims {
+            let (i, base) = (i as usize, m.positions.len() as u32);
+            let verts = self.vert_start[i] as usize..self.vert_start[i + 1] as usize;
+            let shift = base.wrapping_sub(self.vert_start[i]);
+            m.positions.extend_from_slice(&self.positions[verts.clone()]);
+            m.normals.extend_from_slice(&self.normals[verts]);
+            let tris = self.prim_tris(i as u32).iter();
+            m.tris
+                .extend(tris.map(|t| t.map(|v| v.wrapping_add(shift))));
+            m.vert_start.push(m.positions.len() as u32);
             m.tri_start.push(m.tris.len() as u32);
             m.vert_start.push(m.positions.len() as u32);
         }
