@@ -18,8 +18,6 @@ pub(super) struct PrimMesh {
     vert_start: Vec<u32>,
     /// Offsets into `tris`, length N + 1.
     tri_start: Vec<u32>,
-    /// Offsets into `positions`, length N + 1.
-    vert_start: Vec<u32>,
     /// Triangles as indices into `positions`.
     tris: Vec<[u32; 3]>,
 }
@@ -33,11 +31,9 @@ impl PrimMesh {
             vert_start: Vec::with_capacity(scene.len() + 1),
             tri_start: Vec::with_capacity(scene.len() + 1),
             tris: Vec::with_capacity(scene.tris.len()),
-            vert_start: Vec::with_capacity(scene.len() + 1),
         };
         m.vert_start.push(0);
         m.tri_start.push(0);
-        m.vert_start.push(0);
         let mut local: Vec<(u32, V3)> = Vec::new();
         for i in 0..scene.len() {
             let base = m.positions.len() as u32;
@@ -94,7 +90,6 @@ impl PrimMesh {
                 .extend(tris.map(|t| t.map(|v| v.wrapping_add(shift))));
             m.vert_start.push(m.positions.len() as u32);
             m.tri_start.push(m.tris.len() as u32);
-            m.vert_start.push(m.positions.len() as u32);
         }
         m
     }
