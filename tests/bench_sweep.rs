@@ -143,7 +143,13 @@ fn sweep_writes_every_setting_to_csv_heat_maps_and_one_rrd() {
         assert_png(&dir.path().join(format!("sweep-{stem}.png")));
     }
     let e = entities(&dir.path().join("sweep.rrd"));
-    for s in ["A0_B1_C0", "A0_B1_C2", "A1_B1_C0", "A1_B1_C2", "A1_B1_C0_area"] {
+    for s in [
+        "A0_B1_C0",
+        "A0_B1_C2",
+        "A1_B1_C0",
+        "A1_B1_C2",
+        "A1_B1_C0_area",
+    ] {
         assert!(e.contains(&format!("/sweep/{s}/cost")), "{s}: {e:?}");
     }
     assert!(

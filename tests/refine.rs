@@ -324,7 +324,7 @@ fn replay_verifies_a_refined_recording() {
         stdout.contains("the refinement's moves are identical"),
         "{stdout}"
     );
-    common::assert_rrd_verifies(&std::path::Path::new(&format!("{p}.rrd")));
+    common::assert_rrd_verifies(std::path::Path::new(&format!("{p}.rrd")));
 }
 
 #[test]
