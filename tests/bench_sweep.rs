@@ -130,14 +130,26 @@ fn sweep_writes_every_setting_to_csv_heat_maps_and_one_rrd() {
     let settings: Vec<String> = csv
         .lines()
         .skip(1)
-        .map(|l| l.split(',').take(3).collect::<Vec<_>>().join(","))
+        .map(|l| l.split(',').take(4).collect::<Vec<_>>().join(","))
         .collect();
-    assert_eq!(settings, ["0,1,0", "0,1,2", "1,1,0", "1,1,2"]);
+    // Both size measures of the Cost by default, the diameter first.
+    let abc = ["0,1,0", "0,1,2", "1,1,0", "1,1,2"];
+    let want: Vec<String> = ["diameter", "area"]
+        .iter()
+        .flat_map(|m| abc.iter().map(move |s| format!("{s},{m}")))
+        .collect();
+    assert_eq!(settings, want);
     for stem in ["depth", "sah", "query", "time"] {
         assert_png(&dir.path().join(format!("sweep-{stem}.png")));
     }
     let e = entities(&dir.path().join("sweep.rrd"));
-    for s in ["A0_B1_C0", "A0_B1_C2", "A1_B1_C0", "A1_B1_C2"] {
+    for s in [
+        "A0_B1_C0",
+        "A0_B1_C2",
+        "A1_B1_C0",
+        "A1_B1_C2",
+        "A1_B1_C0_area",
+    ] {
         assert!(e.contains(&format!("/sweep/{s}/cost")), "{s}: {e:?}");
     }
     assert!(

@@ -117,7 +117,8 @@ fn refined_trees_are_valid_and_no_worse_on_every_bundled_scene() {
 
 #[test]
 fn refinement_is_deterministic_and_thread_count_independent() {
-    let scene = generate::soup(3000, 7);
+    // Large enough that the first passes search in parallel (`reinsert::PARALLEL_MIN`).
+    let scene = generate::soup(30_000, 7);
     let g = group(&scene, &Params::default(), ());
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
@@ -323,7 +324,7 @@ fn replay_verifies_a_refined_recording() {
         stdout.contains("the refinement's moves are identical"),
         "{stdout}"
     );
-    common::assert_rrd_verifies(&std::path::Path::new(&format!("{p}.rrd")));
+    common::assert_rrd_verifies(std::path::Path::new(&format!("{p}.rrd")));
 }
 
 #[test]

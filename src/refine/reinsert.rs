@@ -94,14 +94,26 @@ pub fn find_best(
 }
 
 /// The best moves of `candidates` on the frozen tree `w`, in candidate order (searched in
-/// parallel; the result is the same for any number of threads).
+/// parallel; the result is the same for any number of threads). Batches under
+/// [`PARALLEL_MIN`] are searched on the calling thread, where handing work to rayon costs
+/// more than it saves.
 pub fn find_all(w: &WorkTree, candidates: &[u32], min_gain: f64) -> Vec<Move> {
+    if candidates.len() < PARALLEL_MIN {
+        let mut stack = Vec::new();
+        return candidates
+            .iter()
+            .filter_map(|&c| find_best(w, c, min_gain, &mut stack))
+            .collect();
+    }
     candidates
         .par_iter()
         .map_init(Vec::new, |stack, &c| find_best(w, c, min_gain, stack))
         .flatten_iter()
         .collect()
 }
+
+/// Fewest candidates searched in parallel.
+pub const PARALLEL_MIN: usize = 2048;
 
 /// Orders moves best first: larger gain, then smaller node id.
 pub fn sort_best_first(moves: &mut [Move]) {

@@ -103,15 +103,18 @@ impl WorkTree {
         self.parent[new as usize] = p;
     }
 
-    /// Recomputes the boxes from `x` up to the root, stopping where a box is unchanged, and
-    /// keeps [`WorkTree::interior`] in step.
+    /// Recomputes the boxes from `x` up to the root, stopping above `x` where a box is
+    /// unchanged, and keeps [`WorkTree::interior`] in step. `x` itself never stops the walk:
+    /// after a move its parent may be new, and that parent's stored box did not cover it.
     fn refit(&mut self, mut x: u32) {
+        let mut first = true;
         while x != NONE {
             let [a, b] = self.kids(x);
             let bx = self.aabb[a as usize].merge(&self.aabb[b as usize]);
-            if bx == self.aabb[x as usize] {
+            if bx == self.aabb[x as usize] && !first {
                 return;
             }
+            first = false;
             let ar = area(&bx);
             self.interior += ar - self.area[x as usize];
             self.aabb[x as usize] = bx;
