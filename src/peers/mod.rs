@@ -4,9 +4,10 @@
 //!
 //! - [`Method::Grouping`], [`Method::GroupingHull`]: the paper's grouping phase (§2.2) with AABB
 //!   or convex-hull p-sets;
-//! - [`Method::GroupingPregroup`], [`Method::GroupingInstanced`]: the same with the paper's
-//!   §1.3 speed-ups ([`crate::grouping::pregroup`]): connected components grouped first, in
-//!   parallel on the current rayon pool, and rigid copies copy-moved;
+//! - [`Method::GroupingPregroup`], [`Method::GroupingInstanced`], [`Method::GroupingObjects`]:
+//!   the same with the paper's §1.3 speed-ups ([`crate::grouping::pregroup`]): connected
+//!   components (or the scene's objects) grouped first, in parallel on the current rayon
+//!   pool, and rigid copies copy-moved;
 //! - [`parry_bvh`]: parry3d's `Bvh`, binned SAH or PLOC, as published;
 //! - [`obvhs_ploc`]: obvhs's PLOC, with or without its reinsertion optimiser, as published;
 //! - [`median_split`]: a top-down median split;
@@ -41,6 +42,8 @@ pub enum Method {
     GroupingPregroup,
     /// The grouping phase with connected components pre-grouped and rigid copies copy-moved.
     GroupingInstanced,
+    /// The grouping phase with the scene's objects pre-grouped and rigid copies copy-moved.
+    GroupingObjects,
     /// parry3d `Bvh`, binned SAH strategy.
     ParryBinned,
     /// parry3d `Bvh`, PLOC strategy.
@@ -57,11 +60,12 @@ pub enum Method {
 
 impl Method {
     /// Every method, ours first.
-    pub const ALL: [Method; 10] = [
+    pub const ALL: [Method; 11] = [
         Method::Grouping,
         Method::GroupingHull,
         Method::GroupingPregroup,
         Method::GroupingInstanced,
+        Method::GroupingObjects,
         Method::ParryBinned,
         Method::ParryPloc,
         Method::ObvhsPloc,
@@ -77,6 +81,7 @@ impl Method {
             Method::GroupingHull => "grouping-hull",
             Method::GroupingPregroup => "grouping-pregroup",
             Method::GroupingInstanced => "grouping-instanced",
+            Method::GroupingObjects => "grouping-objects",
             Method::ParryBinned => "parry-binned",
             Method::ParryPloc => "parry-ploc",
             Method::ObvhsPloc => "obvhs-ploc",
@@ -105,6 +110,7 @@ impl Method {
                 | Method::GroupingHull
                 | Method::GroupingPregroup
                 | Method::GroupingInstanced
+                | Method::GroupingObjects
         )
     }
 }
@@ -141,11 +147,17 @@ pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, St
             },
             ..params.clone()
         };
-        if matches!(method, Method::GroupingPregroup | Method::GroupingInstanced) {
+        let (pregroup, instancing) = match method {
+            Method::GroupingPregroup => (Pregroup::Connected, false),
+            Method::GroupingInstanced => (Pregroup::Connected, true),
+            Method::GroupingObjects => (Pregroup::Objects, true),
+            _ => (p.mode.pregroup, p.mode.instancing),
+        };
+        if pregroup != Pregroup::None {
             p.pset = PSet::Aabb;
-            p.mode.pregroup = Pregroup::Connected;
-            p.mode.instancing = method == Method::GroupingInstanced;
         }
+        p.mode.pregroup = pregroup;
+        p.mode.instancing = instancing;
         let g = grouping::group(scene, &p, ());
         let seconds = t.elapsed().as_secs_f64();
         return Ok(done(g.tree, Some(g.stats), seconds));
@@ -189,7 +201,8 @@ pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, St
         Method::Grouping
         | Method::GroupingHull
         | Method::GroupingPregroup
-        | Method::GroupingInstanced => unreachable!("handled above"),
+        | Method::GroupingInstanced
+        | Method::GroupingObjects => unreachable!("handled above"),
     };
     let tree = topology::subset_tree(scene, &nodes, root)
         .map_err(|e| format!("{}: malformed tree: {e}", method.name()))?;
