@@ -213,7 +213,7 @@ fn replicas_are_found_as_objects_and_as_copies() {
     // Per base: cylinder, washer, boss, six bolt heads (copies of one another) and the box.
     assert_eq!((r.components, r.parts, r.loose), (40, 40, 0));
     assert_eq!((r.classes, r.copies), (5, 35));
-    assert!(MIN_PART <= 6, "the 6-face box is a part");
+    const { assert!(MIN_PART <= 6, "the 6-face box is a part") };
 }
 
 #[test]
