@@ -4,9 +4,10 @@
 //!
 //! - [`Method::Grouping`], [`Method::GroupingHull`]: the paper's grouping phase (§2.2) with AABB
 //!   or convex-hull p-sets;
-//! - [`Method::GroupingPregroup`], [`Method::GroupingInstanced`]: the same with the paper's
-//!   §1.3 speed-ups ([`crate::grouping::pregroup`]): connected components grouped first, in
-//!   parallel on the current rayon pool, and rigid copies copy-moved;
+//! - [`Method::GroupingPregroup`], [`Method::GroupingInstanced`], [`Method::GroupingObjects`]:
+//!   the same with the paper's §1.3 speed-ups ([`crate::grouping::pregroup`]): connected
+//!   components (or the scene's objects) grouped first, in parallel on the current rayon
+//!   pool, and rigid copies copy-moved;
 //! - [`parry_bvh`]: parry3d's `Bvh`, binned SAH or PLOC, as published;
 //! - [`obvhs_ploc`]: obvhs's PLOC, with or without its reinsertion optimiser, as published;
 //! - [`median_split`]: a top-down median split;
@@ -46,6 +47,8 @@ pub enum Method {
     GroupingPregroup,
     /// The grouping phase with connected components pre-grouped and rigid copies copy-moved.
     GroupingInstanced,
+    /// The grouping phase with the scene's objects pre-grouped and rigid copies copy-moved.
+    GroupingObjects,
     /// parry3d `Bvh`, binned SAH strategy.
     ParryBinned,
     /// parry3d `Bvh`, PLOC strategy.
@@ -68,12 +71,13 @@ pub enum Method {
 
 impl Method {
     /// Every method, ours first.
-    pub const ALL: [Method; 13] = [
+    pub const ALL: [Method; 14] = [
         Method::Grouping,
         Method::GroupingRefine,
         Method::GroupingHull,
         Method::GroupingPregroup,
         Method::GroupingInstanced,
+        Method::GroupingObjects,
         Method::ParryBinned,
         Method::ParryPloc,
         Method::ObvhsPloc,
@@ -91,6 +95,7 @@ impl Method {
             Method::GroupingHull => "grouping-hull",
             Method::GroupingPregroup => "grouping-pregroup",
             Method::GroupingInstanced => "grouping-instanced",
+            Method::GroupingObjects => "grouping-objects",
             Method::ParryBinned => "parry-binned",
             Method::ParryPloc => "parry-ploc",
             Method::ObvhsPloc => "obvhs-ploc",
@@ -123,6 +128,7 @@ impl Method {
                 | Method::GroupingRefine
                 | Method::GroupingPregroup
                 | Method::GroupingInstanced
+                | Method::GroupingObjects
         )
     }
 
@@ -192,11 +198,17 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
             },
             ..params.clone()
         };
-        if matches!(method, Method::GroupingPregroup | Method::GroupingInstanced) {
+        let (pregroup, instancing) = match method {
+            Method::GroupingPregroup => (Pregroup::Connected, false),
+            Method::GroupingInstanced => (Pregroup::Connected, true),
+            Method::GroupingObjects => (Pregroup::Objects, true),
+            _ => (p.mode.pregroup, p.mode.instancing),
+        };
+        if pregroup != Pregroup::None {
             p.pset = PSet::Aabb;
-            p.mode.pregroup = Pregroup::Connected;
-            p.mode.instancing = method == Method::GroupingInstanced;
         }
+        p.mode.pregroup = pregroup;
+        p.mode.instancing = instancing;
         let g = grouping::group(scene, &p, ());
         let seconds = t.elapsed().as_secs_f64();
         return Ok(done(g.tree, Some(g.stats), seconds));
@@ -240,7 +252,8 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
         Method::Grouping
         | Method::GroupingHull
         | Method::GroupingPregroup
-        | Method::GroupingInstanced => unreachable!("handled above"),
+        | Method::GroupingInstanced
+        | Method::GroupingObjects => unreachable!("handled above"),
         Method::GroupingRefine | Method::ParryBinnedRefine | Method::ObvhsPlocRefine => {
             unreachable!("refined methods are built from their base")
         }

@@ -2,11 +2,12 @@
 //! on their own before the top level.
 //!
 //! - [`connected`]: primitives joined by shared boundary, i.e. sharing a vertex after welding
-//!   vertices that lie within [`WELD_TOLERANCE`] × the scene's AABB diagonal of each other (L∞).
-//!   Welding uses a hash grid of positions quantised to cells of 64 tolerances: a vertex is
-//!   compared with the vertices of its cell and of the neighbouring cells it is within the
-//!   tolerance of, and close pairs are joined in a union-find; each primitive then joins its
-//!   vertices. O(V + N) expected (vertices piled up in one cell compare pairwise).
+//!   vertices that lie within [`WELD_TOLERANCE`] × the diagonal of the box of the scene's
+//!   points of each other (L∞).
+//!   Welding sorts vertices by a grid cell of 64 tolerances: a vertex is compared with the
+//!   vertices of its cell and of the neighbouring cells it is within the tolerance of, and
+//!   close pairs are joined in a union-find; each primitive then joins its vertices.
+//!   O(V log V) (vertices piled up in one cell compare pairwise).
 //! - [`objects`]: the scene's own objects ([`Scene::objects`], the OBJ `o`/`g` groups).
 //!
 //! Both are deterministic: components are numbered in order of their smallest primitive, and
@@ -51,15 +52,33 @@ impl Components {
     /// Numbers the classes of `label` (any per-primitive key) in order of their smallest
     /// primitive.
     fn from_labels(label: &[u32]) -> Components {
-        let mut id: HashMap<u32, u32> = HashMap::default();
+        // Labels are point indices or object ids: a dense table when they are small enough.
+        let max = label.iter().copied().max().unwrap_or(0) as usize;
+        let mut dense = vec![
+            u32::MAX;
+            if max < 4 * label.len() + 1024 {
+                max + 1
+            } else {
+                0
+            }
+        ];
+        let mut sparse: HashMap<u32, u32> = HashMap::default();
+        let mut k = 0u32;
         let of: Vec<u32> = label
             .iter()
             .map(|&l| {
-                let next = id.len() as u32;
-                *id.entry(l).or_insert(next)
+                let slot = match dense.get_mut(l as usize) {
+                    Some(slot) => slot,
+                    None => sparse.entry(l).or_insert(u32::MAX),
+                };
+                if *slot == u32::MAX {
+                    *slot = k;
+                    k += 1;
+                }
+                *slot
             })
             .collect();
-        let k = id.len();
+        let k = k as usize;
         let mut start = vec![0u32; k + 1];
         for &c in &of {
             start[c as usize + 1] += 1;
@@ -111,9 +130,10 @@ pub fn connected(scene: &Scene) -> Components {
     let n = scene.len();
     let np = scene.points.len();
     let mut uf = UnionFind((0..np as u32).collect());
-    let tol = WELD_TOLERANCE * scene.aabb().diameter();
+    let bounds = crate::geom::Aabb::from_points(&scene.points);
+    let tol = WELD_TOLERANCE * bounds.diameter();
     if tol.is_finite() && tol > 0.0 {
-        weld(scene, tol, &mut uf);
+        weld(scene, &bounds.min, tol, &mut uf);
     }
     for i in 0..n {
         for w in scene.prim(i).windows(2) {
@@ -133,12 +153,14 @@ pub fn connected(scene: &Scene) -> Components {
 
 /// Joins in `uf` the vertices (used by primitives) within `tol` (L∞) of each other.
 ///
-/// Cells have edge [`CELL_TOLERANCES`] × `tol`, so a vertex is compared with the vertices of
-/// its own cell and, only when it lies within `tol` of a cell face, of the cells beyond that
-/// face: about 1.1 cell visits per vertex instead of 27. Each cell's vertices are a linked list
-/// through `next`.
-fn weld(scene: &Scene, tol: f64, uf: &mut UnionFind) {
-    const NIL: u32 = u32::MAX;
+/// Cells have edge [`CELL_TOLERANCES`] × `tol`; vertices are sorted by their packed cell key
+/// (21 bits per axis; keys that wrap around only bring far vertices together, which the
+/// distance test rejects). A vertex is compared with the later vertices of its own cell and,
+/// only when it lies within `tol` of a cell face, with the vertices of the cells beyond that
+/// face (found by binary search): about 1.1 cell visits per vertex instead of 27, and no hash
+/// table.
+fn weld(scene: &Scene, min: &crate::geom::P3, tol: f64, uf: &mut UnionFind) {
+    const MASK: u64 = (1 << 21) - 1;
     let np = scene.points.len();
     let h = CELL_TOLERANCES * tol;
     let inv = 1.0 / h;
@@ -146,26 +168,31 @@ fn weld(scene: &Scene, tol: f64, uf: &mut UnionFind) {
     for &v in &scene.prim_points {
         used[v as usize] = true;
     }
-    let cell = |p: &crate::geom::P3| [p.x, p.y, p.z].map(|c| (c * inv).floor() as i64);
-    let mut head: HashMap<[i64; 3], u32> = HashMap::default();
-    head.reserve(np);
-    let mut next = vec![NIL; np];
-    for (v, p) in scene.points.iter().enumerate() {
-        if used[v] {
-            next[v] = head.insert(cell(p), v as u32).unwrap_or(NIL);
+    // Offsets from the lower corner are ≥ 0, so truncation is the floor.
+    let cell = |p: &crate::geom::P3| [0, 1, 2].map(|a| ((p[a] - min[a]) * inv) as i64);
+    let pack = |k: [i64; 3]| {
+        (k[0] as u64 & MASK) | ((k[1] as u64 & MASK) << 21) | ((k[2] as u64 & MASK) << 42)
+    };
+    let mut order: Vec<(u64, u32)> = (0..np)
+        .filter(|&v| used[v])
+        .map(|v| (pack(cell(&scene.points[v])), v as u32))
+        .collect();
+    order.sort_unstable();
+    let close =
+        |v: u32, w: u32| (scene.points[w as usize] - scene.points[v as usize]).amax() <= tol;
+    for (i, &(key, v)) in order.iter().enumerate() {
+        for &(_, w) in order[i + 1..].iter().take_while(|e| e.0 == key) {
+            if close(v, w) {
+                uf.union(v, w);
+            }
         }
-    }
-    let mut offsets: Vec<[i64; 3]> = Vec::with_capacity(27);
-    for (v, p) in scene.points.iter().enumerate() {
-        if !used[v] {
-            continue;
-        }
+        let p = &scene.points[v as usize];
         let k = cell(p);
         // The neighbouring cells this vertex can reach within `tol`, per axis.
         let mut axis = [[0i64; 3]; 3];
         let mut len = [1usize; 3];
         for a in 0..3 {
-            let lo = k[a] as f64 * h;
+            let lo = min[a] + k[a] as f64 * h;
             if p[a] - lo <= tol {
                 axis[a][len[a]] = -1;
                 len[a] += 1;
@@ -175,22 +202,24 @@ fn weld(scene: &Scene, tol: f64, uf: &mut UnionFind) {
                 len[a] += 1;
             }
         }
-        offsets.clear();
+        if len == [1; 3] {
+            continue;
+        }
         for &dx in &axis[0][..len[0]] {
             for &dy in &axis[1][..len[1]] {
                 for &dz in &axis[2][..len[2]] {
-                    offsets.push([k[0] + dx, k[1] + dy, k[2] + dz]);
+                    let nk = pack([k[0] + dx, k[1] + dy, k[2] + dz]);
+                    if nk == key {
+                        continue;
+                    }
+                    let from = order.partition_point(|e| e.0 < nk);
+                    for &(_, w) in order[from..].iter().take_while(|e| e.0 == nk) {
+                        // Each close pair across a face is found from both ends; join it once.
+                        if w > v && close(v, w) {
+                            uf.union(v, w);
+                        }
+                    }
                 }
-            }
-        }
-        for c in &offsets {
-            let mut w = head.get(c).copied().unwrap_or(NIL);
-            while w != NIL {
-                // Each close pair is found from both ends; join it once.
-                if w > v as u32 && (scene.points[w as usize] - p).amax() <= tol {
-                    uf.union(v as u32, w);
-                }
-                w = next[w as usize];
             }
         }
     }

@@ -6,21 +6,24 @@
 //!    in increasing order, the same vertex-index pattern (each primitive's vertices numbered by
 //!    first appearance within the part), so their vertices correspond one to one; and
 //! 2. one proper rotation R (det R = +1) and translation t map every vertex of `p` onto the
-//!    corresponding vertex of `q` within [`COPY_TOLERANCE`] × `p`'s AABB diagonal (Euclidean).
+//!    corresponding vertex of `q` within [`COPY_TOLERANCE`] × `p`'s radius (the largest
+//!    distance of its vertices from their centroid, which a rotation does not change).
 //!    R and t are the least-squares fit (Kabsch) over the corresponding vertices; a mirror
 //!    image needs det R = −1 and is not a copy.
 //!
-//! Every part is compared with the representatives found before it with the same structure,
-//! in part order, and copies the first that fits; a part that fits none is a new
-//! representative. The result does not depend on thread count.
+//! Every part is compared with the representatives found before it with the same structure
+//! and a radius of gyration within reach ([`find`]), in order of that radius and then of
+//! discovery, and copies the first that fits; a part that fits none is a new representative.
+//! The search is sequential and its result does not depend on the thread count.
 
 use crate::geom::{P3, V3};
 use crate::scene::Scene;
 use crate::scene::components::Components;
 use foldhash::HashMap;
 use nalgebra::Matrix3;
+use std::collections::BTreeSet;
 
-/// Largest vertex misfit of a copy, as a fraction of the representative's AABB diagonal.
+/// Largest vertex misfit of a copy, as a fraction of the representative's radius.
 pub const COPY_TOLERANCE: f64 = 1e-6;
 
 /// How a part copies its representative.
@@ -84,30 +87,70 @@ pub fn kabsch(a: &[P3], b: &[P3]) -> (Matrix3<f64>, V3, f64) {
     (r, t, misfit)
 }
 
+/// The radius of gyration of `points` (root mean square distance from their centroid) and
+/// their largest distance from it: both unchanged by a rigid motion.
+fn radii(points: &[P3]) -> (f64, f64) {
+    let k = points.len().max(1) as f64;
+    let c = points.iter().fold(V3::zeros(), |s, p| s + p.coords) / k;
+    let (mut sq, mut max) = (0.0, 0.0f64);
+    for p in points {
+        let d2 = (p.coords - c).norm_squared();
+        sq += d2;
+        max = max.max(d2);
+    }
+    ((sq / k).sqrt(), max.sqrt())
+}
+
+/// A representative: its part index, points and radius.
+struct Rep {
+    part: usize,
+    points: Vec<P3>,
+    radius: f64,
+}
+
 /// For each part (component indices `parts` of `comps`), the part it copies, if any.
+///
+/// Candidates are narrowed before Kabsch by the radius of gyration g: a copy within tolerance
+/// τ moves every vertex by at most τ, so g moves by at most 2τ. Representatives of one
+/// structure are kept ordered by g, and only those within that window are fitted, so a scene
+/// of thousands of distinct pieces of one structure (a soup of triangle pairs) costs
+/// O(P log P), not O(P²).
 pub(super) fn find(scene: &Scene, comps: &Components, parts: &[u32]) -> Vec<Option<CopyOf>> {
     let mut out = vec![None; parts.len()];
-    // Representatives (part index, their points) by structure key.
-    let mut reps: HashMap<Vec<u32>, Vec<(usize, Vec<P3>)>> = HashMap::default();
-    let mut points = Vec::new();
+    let mut reps: Vec<Rep> = Vec::new();
+    // Representatives by structure key, ordered by (g bits, index into `reps`).
+    let mut by_key: HashMap<Vec<u32>, BTreeSet<(u64, u32)>> = HashMap::default();
     let mut local = vec![u32::MAX; scene.points.len()];
     for (j, &c) in parts.iter().enumerate() {
         let (verts, key) = structure(scene, comps.get(c as usize), &mut local);
-        points.clear();
-        points.extend(verts.iter().map(|&v| scene.points[v as usize]));
-        let list = reps.entry(key).or_default();
-        let found = list.iter().find_map(|(r, rp)| {
-            let tol = COPY_TOLERANCE * crate::geom::Aabb::from_points(rp.iter()).diameter();
-            let (rotation, translation, misfit) = kabsch(rp, &points);
+        let points: Vec<P3> = verts.iter().map(|&v| scene.points[v as usize]).collect();
+        let (g, radius) = radii(&points);
+        let set = by_key.entry(key).or_default();
+        // Every representative whose tolerance could admit this part: τ ≤ COPY_TOLERANCE ×
+        // its radius ≤ COPY_TOLERANCE × (radius + 2τ).
+        let window = 2.0 * COPY_TOLERANCE * (radius * 1.01) + f64::MIN_POSITIVE;
+        let lo = (g - window).max(0.0).to_bits();
+        let hi = (g + window).to_bits();
+        let found = set.range((lo, 0)..=(hi, u32::MAX)).find_map(|&(_, r)| {
+            let rep = &reps[r as usize];
+            let tol = COPY_TOLERANCE * rep.radius;
+            let (rotation, translation, misfit) = kabsch(&rep.points, &points);
             (misfit <= tol && rotation.determinant() > 0.0).then_some(CopyOf {
-                of: *r,
+                of: rep.part,
                 rotation,
                 translation,
             })
         });
         match found {
             Some(copy) => out[j] = Some(copy),
-            None => list.push((j, points.clone())),
+            None => {
+                set.insert((g.to_bits(), reps.len() as u32));
+                reps.push(Rep {
+                    part: j,
+                    points,
+                    radius,
+                });
+            }
         }
     }
     out
