@@ -39,6 +39,7 @@ mod cluster;
 pub mod events;
 mod hull_pset;
 pub mod mpairs;
+pub mod partitioned;
 pub mod subset_tree;
 pub mod voxel_hash;
 
@@ -490,5 +491,8 @@ fn run<O: Observer>(
     observer: O,
     budget: &Budget<'_>,
 ) -> Result<Grouping, Stopped> {
-    cluster::run(scene, params, observer, budget)
+    match params.mode.schedule {
+        Schedule::Exact => cluster::run(scene, params, observer, budget),
+        Schedule::Partitioned => partitioned::run(scene, params, observer, budget),
+    }
 }
