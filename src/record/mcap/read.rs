@@ -5,10 +5,10 @@
 //! data-section and summary CRC checks and a record length limit), so truncated or corrupted
 //! files give an error, never a panic, and no index offset from the file is trusted.
 
-use super::messages::{DormantEvent, FinishEvent, MergeEvent, RoundEvent};
+use super::messages::{DormantEvent, FinishEvent, MergeEvent, PartEvent, RoundEvent};
 use super::metadata;
 use crate::geom::Aabb;
-use crate::grouping::{EventLog, Merge, ResolvedParams, SubsetTree};
+use crate::grouping::{EventLog, Merge, Part, ResolvedParams, SubsetTree};
 use crate::record::Detail;
 use crate::scene::{LoadOptions, Scene};
 use anyhow::{Result, anyhow, bail};
@@ -53,6 +53,8 @@ pub struct Recorded {
     pub dormant: Vec<(u32, u32)>,
     /// Root body id, once finished.
     pub root: Option<u32>,
+    /// Every part announced, in order (runs with parts: partitioned, pre-grouped).
+    pub parts: Vec<Part>,
 }
 
 impl Recorded {
@@ -77,6 +79,7 @@ impl Recorded {
             dormant: self.dormant.clone(),
             doublings: self.doublings.clone(),
             root: self.root,
+            parts: self.parts.clone(),
         }
     }
 }
@@ -92,6 +95,7 @@ struct Raw {
     rounds: Vec<RoundEvent>,
     dormant: Vec<DormantEvent>,
     finish: Option<FinishEvent>,
+    parts: Vec<Part>,
 }
 
 /// The schema each decoded topic must carry.
@@ -100,6 +104,7 @@ const TYPED_TOPICS: &[(&str, &str)] = &[
     ("/grouping/round", "roundevent.RoundEvent"),
     ("/grouping/dormant", "dormantevent.DormantEvent"),
     ("/grouping/finish", "finishevent.FinishEvent"),
+    ("/grouping/part", "partevent.PartEvent"),
 ];
 
 impl Raw {
@@ -123,6 +128,10 @@ impl Raw {
                 .push(Merge::from(&MergeEvent::decode(data).map_err(bad)?)),
             "/grouping/round" => self.rounds.push(RoundEvent::decode(data).map_err(bad)?),
             "/grouping/dormant" => self.dormant.push(DormantEvent::decode(data).map_err(bad)?),
+            "/grouping/part" => {
+                let e = PartEvent::decode(data).map_err(bad)?;
+                self.parts.push(Part::try_from(&e).map_err(bad)?);
+            }
             _ => self.finish = Some(FinishEvent::decode(data).map_err(bad)?),
         }
         Ok(())
@@ -293,6 +302,7 @@ fn interpret(raw: Raw) -> Result<Recorded> {
             .collect(),
         dormant: raw.dormant.iter().map(|d| (d.round, d.body)).collect(),
         root: raw.finish.map(|f| f.root),
+        parts: raw.parts,
         metadata: m,
         timing,
     })
