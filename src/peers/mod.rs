@@ -3,7 +3,8 @@
 //! ([`crate::query`]) measure every hierarchy the same way.
 //!
 //! - [`Method::Grouping`], [`Method::GroupingHull`]: the paper's grouping phase (§2.2) with AABB
-//!   or convex-hull p-sets;
+//!   or convex-hull p-sets; [`Method::GroupingPartitioned`]: the same step in the partitioned
+//!   schedule ([`crate::grouping::partitioned`]);
 //! - [`parry_bvh`]: parry3d's `Bvh`, binned SAH or PLOC, as published;
 //! - [`obvhs_ploc`]: obvhs's PLOC, with or without its reinsertion optimiser, as published;
 //! - [`median_split`]: a top-down median split;
@@ -12,7 +13,8 @@
 //! A peer's reported time covers its own build only, from primitive boxes (`f32` relative to the
 //! scene centre for parry and obvhs, `f64` for ours) to its native tree; reading its topology
 //! into a Subset Tree ([`topology`]) is not timed. Box computation per primitive is shared and
-//! not timed either. Every method is single-threaded.
+//! not timed either. The partitioned grouping and obvhs PLOC (built with its `parallel` feature)
+//! use the current rayon pool; every other method is single-threaded.
 
 pub mod goldsmith_salmon;
 pub mod median_split;
@@ -20,7 +22,7 @@ pub mod obvhs_ploc;
 pub mod parry_bvh;
 pub mod topology;
 
-use crate::grouping::{self, PSet, Params, Stats, SubsetTree};
+use crate::grouping::{self, PSet, Params, Schedule, Stats, SubsetTree};
 use crate::scene::Scene;
 use parry3d::partitioning::BvhBuildStrategy;
 use std::time::Instant;
@@ -32,6 +34,8 @@ pub enum Method {
     Grouping,
     /// The grouping phase with convex-hull p-sets.
     GroupingHull,
+    /// The grouping phase in the partitioned schedule (AABB p-sets).
+    GroupingPartitioned,
     /// parry3d `Bvh`, binned SAH strategy.
     ParryBinned,
     /// parry3d `Bvh`, PLOC strategy.
@@ -48,9 +52,10 @@ pub enum Method {
 
 impl Method {
     /// Every method, ours first.
-    pub const ALL: [Method; 8] = [
+    pub const ALL: [Method; 9] = [
         Method::Grouping,
         Method::GroupingHull,
+        Method::GroupingPartitioned,
         Method::ParryBinned,
         Method::ParryPloc,
         Method::ObvhsPloc,
@@ -64,6 +69,7 @@ impl Method {
         match self {
             Method::Grouping => "grouping",
             Method::GroupingHull => "grouping-hull",
+            Method::GroupingPartitioned => "grouping-partitioned",
             Method::ParryBinned => "parry-binned",
             Method::ParryPloc => "parry-ploc",
             Method::ObvhsPloc => "obvhs-ploc",
@@ -86,7 +92,10 @@ impl Method {
 
     /// Whether this is the paper's grouping phase.
     pub fn is_grouping(self) -> bool {
-        matches!(self, Method::Grouping | Method::GroupingHull)
+        matches!(
+            self,
+            Method::Grouping | Method::GroupingHull | Method::GroupingPartitioned
+        )
     }
 }
 
@@ -114,7 +123,7 @@ pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, St
         stats,
     };
     if method.is_grouping() {
-        let p = Params {
+        let mut p = Params {
             pset: if method == Method::GroupingHull {
                 PSet::Hull
             } else {
@@ -122,6 +131,10 @@ pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, St
             },
             ..params.clone()
         };
+        if method == Method::GroupingPartitioned {
+            p.pset = PSet::Aabb;
+            p.mode.schedule = Schedule::Partitioned;
+        }
         let g = grouping::group(scene, &p, ());
         let seconds = t.elapsed().as_secs_f64();
         return Ok(done(g.tree, Some(g.stats), seconds));
@@ -162,7 +175,9 @@ pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, St
             let (nodes, root) = goldsmith_salmon::build(&boxes);
             (nodes, root, t.elapsed().as_secs_f64())
         }
-        Method::Grouping | Method::GroupingHull => unreachable!("handled above"),
+        Method::Grouping | Method::GroupingHull | Method::GroupingPartitioned => {
+            unreachable!("handled above")
+        }
     };
     let tree = topology::subset_tree(scene, &nodes, root)
         .map_err(|e| format!("{}: malformed tree: {e}", method.name()))?;
