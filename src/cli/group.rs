@@ -130,6 +130,7 @@ impl GroupCmd {
     pub fn run(self) -> Result<ExitCode> {
         let loaded = self.scene.load()?;
         let params = self.group.params()?;
+        let threads = self.group.threads()?;
         self.limits.check()?;
         let scene = &loaded.scene;
         let start = Instant::now();
@@ -164,6 +165,7 @@ impl GroupCmd {
                 "depth_max": t.depth_max(),
                 "depth_mean": t.depth_mean(),
                 "seconds": seconds,
+                "threads": threads,
                 "params": g.params,
                 "stats": g.stats,
                 "pregrouping": g.pregrouping,
@@ -181,6 +183,11 @@ impl GroupCmd {
                 g.params.dlimit0,
                 g.params.glimit0,
                 g.params.pset
+            );
+            println!(
+                "schedule    {:?} on {threads} thread{}",
+                g.params.mode.schedule,
+                if threads == 1 { "" } else { "s" }
             );
             if let Some(p) = &g.pregrouping {
                 println!("{}", pregrouping_lines(p));

@@ -1,6 +1,7 @@
 //! Argument definitions and dispatch for every subcommand.
 
 mod bench;
+mod bench_partitioned;
 mod cover;
 mod group;
 mod record;
@@ -137,11 +138,32 @@ pub struct GroupArgs {
     /// Size measure in the Cost: diameter (the paper's) or area (surface area of the box).
     #[arg(long, value_enum, default_value_t = CostMeasure::Diameter)]
     pub cost: CostMeasure,
+    /// Threads for the parallel steps (partitioned chunks, the exact run's round-start scans);
+    /// the tree is the same for any count [default: all cores].
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
 }
 
 impl GroupArgs {
-    /// Checks the values and turns them into [`Params`].
+    /// Builds the global rayon pool with `--threads` threads (once per process; later calls
+    /// keep the first pool) and returns the number of threads it has.
+    pub fn threads(&self) -> Result<usize> {
+        if self.threads == Some(0) {
+            anyhow::bail!("--threads must be at least 1, got 0");
+        }
+        let mut pool = rayon::ThreadPoolBuilder::new();
+        if let Some(n) = self.threads {
+            pool = pool.num_threads(n);
+        }
+        // Fails only when a pool exists already: that pool is then the one used.
+        let _ = pool.build_global();
+        Ok(rayon::current_num_threads())
+    }
+
+    /// Checks the values (building the thread pool, see [`GroupArgs::threads`]) and turns them
+    /// into [`Params`].
     pub fn params(&self) -> Result<Params> {
+        self.threads()?;
         let weights = Weights {
             a: self.a,
             b: self.b,

@@ -251,6 +251,22 @@ impl ReplayCmd {
                     return Ok(BudgetArgs::exit_code(s.reason));
                 }
             };
+            let k = rec.parts.len();
+            if log.parts.get(..k) != Some(&rec.parts[..]) || (rec.complete && log.parts.len() != k)
+            {
+                let i = (0..k)
+                    .find(|&i| log.parts.get(i) != Some(&rec.parts[i]))
+                    .unwrap_or(k);
+                let show = |p: Option<&wraptree::grouping::Part>| {
+                    p.map_or("none".to_string(), |p| p.to_string())
+                };
+                eprintln!(
+                    "error: {name}: --verify: part {i} differs: recorded {}, re-run {}",
+                    show(rec.parts.get(i)),
+                    show(log.parts.get(i))
+                );
+                return Ok(ExitCode::FAILURE);
+            }
             match first_divergence(&rec.merges, &log.merges) {
                 None if !rec.complete => println!(
                     "verified: the {0} recorded merges match the re-run's first {0} (the recording stopped there)",

@@ -15,7 +15,7 @@ use std::sync::atomic::Ordering;
 mod keys;
 mod scan;
 
-use keys::{spread_bits, tie_tag};
+pub(in crate::grouping) use keys::{spread_bits, tie_tag};
 
 /// What the round loop needs from a p-set wrapper beyond each body's AABB and diameter.
 pub(super) trait PSetBodies {
@@ -80,6 +80,59 @@ pub(crate) fn run_boxes<O: Observer>(
     Clusterer::new(boxes, params, AabbBodies, diameters, observer).run(budget)
 }
 
+/// What [`run_boxes_until`] leaves: the merges made (local ids, as in [`run_boxes`]) and the
+/// bodies still without a parent.
+pub(crate) struct Partial {
+    /// Children of each new body, in merge order (new body `i` has local id `boxes.len() + i`).
+    pub children: Vec<[u32; 2]>,
+    /// Box of each new body, in merge order.
+    pub aabb: Vec<Aabb>,
+    /// Diameter of each new body, in merge order.
+    pub diameter: Vec<f64>,
+    /// Local ids of the bodies left without a parent, in increasing order.
+    pub roots: Vec<u32>,
+    /// Rounds run.
+    pub rounds: u32,
+    /// Work counters.
+    pub stats: Stats,
+}
+
+/// Like [`run_boxes`], but stops as soon as only `keep` (≥ 1) parent-less bodies remain, and
+/// breaks ties by the tags of the ids `tag_id(local id)` (so a subproblem whose local ids map
+/// increasingly onto a larger run's ids breaks ties as that run would). No `Finish` event.
+pub(crate) fn run_boxes_until<O: Observer>(
+    boxes: Vec<Aabb>,
+    keep: usize,
+    tag_id: impl Fn(u32) -> u32,
+    params: &ResolvedParams,
+    observer: O,
+    budget: &Budget<'_>,
+) -> Result<Partial, Stopped> {
+    assert!(
+        keep >= 1 && keep <= boxes.len(),
+        "keep must be in 1..=bodies"
+    );
+    let n = boxes.len();
+    let diameters = boxes.iter().map(Aabb::diameter).collect();
+    let mut c = Clusterer::new(boxes, params, AabbBodies, diameters, observer);
+    c.keep = keep;
+    for (i, t) in c.tag.iter_mut().enumerate() {
+        *t = tie_tag(params.seed, tag_id(i as u32));
+    }
+    let rounds = c.rounds(budget)?;
+    let roots = (0..c.parent.len() as u32)
+        .filter(|&x| c.parent[x as usize] == NONE && (x as usize) < n + c.children.len())
+        .collect();
+    Ok(Partial {
+        aabb: c.aabb.split_off(n),
+        diameter: c.diameter.split_off(n),
+        children: c.children,
+        roots,
+        rounds,
+        stats: c.stats,
+    })
+}
+
 /// The budget as the round-start scans see it: pairs left before `max_pairs` is exceeded,
 /// and the stop flag and deadline, read every [`Budget::CLOCK_EVERY`] bodies.
 pub(super) struct ScanLimit<'b> {
@@ -139,6 +192,8 @@ pub(super) fn fill_balance(d: f64, dx: f64, dy: f64) -> (f64, f64) {
 /// The state of one grouping run.
 struct Clusterer<P, O> {
     n: usize,
+    /// Parent-less bodies at which the run stops (1: the root).
+    keep: usize,
     params: ResolvedParams,
     pset: P,
     observer: O,
@@ -208,6 +263,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             && (0..3).all(|k| small(bounds.min[k]) && small(bounds.max[k]));
         Clusterer {
             n,
+            keep: 1,
             params: *params,
             pset,
             observer,
@@ -276,7 +332,27 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
     }
 
     fn run(mut self, budget: &Budget<'_>) -> Result<Grouping, Stopped> {
+        let round = self.rounds(budget)?;
+        let merges = self.children.len() as u32;
+        let tree = SubsetTree::new(self.aabb, self.diameter, self.children)
+            .expect("the round loop makes exactly N - 1 valid merges");
+        self.observer.on_event(&Event::Finish {
+            root: tree.root(),
+            rounds: round,
+            merges,
+        });
+        Ok(Grouping {
+            tree,
+            rounds: round,
+            params: self.params,
+            stats: self.stats,
+        })
+    }
+
+    /// The round loop, until `self.keep` parent-less bodies remain; returns the rounds run.
+    fn rounds(&mut self, budget: &Budget<'_>) -> Result<u32, Stopped> {
         let n = self.n;
+        let keep = self.keep;
         let max_pairs = budget.max_pairs.unwrap_or(u64::MAX);
         let timed = budget.stop.is_some() || budget.deadline.is_some();
         // Merges since the clock was last read.
@@ -288,7 +364,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         let mut morton: Vec<(u64, u32)> = Vec::new();
         let mut order: Vec<u32> = Vec::new();
         // Step 2: one parent-less body left is the root.
-        while parentless.len() > 1 {
+        while parentless.len() > keep {
             if let Some(reason) = budget.exceeded_now() {
                 return Err(self.stopped(reason, round));
             }
@@ -402,6 +478,9 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                     }
                 }
                 self.merge_pair(e, round, dlimit, glimit);
+                if keep > 1 && parentless.len() - (self.children.len() - merges_before) <= keep {
+                    break;
+                }
             }
             let made = (self.children.len() - merges_before) as u32;
             parentless.retain(|&x| self.parent[x as usize] == NONE);
@@ -410,7 +489,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                     .filter(|&x| self.parent[x as usize] == NONE),
             );
             round += 1;
-            if parentless.len() > 1 {
+            if parentless.len() > keep {
                 // Step 5: double the limits and go to step 2.
                 dlimit *= 2.0;
                 glimit *= 2.0;
@@ -422,21 +501,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                 });
             }
         }
-        let merges = self.children.len() as u32;
-        let tree = SubsetTree::new(self.aabb, self.diameter, self.children)
-            .expect("the round loop makes exactly N - 1 valid merges");
-        self.observer.on_event(&Event::Finish {
-            root: tree.root(),
-            rounds: round,
-            merges,
-        });
-        Ok(Grouping {
-            tree,
-            rounds: round,
-            params: self.params,
-            stats: self.stats,
-            pregrouping: None,
-        })
+        Ok(round)
     }
 
     /// Step 4(a)–(c) for one popped pair.

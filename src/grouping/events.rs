@@ -179,6 +179,9 @@ pub enum Event<'a> {
 
 /// Receives every [`Event`] of a grouping run, in order.
 pub trait Observer {
+    /// Whether this observer may use events at all. `false` (the silent `()`) lets schedules
+    /// that would buffer events (the partitioned one) skip that work.
+    const LISTENS: bool = true;
     /// Called once per event.
     fn on_event(&mut self, event: &Event<'_>);
 
@@ -191,6 +194,7 @@ pub trait Observer {
 
 /// The silent observer.
 impl Observer for () {
+    const LISTENS: bool = false;
     #[inline(always)]
     fn on_event(&mut self, _: &Event<'_>) {}
 
@@ -200,6 +204,7 @@ impl Observer for () {
 }
 
 impl<O: Observer + ?Sized> Observer for &mut O {
+    const LISTENS: bool = O::LISTENS;
     #[inline]
     fn on_event(&mut self, event: &Event<'_>) {
         (**self).on_event(event)
@@ -212,6 +217,7 @@ impl<O: Observer + ?Sized> Observer for &mut O {
 
 /// An optional observer (e.g. a progress bar shown only on a terminal).
 impl<O: Observer> Observer for Option<O> {
+    const LISTENS: bool = O::LISTENS;
     #[inline]
     fn on_event(&mut self, event: &Event<'_>) {
         if let Some(o) = self {
@@ -228,6 +234,7 @@ impl<O: Observer> Observer for Option<O> {
 pub struct Tee<A, B>(pub A, pub B);
 
 impl<A: Observer, B: Observer> Observer for Tee<A, B> {
+    const LISTENS: bool = A::LISTENS || B::LISTENS;
     #[inline]
     fn on_event(&mut self, event: &Event<'_>) {
         self.0.on_event(event);

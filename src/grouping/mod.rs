@@ -39,6 +39,7 @@ mod cluster;
 pub mod events;
 mod hull_pset;
 pub mod mpairs;
+pub mod partitioned;
 pub mod pregroup;
 pub mod subset_tree;
 pub mod voxel_hash;
@@ -517,5 +518,8 @@ fn run<O: Observer>(
     if params.mode.pregroup != Pregroup::None && params.pset == PSet::Aabb {
         return pregroup::run(scene, params, observer, budget);
     }
-    cluster::run(scene, params, observer, budget)
+    match params.mode.schedule {
+        Schedule::Exact => cluster::run(scene, params, observer, budget),
+        Schedule::Partitioned => partitioned::run(scene, params, observer, budget),
+    }
 }

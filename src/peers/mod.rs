@@ -3,7 +3,8 @@
 //! ([`crate::query`]) measure every hierarchy the same way.
 //!
 //! - [`Method::Grouping`], [`Method::GroupingHull`]: the paper's grouping phase (§2.2) with AABB
-//!   or convex-hull p-sets;
+//!   or convex-hull p-sets; [`Method::GroupingPartitioned`]: the same step in the partitioned
+//!   schedule ([`crate::grouping::partitioned`]);
 //! - [`Method::GroupingPregroup`], [`Method::GroupingInstanced`], [`Method::GroupingObjects`]:
 //!   the same with the paper's §1.3 speed-ups ([`crate::grouping::pregroup`]): connected
 //!   components (or the scene's objects) grouped first, in parallel on the current rayon
@@ -18,11 +19,12 @@
 //! A peer's reported time covers its own build only, from primitive boxes (`f32` relative to the
 //! scene centre for parry and obvhs, `f64` for ours) to its native tree; reading its topology
 //! into a Subset Tree ([`topology`]) is not timed. Box computation per primitive is shared and
-//! not timed either. Every builder is single-threaded except the pre-grouped ones, which use the
-//! current rayon pool (run them inside `ThreadPool::install` to choose the thread count; their
-//! time includes finding the components and the copies). The refinement pass searches on
-//! rayon's threads and its time is added to the builder's: a refined method's time is the
-//! total, [`Built::refine_seconds`] the refinement's part.
+//! not timed either. The partitioned grouping, the pre-grouped ones (whose time includes
+//! finding the components and the copies) and obvhs PLOC (built with its `parallel` feature) use
+//! the current rayon pool (run them inside `ThreadPool::install` to choose the thread count);
+//! every other builder is single-threaded. The refinement pass searches on rayon's threads and
+//! its time is added to the builder's: a refined method's time is the total,
+//! [`Built::refine_seconds`] the refinement's part.
 
 pub mod goldsmith_salmon;
 pub mod median_split;
@@ -30,7 +32,7 @@ pub mod obvhs_ploc;
 pub mod parry_bvh;
 pub mod topology;
 
-use crate::grouping::{self, PSet, Params, Pregroup, Stats, SubsetTree};
+use crate::grouping::{self, PSet, Params, Pregroup, Schedule, Stats, SubsetTree};
 use crate::refine::{self, RefineParams};
 use crate::scene::Scene;
 use parry3d::partitioning::BvhBuildStrategy;
@@ -43,6 +45,8 @@ pub enum Method {
     Grouping,
     /// The grouping phase with convex-hull p-sets.
     GroupingHull,
+    /// The grouping phase in the partitioned schedule (AABB p-sets).
+    GroupingPartitioned,
     /// The grouping phase with connected components pre-grouped (AABB p-set).
     GroupingPregroup,
     /// The grouping phase with connected components pre-grouped and rigid copies copy-moved.
@@ -71,10 +75,11 @@ pub enum Method {
 
 impl Method {
     /// Every method, ours first.
-    pub const ALL: [Method; 14] = [
+    pub const ALL: [Method; 15] = [
         Method::Grouping,
         Method::GroupingRefine,
         Method::GroupingHull,
+        Method::GroupingPartitioned,
         Method::GroupingPregroup,
         Method::GroupingInstanced,
         Method::GroupingObjects,
@@ -93,6 +98,7 @@ impl Method {
         match self {
             Method::Grouping => "grouping",
             Method::GroupingHull => "grouping-hull",
+            Method::GroupingPartitioned => "grouping-partitioned",
             Method::GroupingPregroup => "grouping-pregroup",
             Method::GroupingInstanced => "grouping-instanced",
             Method::GroupingObjects => "grouping-objects",
@@ -129,6 +135,7 @@ impl Method {
                 | Method::GroupingPregroup
                 | Method::GroupingInstanced
                 | Method::GroupingObjects
+                | Method::GroupingPartitioned
         )
     }
 
@@ -209,6 +216,10 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
         }
         p.mode.pregroup = pregroup;
         p.mode.instancing = instancing;
+        if method == Method::GroupingPartitioned {
+            p.pset = PSet::Aabb;
+            p.mode.schedule = Schedule::Partitioned;
+        }
         let g = grouping::group(scene, &p, ());
         let seconds = t.elapsed().as_secs_f64();
         return Ok(done(g.tree, Some(g.stats), seconds));
@@ -253,7 +264,8 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
         | Method::GroupingHull
         | Method::GroupingPregroup
         | Method::GroupingInstanced
-        | Method::GroupingObjects => unreachable!("handled above"),
+        | Method::GroupingObjects
+        | Method::GroupingPartitioned => unreachable!("handled above"),
         Method::GroupingRefine | Method::ParryBinnedRefine | Method::ObvhsPlocRefine => {
             unreachable!("refined methods are built from their base")
         }

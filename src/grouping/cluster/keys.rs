@@ -1,7 +1,7 @@
 //! Per-body keys: seeded tie tags and Morton codes' bit spreading.
 
 /// splitmix64: the seeded tie tag of a body id.
-pub(super) fn tie_tag(seed: Option<u64>, id: u32) -> u64 {
+pub(in crate::grouping) fn tie_tag(seed: Option<u64>, id: u32) -> u64 {
     match seed {
         None => id as u64,
         Some(s) => {
@@ -14,7 +14,7 @@ pub(super) fn tie_tag(seed: Option<u64>, id: u32) -> u64 {
 }
 
 /// Spreads the low 21 bits of `v` to every third bit.
-pub(super) fn spread_bits(v: u64) -> u64 {
+pub(in crate::grouping) fn spread_bits(v: u64) -> u64 {
     let mut x = v & 0x1f_ffff;
     x = (x | x << 32) & 0x001f_0000_0000_ffff;
     x = (x | x << 16) & 0x001f_0000_ff00_00ff;

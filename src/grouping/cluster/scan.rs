@@ -37,6 +37,8 @@
 //! With C = 0 and B > 0 the pair Cost skips Balance (then weighted by zero), bit for bit the
 //! same value. Other p-sets search every candidate for the single best partner, as in the paper.
 
+mod par;
+
 use super::{Clusterer, PSetBodies, ScanLimit, box_area, fill_balance};
 use crate::geom::{Aabb, P3, V3};
 use crate::grouping::events::Observer;
@@ -143,6 +145,16 @@ impl Quick {
     }
 }
 
+/// The box that holds the centre of every eligible partner of a body with box `xa`, given the
+/// largest half-extent per axis of the stored bodies.
+#[inline]
+fn query_box(half_ext: &[f64; 3], xa: &Aabb, glimit: f64) -> (P3, P3) {
+    // A little more than GLimit + half-extent, so rounding never drops a partner.
+    let m = (0..3).fold(0f64, |m, k| m.max(xa.min[k].abs()).max(xa.max[k].abs()));
+    let reach = V3::from(half_ext.map(|h| (h + glimit) * (1.0 + 1e-12) + m * 1e-13));
+    (xa.min - reach, xa.max + reach)
+}
+
 /// A lower bound on the Cost of pairing the body with box `xa` and diameter `dx` with any body
 /// stored in a cell with bounds `cb`.
 #[inline(always)]
@@ -176,13 +188,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
     /// The box that holds the centre of every eligible partner of a body with box `xa`.
     #[inline]
     fn query(&self, xa: &Aabb, glimit: f64) -> (P3, P3) {
-        // A little more than GLimit + half-extent, so rounding never drops a partner.
-        let m = (0..3).fold(0f64, |m, k| m.max(xa.min[k].abs()).max(xa.max[k].abs()));
-        let reach = V3::from(
-            self.half_ext
-                .map(|h| (h + glimit) * (1.0 + 1e-12) + m * 1e-13),
-        );
-        (xa.min - reach, xa.max + reach)
+        query_box(&self.half_ext, xa, glimit)
     }
 
     /// Step 3 after the active bodies are stored: fills every active body's partner list and
@@ -196,7 +202,17 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
     ) -> u64 {
         if P::AABB {
             let a = self.params.weights.a;
-            if a == 1.0 {
+            // The parallel scan computes the diameter Cost only; the area Cost scans in order.
+            let area = self.params.mode.cost == CostMeasure::Area;
+            if !area && par::worth_it(order.len(), limit) {
+                if a == 1.0 {
+                    self.pairs_once_par::<1>(glimit, limit)
+                } else if a == 0.0 {
+                    self.pairs_once_par::<0>(glimit, limit)
+                } else {
+                    self.pairs_once_par::<2>(glimit, limit)
+                }
+            } else if a == 1.0 {
                 self.pairs_once::<1>(glimit, limit)
             } else if a == 0.0 {
                 self.pairs_once::<0>(glimit, limit)

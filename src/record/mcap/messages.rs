@@ -7,7 +7,7 @@
 //! flat message of varints and doubles needs only the few lines of wire parsing below.
 
 use crate::geom::{Aabb, P3};
-use crate::grouping::Merge;
+use crate::grouping::{Merge, Part, PartKind};
 
 /// A scalar the flat decoder understands: its protobuf wire type and conversion from the raw
 /// varint or 64-bit value.
@@ -328,6 +328,112 @@ impl From<&RefineStepEvent> for crate::refine::Step {
     }
 }
 
+flat_message! {
+    /// A part of the run (a chunk of the partitioned schedule, a component, a copy, the top),
+    /// on `/grouping/part`: every field of [`Part`], its kind flattened (fields a kind does not
+    /// have are 0).
+    PartEvent {
+        /// 0-based part index.
+        id: u32,
+        /// 0 chunk, 1 component, 2 copy, 3 top.
+        kind: u32,
+        /// Bodies the part starts from.
+        bodies: u32,
+        /// Step of the part's first merge.
+        first_step: u32,
+        /// Chunk: depth in the split.
+        level: u32,
+        /// Chunk: bodies left for the level above.
+        keep: u32,
+        /// Component: its index; copy: the component it copies.
+        index: u32,
+        /// Copy: rotation, row-major, 0 0.
+        r0: f64,
+        /// Rotation 0 1.
+        r1: f64,
+        /// Rotation 0 2.
+        r2: f64,
+        /// Rotation 1 0.
+        r3: f64,
+        /// Rotation 1 1.
+        r4: f64,
+        /// Rotation 1 2.
+        r5: f64,
+        /// Rotation 2 0.
+        r6: f64,
+        /// Rotation 2 1.
+        r7: f64,
+        /// Rotation 2 2.
+        r8: f64,
+        /// Copy: translation x.
+        tx: f64,
+        /// Translation y.
+        ty: f64,
+        /// Translation z.
+        tz: f64,
+    }
+}
+
+impl From<&Part> for PartEvent {
+    fn from(p: &Part) -> Self {
+        let mut e = PartEvent {
+            id: p.id,
+            bodies: p.bodies,
+            first_step: p.first_step,
+            ..PartEvent::default()
+        };
+        match p.kind {
+            PartKind::Chunk { level, keep } => {
+                e.kind = 0;
+                e.level = level;
+                e.keep = keep;
+            }
+            PartKind::Component { index } => {
+                e.kind = 1;
+                e.index = index;
+            }
+            PartKind::Copy {
+                of,
+                rotation: r,
+                translation: t,
+            } => {
+                e.kind = 2;
+                e.index = of;
+                [e.r0, e.r1, e.r2, e.r3, e.r4, e.r5, e.r6, e.r7, e.r8] = r;
+                [e.tx, e.ty, e.tz] = t;
+            }
+            PartKind::Top => e.kind = 3,
+        }
+        e
+    }
+}
+
+impl TryFrom<&PartEvent> for Part {
+    type Error = String;
+    fn try_from(e: &PartEvent) -> Result<Self, String> {
+        let kind = match e.kind {
+            0 => PartKind::Chunk {
+                level: e.level,
+                keep: e.keep,
+            },
+            1 => PartKind::Component { index: e.index },
+            2 => PartKind::Copy {
+                of: e.index,
+                rotation: [e.r0, e.r1, e.r2, e.r3, e.r4, e.r5, e.r6, e.r7, e.r8],
+                translation: [e.tx, e.ty, e.tz],
+            },
+            3 => PartKind::Top,
+            k => return Err(format!("unknown part kind {k}")),
+        };
+        Ok(Part {
+            id: e.id,
+            kind,
+            bodies: e.bodies,
+            first_step: e.first_step,
+        })
+    }
+}
+
 impl From<&Merge> for MergeEvent {
     fn from(m: &Merge) -> Self {
         MergeEvent {
@@ -424,6 +530,30 @@ mod tests {
             merges: 2,
         };
         assert_eq!(FinishEvent::decode(&encode(&f)).unwrap(), f);
+        for kind in [
+            PartKind::Chunk { level: 3, keep: 5 },
+            PartKind::Component { index: 6 },
+            PartKind::Copy {
+                of: 2,
+                rotation: [0.5, -1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0],
+                translation: [9.0, 10.0, -11.0],
+            },
+            PartKind::Top,
+        ] {
+            let p = Part {
+                id: 4,
+                kind,
+                bodies: 19,
+                first_step: 1 << 30,
+            };
+            let back = PartEvent::decode(&encode(&PartEvent::from(&p))).unwrap();
+            assert_eq!(Part::try_from(&back).unwrap(), p);
+        }
+        let bad = PartEvent {
+            kind: 9,
+            ..PartEvent::default()
+        };
+        assert!(Part::try_from(&bad).is_err());
     }
 
     #[test]

@@ -4,7 +4,8 @@
 //! Every value is a string; numbers use Rust's shortest round-trip formatting, so parsing
 //! them gives back the exact `f64`.
 
-use crate::grouping::{Mode, PSet, ResolvedParams, Weights};
+use crate::grouping::partitioned::Chunking;
+use crate::grouping::{Mode, PSet, ResolvedParams, Schedule, Weights};
 use crate::record::{Detail, Outcome, RunInfo};
 use crate::refine::RefineParams;
 use anyhow::{Context, Result, anyhow};
@@ -52,6 +53,10 @@ pub const KEYS: &[&str] = &[
 /// found (with a known reason). `merges` and `rounds` are then the merges made and the rounds
 /// announced.
 pub const STOP_KEYS: &[&str] = &["stop_reason", "stop_eligible_pairs"];
+
+/// Keys the `wraptree` record adds for the partitioned schedule: its chunk size δ and the
+/// reduction function's ε ([`Chunking`]); informative, as a build has one fixed chunking.
+pub const PARTITIONED_KEYS: &[&str] = &["chunk_delta", "chunk_epsilon"];
 
 /// Keys the `wraptree` record adds when a cover is logged (`cover_budget` only for a cover
 /// asked for by budget).
@@ -165,6 +170,11 @@ pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String,
     put("pregroup", value_name(&p.mode.pregroup));
     put("instancing", p.mode.instancing.to_string());
     put("cost", value_name(&p.mode.cost));
+    if p.mode.schedule == Schedule::Partitioned {
+        let ch = Chunking::DEFAULT;
+        put("chunk_delta", ch.delta.to_string());
+        put("chunk_epsilon", ch.epsilon.to_string());
+    }
     put("detail", value_name(&info.detail));
     put("scene", info.scene.name.clone());
     put("scene_file", info.source.file_name.clone());

@@ -12,6 +12,7 @@
 //! | `/scene` | `foxglove.SceneUpdate` | entity `scene`: every input primitive in one indexed `TriangleListPrimitive`, light grey | always, once |
 //! | `/grouping/round` | `roundevent.RoundEvent` | each round start (DLimit, GLimit, active, dormant, eligible pairs) and each DLimit doubling (`doubling = true`, merges of the ended round, new limits) | always |
 //! | `/grouping/merge` | `mergeevent.MergeEvent` | every merge: step, round, a, b, new, AABB, diameter, Fill, Balance, Cost, queue length, active | always |
+//! | `/grouping/part` | `partevent.PartEvent` | each part of the run (partitioned schedule's chunks and top, pre-grouping's components and copies): id, kind (0 chunk, 1 component, 2 copy, 3 top), bodies, first step, chunk level and keep, component index (or the copied one), copy rotation and translation; the merges up to the next part belong to it | runs with parts, from the first part on |
 //! | `/grouping/finish` | `finishevent.FinishEvent` | root, rounds, merges | always, once |
 //! | `/refine/step` | `refinestepevent.RefineStepEvent` | every kept move of the refinement: step, pass, moved node, its parent slot, old and new sibling, the moved subtree's and new parent's boxes, SAH before and after | `record --refine` |
 //! | `/grouping/active` | `foxglove.SceneUpdate` | entity `active`: one translucent green box per active body at each round start | `--detail merges` or `full` |
@@ -44,7 +45,7 @@ use crate::record::{Detail, Outcome, RunInfo};
 use anyhow::{Context, Result, anyhow, bail};
 use foxglove::Encode;
 use foxglove::messages::SceneUpdate;
-use messages::{DormantEvent, FinishEvent, MergeEvent, RefineStepEvent, RoundEvent};
+use messages::{DormantEvent, FinishEvent, MergeEvent, PartEvent, RefineStepEvent, RoundEvent};
 use scene_msgs::SceneMesh;
 use std::collections::BTreeMap;
 use std::io::{Seek, Write};
@@ -78,6 +79,8 @@ struct Topics {
     detail: Option<[Topic; 2]>,
     /// `/grouping/bodies` with `--detail full`.
     bodies: Option<Topic>,
+    /// `/grouping/part`, added at the first part (runs without parts do not have it).
+    part: Option<Topic>,
 }
 
 /// Writes a grouping run to an `.mcap` file; feed it events as an [`Observer`], then call
@@ -184,6 +187,7 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             } else {
                 None
             },
+            part: None,
         };
         let scene = info.scene;
         let mut bodies = Vec::with_capacity(2 * scene.len());
@@ -336,8 +340,18 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
                 };
                 emit(w, buf, &mut self.topics.round, t, &msg)?;
             }
-            // Parts are written by the partitioned schedule's recorder support (in progress).
-            Event::Part(_) => {}
+            Event::Part(p) => {
+                let topic = match &mut self.topics.part {
+                    Some(topic) => topic,
+                    None => {
+                        let schema = add_schema::<PartEvent, W>(w)?;
+                        self.topics
+                            .part
+                            .insert(add_topic(w, schema, "/grouping/part")?)
+                    }
+                };
+                emit(w, buf, topic, t, &PartEvent::from(&p))?;
+            }
             Event::RefineStart { params, sah } => {
                 let schema = add_schema::<RefineStepEvent, W>(w)?;
                 let topic = add_topic(w, schema, "/refine/step")?;

@@ -5,10 +5,10 @@
 //! data-section and summary CRC checks and a record length limit), so truncated or corrupted
 //! files give an error, never a panic, and no index offset from the file is trusted.
 
-use super::messages::{DormantEvent, FinishEvent, MergeEvent, RefineStepEvent, RoundEvent};
+use super::messages::{DormantEvent, FinishEvent, MergeEvent, PartEvent, RefineStepEvent, RoundEvent};
 use super::metadata;
 use crate::geom::Aabb;
-use crate::grouping::{EventLog, Merge, ResolvedParams, SubsetTree};
+use crate::grouping::{EventLog, Merge, Part, ResolvedParams, SubsetTree};
 use crate::record::Detail;
 use crate::scene::{LoadOptions, Scene};
 use anyhow::{Result, anyhow, bail};
@@ -57,6 +57,8 @@ pub struct Recorded {
     pub refine: Option<metadata::RefineSummary>,
     /// Every refinement step, in order.
     pub refine_steps: Vec<crate::refine::Step>,
+    /// Every part announced, in order (runs with parts: partitioned, pre-grouped).
+    pub parts: Vec<Part>,
 }
 
 impl Recorded {
@@ -83,6 +85,7 @@ impl Recorded {
             root: self.root,
             refine_start: self.refine.map(|r| (r.params, r.sah_before)),
             refine: self.refine_steps.clone(),
+            parts: self.parts.clone(),
             ..EventLog::default()
         }
     }
@@ -100,6 +103,7 @@ struct Raw {
     dormant: Vec<DormantEvent>,
     finish: Option<FinishEvent>,
     refine: Vec<crate::refine::Step>,
+    parts: Vec<Part>,
 }
 
 /// The schema each decoded topic must carry.
@@ -109,6 +113,7 @@ const TYPED_TOPICS: &[(&str, &str)] = &[
     ("/grouping/dormant", "dormantevent.DormantEvent"),
     ("/grouping/finish", "finishevent.FinishEvent"),
     ("/refine/step", "refinestepevent.RefineStepEvent"),
+    ("/grouping/part", "partevent.PartEvent"),
 ];
 
 impl Raw {
@@ -135,6 +140,10 @@ impl Raw {
             "/refine/step" => self.refine.push(crate::refine::Step::from(
                 &RefineStepEvent::decode(data).map_err(bad)?,
             )),
+            "/grouping/part" => {
+                let e = PartEvent::decode(data).map_err(bad)?;
+                self.parts.push(Part::try_from(&e).map_err(bad)?);
+            }
             _ => self.finish = Some(FinishEvent::decode(data).map_err(bad)?),
         }
         Ok(())
@@ -321,6 +330,7 @@ fn interpret(raw: Raw) -> Result<Recorded> {
         root: raw.finish.map(|f| f.root),
         refine,
         refine_steps: raw.refine,
+        parts: raw.parts,
         metadata: m,
         timing,
     })

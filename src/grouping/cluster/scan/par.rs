@@ -1,0 +1,193 @@
+//! Step 3's round-start scan (AABB p-set) on several threads, with the same result as the
+//! sequential scan.
+//!
+//! The voxel hash's cells are cut into contiguous ranges, scanned in parallel exactly as the
+//! sequential scan does (each pair of cells once, each eligible pair once). A range offers a
+//! pair to the partner lists of its own bodies directly — every body lies in one cell, so no two
+//! ranges write the same list — and buffers the offers to bodies of other ranges, which are
+//! made after the parallel part. A list holds the first partners in (Cost, tie tag) order,
+//! which does not depend on the order of the offers, and the Cost filter that skips offers only
+//! skips ones that could not enter a list, so every list, the pair count and the candidate count
+//! are those of the sequential scan, for any number of threads.
+//!
+//! It runs when the pool has several threads, the round has at least [`MIN_BODIES`] active
+//! bodies and the budget has no `max_pairs` (where a scan stops then depends on the order in
+//! which pairs are counted). The stop flag and the deadline are read by every range every
+//! [`Budget::CLOCK_EVERY`] bodies.
+
+use super::reachable;
+use super::{Clusterer, PSetBodies, Quick, ScanLimit, apart, merged_extents, pair_cost, query_box};
+use crate::geom::P3;
+use crate::grouping::Budget;
+use crate::grouping::events::Observer;
+use crate::grouping::mpairs::List;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Rounds with fewer active bodies scan on one thread.
+pub(super) const MIN_BODIES: usize = 8192;
+
+/// Cell ranges per thread (more than one evens out uneven ranges).
+const RANGES_PER_THREAD: usize = 8;
+
+/// Whether a round-start scan of `bodies` active bodies under `limit` runs in parallel.
+pub(super) fn worth_it(bodies: usize, limit: &ScanLimit<'_>) -> bool {
+    bodies >= MIN_BODIES && limit.room == u64::MAX && rayon::current_num_threads() > 1
+}
+
+/// The partner lists, shared by the ranges; each range writes only its own bodies' lists.
+#[derive(Clone, Copy)]
+struct Lists(*mut List);
+
+// SAFETY: the ranges write disjoint lists (see `Clusterer::pairs_once_par`).
+unsafe impl Send for Lists {}
+// SAFETY: as above.
+unsafe impl Sync for Lists {}
+
+impl Lists {
+    /// The list in slot `s`.
+    ///
+    /// # Safety
+    /// `s` is a valid slot, and no other reference to that list is alive.
+    #[inline(always)]
+    unsafe fn get<'a>(self, s: usize) -> &'a mut List {
+        // SAFETY: guaranteed by the caller.
+        unsafe { &mut *self.0.add(s) }
+    }
+}
+
+/// What one cell range found.
+#[derive(Default)]
+struct Found {
+    pairs: u64,
+    candidates: u64,
+    /// Offers to bodies of other ranges: (slot, Cost, partner).
+    remote: Vec<(u32, f64, u32)>,
+}
+
+impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
+    /// [`Clusterer::pairs_once`] on the current rayon pool (see the module doc).
+    pub(super) fn pairs_once_par<const A: u8>(
+        &mut self,
+        glimit: f64,
+        limit: &mut ScanLimit<'_>,
+    ) -> u64 {
+        let (k, w, finite) = (self.k, self.params.weights, self.finite);
+        let quick = Quick::new(&w, self.quick);
+        let hash = &self.hash;
+        let half_ext = self.half_ext;
+        let tags: &[u64] = &self.tag;
+        let cells = hash.cells() as usize;
+        let parts = (rayon::current_num_threads() * RANGES_PER_THREAD).clamp(1, cells.max(1));
+        let lists = self.partners.lists_mut();
+        let slots = lists.len();
+        let lists = Lists(lists.as_mut_ptr());
+        let halt = AtomicBool::new(false);
+        let (budget, timed) = (limit.budget, limit.timed);
+        let scan = |p: usize| -> (Found, Option<crate::grouping::StopReason>) {
+            let (lo, hi) = ((p * cells / parts) as u32, ((p + 1) * cells / parts) as u32);
+            let mut f = Found::default();
+            let mut near: Vec<u32> = Vec::with_capacity(27);
+            let mut fwd: Vec<u32> = Vec::with_capacity(27);
+            let mut bodies = 0u32;
+            for c in lo..hi {
+                let vc = hash.coords(c);
+                let (mut clo, mut chi) = (
+                    P3::new(f64::MAX, f64::MAX, f64::MAX),
+                    P3::new(f64::MIN, f64::MIN, f64::MIN),
+                );
+                for r in hash.recs(c) {
+                    let (l, h) = query_box(&half_ext, &r.aabb, glimit);
+                    clo = clo.inf(&l);
+                    chi = chi.sup(&h);
+                }
+                near.clear();
+                hash.for_each_cell(&clo, &chi, |cell, v| {
+                    if v > vc && !apart(&hash.bounds(c).union, &hash.bounds(cell).union, glimit) {
+                        near.push(cell);
+                    }
+                });
+                for i in 0..hash.recs(c).len() {
+                    if timed {
+                        bodies = bodies.wrapping_add(1);
+                        if bodies.is_multiple_of(Budget::CLOCK_EVERY) {
+                            if halt.load(Ordering::Relaxed) {
+                                return (f, None);
+                            }
+                            if let Some(r) = budget.exceeded_now() {
+                                halt.store(true, Ordering::Relaxed);
+                                return (f, Some(r));
+                            }
+                        }
+                    }
+                    let xr = hash.recs(c)[i];
+                    let (x, xa, dx, sx) = (xr.id, xr.aabb, xr.diameter, xr.slot as usize);
+                    debug_assert!(sx < slots);
+                    fwd.clear();
+                    fwd.extend(
+                        near.iter()
+                            .copied()
+                            .filter(|&cell| reachable(hash.bounds(cell), &xa, glimit)),
+                    );
+                    let own = (&hash.recs(c)[i + 1..], true);
+                    let segs = fwd
+                        .iter()
+                        .map(|&cell| (hash.recs(cell), (lo..hi).contains(&cell)));
+                    for (seg, local) in std::iter::once(own).chain(segs) {
+                        for yr in seg {
+                            if finite && yr.aabb.min.x - xa.max.x > glimit {
+                                break;
+                            }
+                            f.candidates += 1;
+                            if apart(&xa, &yr.aabb, glimit) {
+                                continue;
+                            }
+                            f.pairs += 1;
+                            let e = merged_extents(&xa, &yr.aabb);
+                            let sy = yr.slot as usize;
+                            // SAFETY: `x` lies in a cell of this range, which alone writes
+                            // its list; `y` too when `local`; `x != y`.
+                            let lx = unsafe { lists.get(sx) };
+                            if local {
+                                // SAFETY: as above.
+                                let ly = unsafe { lists.get(sy) };
+                                if let Some(q) = quick {
+                                    let bar = lx.bar(k).max(ly.bar(k));
+                                    if q.beyond(e.norm_squared(), dx + yr.diameter, bar) {
+                                        continue;
+                                    }
+                                }
+                                let cost = pair_cost::<A>(&w, e.norm(), dx, yr.diameter);
+                                lx.offer(k, cost, yr.id, tags);
+                                ly.offer(k, cost, x, tags);
+                            } else {
+                                let cost = pair_cost::<A>(&w, e.norm(), dx, yr.diameter);
+                                lx.offer(k, cost, yr.id, tags);
+                                f.remote.push((sy as u32, cost, x));
+                            }
+                        }
+                    }
+                }
+            }
+            (f, None)
+        };
+        let found: Vec<(Found, Option<crate::grouping::StopReason>)> =
+            (0..parts).into_par_iter().map(scan).collect();
+        let lists = self.partners.lists_mut();
+        let mut pairs = 0u64;
+        for (f, hit) in &found {
+            pairs += f.pairs;
+            self.stats.candidates += f.candidates;
+            if limit.hit.is_none() {
+                limit.hit = *hit;
+            }
+            for &(s, cost, x) in &f.remote {
+                lists[s as usize].offer(k, cost, x, &self.tag);
+            }
+        }
+        if limit.hit.is_none() && halt.load(Ordering::Relaxed) {
+            limit.hit = budget.exceeded_now();
+        }
+        pairs
+    }
+}

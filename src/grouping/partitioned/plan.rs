@@ -1,0 +1,108 @@
+//! The top-down split: Morton order of the primitives and the tree of chunks over it.
+
+use super::Chunking;
+use crate::geom::Aabb;
+use crate::grouping::cluster::spread_bits;
+use rayon::prelude::*;
+
+/// A node of the split, in post-order.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Node {
+    /// Range of the Morton-sorted primitives.
+    pub(super) lo: u32,
+    pub(super) hi: u32,
+    /// The two halves (node indices), or none for a chunk.
+    pub(super) kids: Option<(u32, u32)>,
+    /// Depth (0 = the root).
+    pub(super) level: u32,
+    /// Bodies the node's own subproblem starts from.
+    pub(super) inputs: u32,
+    /// Bodies it leaves (1 at the root).
+    pub(super) keep: u32,
+    /// Step of its own first merge.
+    pub(super) own_step: u32,
+}
+
+/// The split of `codes` (sorted) into chunks, nodes in post-order.
+pub(super) fn plan(codes: &[(u64, u32)], chunking: &Chunking) -> Vec<Node> {
+    fn build(
+        codes: &[(u64, u32)],
+        ch: &Chunking,
+        lo: u32,
+        hi: u32,
+        level: u32,
+        first_step: u32,
+        nodes: &mut Vec<Node>,
+    ) -> u32 {
+        let size = hi - lo;
+        let top = level == 0;
+        let node = if size < ch.delta.max(2) {
+            Node {
+                lo,
+                hi,
+                kids: None,
+                level,
+                inputs: size,
+                keep: if top { 1 } else { size.min(ch.keep(ch.delta)) },
+                own_step: first_step,
+            }
+        } else {
+            let (a, b) = (codes[lo as usize].0, codes[hi as usize - 1].0);
+            let mid = if a == b {
+                lo + size / 2
+            } else {
+                let bit = 63 - (a ^ b).leading_zeros();
+                let part = &codes[lo as usize..hi as usize];
+                lo + part.partition_point(|c| c.0 >> bit & 1 == 0) as u32
+            };
+            let l = build(codes, ch, lo, mid, level + 1, first_step, nodes);
+            let kl = nodes[l as usize].keep;
+            let r_first = first_step + (mid - lo - kl);
+            let r = build(codes, ch, mid, hi, level + 1, r_first, nodes);
+            let kr = nodes[r as usize].keep;
+            let inputs = kl + kr;
+            Node {
+                lo,
+                hi,
+                kids: Some((l, r)),
+                level,
+                inputs,
+                keep: if top { 1 } else { inputs.min(ch.keep(size)) },
+                own_step: r_first + (hi - mid - kr),
+            }
+        };
+        nodes.push(node);
+        nodes.len() as u32 - 1
+    }
+    let mut nodes = Vec::new();
+    build(codes, chunking, 0, codes.len() as u32, 0, 0, &mut nodes);
+    nodes
+}
+
+/// The primitives' ids sorted by the Morton code of their box centres (ties by id).
+pub(super) fn morton_order(boxes: &[Aabb]) -> Vec<(u64, u32)> {
+    let cb = boxes.iter().fold(Aabb::EMPTY, |b, x| b.grow(&x.center()));
+    let ext = cb.extents();
+    let scale = [0, 1, 2].map(|k| {
+        if ext[k] > 0.0 && ext[k].is_finite() {
+            2_097_151.0 / ext[k]
+        } else {
+            0.0
+        }
+    });
+    let mut codes: Vec<(u64, u32)> = boxes
+        .par_iter()
+        .enumerate()
+        .map(|(i, b)| {
+            let c = b.center();
+            let mut key = 0u64;
+            for k in 0..3 {
+                let t = ((c[k] - cb.min[k]) * scale[k]).clamp(0.0, 2_097_151.0) as u64;
+                key |= spread_bits(t) << k;
+            }
+            (key, i as u32)
+        })
+        .collect();
+    codes.par_sort_unstable();
+    codes
+}

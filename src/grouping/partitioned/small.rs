@@ -1,0 +1,318 @@
+//! The agglomerative step of §2.2 by brute force, for subproblems of at most [`SMALL`] bodies.
+//!
+//! Every pair of bodies gets, once, its Cost and the first round in which it is eligible: the
+//! smallest `r` with both diameters ≤ DLimit0·2^r and the L∞ gap ≤ GLimit0·2^r (the limits of
+//! round `r` are DLimit0 and GLimit0 doubled `r` times, as in the exact run). Each body keeps
+//! its cheapest partner among the pairs eligible in the current round; the cheapest of those
+//! is merged, the merged body takes the slot of one of its children, and only the bodies whose
+//! partner was one of the children search their row again. When no pair is eligible, the run
+//! moves to the first round in which one is (the rounds in between would merge nothing). Pairs
+//! are ordered by (Cost, smaller tie tag, larger tie tag) as in MPairs, so the merges are those
+//! of the exact schedule run on the same bodies with the same limits.
+
+use super::{Body, Ctx, Info, Out, SubStats};
+use crate::grouping::cluster::{fill_balance, tie_tag};
+use crate::grouping::mpairs::order_bits;
+use std::cell::RefCell;
+
+/// The most bodies a subproblem may have to be solved by brute force.
+pub(super) const SMALL: usize = 64;
+
+/// A round that never comes (NaN sizes).
+const NEVER: u32 = u32::MAX;
+
+/// The limits of every round: `tab[r]` = `base` doubled `r` times, up to the first infinity.
+pub(super) struct Limits {
+    tab: Vec<f64>,
+}
+
+impl Limits {
+    /// The doubling sequence of `base` (> 0).
+    pub(super) fn new(base: f64) -> Limits {
+        let mut tab = vec![base];
+        let mut v = base;
+        while v < f64::INFINITY && tab.len() < 4096 {
+            v *= 2.0;
+            tab.push(v);
+        }
+        Limits { tab }
+    }
+
+    /// The limit of round `r`.
+    #[inline]
+    pub(super) fn at(&self, r: u32) -> f64 {
+        self.tab[(r as usize).min(self.tab.len() - 1)]
+    }
+
+    /// The first round whose limit is ≥ `x` ([`NEVER`] for NaN).
+    #[inline]
+    pub(super) fn first(&self, x: f64) -> u32 {
+        let t = &self.tab;
+        if x <= t[0] {
+            return 0;
+        }
+        if x.is_nan() {
+            return NEVER;
+        }
+        let last = t.len() - 1;
+        // The binary exponents differ by about the answer; step to it exactly.
+        let e = |v: f64| ((v.to_bits() >> 52) & 0x7ff) as i64;
+        let mut r = (e(x) - e(t[0])).clamp(0, last as i64) as usize;
+        while r < last && t[r] < x {
+            r += 1;
+        }
+        while r > 0 && t[r - 1] >= x {
+            r -= 1;
+        }
+        r as u32
+    }
+}
+
+/// The pairs of a subproblem: Cost (as [`order_bits`]) and first eligible round of every
+/// ordered pair of slots, each body's cheapest partner eligible in the current round, and the
+/// first later round in which any of its pairs becomes eligible (a lower bound once partners
+/// merge away).
+struct Table {
+    m: usize,
+    cost: Vec<u64>,
+    round: Vec<u32>,
+    tag: Vec<u64>,
+    /// Slots holding a body, in no particular order.
+    live: Vec<usize>,
+    best: Vec<usize>,
+    next: Vec<u32>,
+    /// First round in which each body obeys DLimit.
+    rd: Vec<u32>,
+}
+
+/// No partner.
+const NO: usize = usize::MAX;
+
+impl Table {
+    /// Whether partner `j` comes before partner `b` in slot `i`'s row (Cost, then tie tag).
+    #[inline(always)]
+    fn better(&self, i: usize, j: usize, b: usize) -> bool {
+        if b == NO {
+            return true;
+        }
+        let (cj, cb) = (self.cost[i * self.m + j], self.cost[i * self.m + b]);
+        cj < cb || (cj == cb && self.tag[j] < self.tag[b])
+    }
+
+    /// Finds slot `i`'s cheapest partner eligible in round `r` and its next round; returns the
+    /// number of its eligible pairs with a larger slot.
+    fn scan_row(&mut self, i: usize, r: u32) -> u64 {
+        let (mut b, mut next, mut above) = (NO, NEVER, 0u64);
+        let row = i * self.m;
+        for &j in &self.live {
+            if j == i {
+                continue;
+            }
+            let rj = self.round[row + j];
+            if rj <= r {
+                above += u64::from(j > i);
+                if self.better(i, j, b) {
+                    b = j;
+                }
+            } else if rj < next {
+                next = rj;
+            }
+        }
+        self.best[i] = b;
+        self.next[i] = next;
+        above
+    }
+
+    /// The pair merged next: the cheapest eligible pair by (Cost, smaller tag, larger tag).
+    fn top(&self) -> Option<(usize, usize)> {
+        let mut top: Option<(usize, usize)> = None;
+        for &i in &self.live {
+            let j = self.best[i];
+            if j == NO {
+                continue;
+            }
+            let wins = match top {
+                None => true,
+                Some((k, l)) => {
+                    let (c, d) = (self.cost[i * self.m + j], self.cost[k * self.m + l]);
+                    let key = |x: usize, y: usize| {
+                        let (a, b) = (self.tag[x], self.tag[y]);
+                        (a.min(b), a.max(b))
+                    };
+                    c < d || (c == d && key(i, j) < key(k, l))
+                }
+            };
+            if wins {
+                top = Some((i, j));
+            }
+        }
+        top
+    }
+}
+
+thread_local! {
+    /// Each thread's table, reused by its subproblems (no allocation per subproblem).
+    static TABLE: RefCell<Table> = const { RefCell::new(Table {
+        m: 0,
+        cost: Vec::new(),
+        round: Vec::new(),
+        tag: Vec::new(),
+        live: Vec::new(),
+        best: Vec::new(),
+        next: Vec::new(),
+        rd: Vec::new(),
+    }) };
+}
+
+/// Groups `bodies` (at most [`SMALL`], in any order) until `keep` remain, writing merge `i` to
+/// `out` at index `i` with new id `first_new + i`; returns the bodies left, in no particular
+/// order (the merges do not depend on the order of `bodies`: every choice is by Cost and tie
+/// tags).
+pub(super) fn combine(ctx: &Ctx, bodies: Vec<Body>, keep: usize, out: &mut Out<'_>) -> Vec<Body> {
+    if bodies.len() <= keep {
+        return bodies;
+    }
+    TABLE.with(|t| run(ctx, bodies, keep, out, &mut t.borrow_mut()))
+}
+
+/// [`combine`] with the thread's table.
+fn run(ctx: &Ctx, bodies: Vec<Body>, keep: usize, out: &mut Out<'_>, t: &mut Table) -> Vec<Body> {
+    let m = bodies.len();
+    debug_assert!(m <= SMALL && keep >= 1);
+    let mut st = SubStats::default();
+    let w = ctx.params.weights;
+    let seed = ctx.params.seed;
+    let mut body = bodies;
+    t.m = m;
+    if t.cost.len() < m * m {
+        t.cost.resize(m * m, 0);
+        t.round.resize(m * m, NEVER);
+    }
+    t.tag.clear();
+    t.tag.extend(body.iter().map(|b| tie_tag(seed, b.id)));
+    t.rd.clear();
+    t.rd.extend(body.iter().map(|b| ctx.dl.first(b.d)));
+    t.live.clear();
+    t.live.extend(0..m);
+    t.best.clear();
+    t.best.resize(m, NO);
+    // Not scanned yet: every row is scanned at the first round start.
+    t.next.clear();
+    t.next.resize(m, 0);
+    let eval = |a: &Body, b: &Body, ra: u32, rb: u32| -> (u64, u32) {
+        let d = a.aabb.merge(&b.aabb).diameter();
+        let (fill, balance) = fill_balance(d, a.d, b.d);
+        let round = ra.max(rb).max(ctx.gl.first(a.aabb.gap_linf(&b.aabb)));
+        (order_bits(w.cost(d, fill, balance)), round)
+    };
+    for i in 0..m {
+        for j in i + 1..m {
+            let (c, r) = eval(&body[i], &body[j], t.rd[i], t.rd[j]);
+            (t.cost[i * m + j], t.round[i * m + j]) = (c, r);
+            (t.cost[j * m + i], t.round[j * m + i]) = (c, r);
+        }
+    }
+    st.candidates += (m * (m - 1) / 2) as u64;
+    let mut round = 0u32;
+    let mut made = 0usize;
+    let mut fresh = true;
+    while t.live.len() > keep {
+        if fresh {
+            // Round start: every body's cheapest eligible partner. When a round ends no body
+            // has one, so only bodies with a pair eligible from this round on can gain one.
+            for k in 0..t.live.len() {
+                let i = t.live[k];
+                if t.next[i] <= round {
+                    st.eligible_pairs += t.scan_row(i, round);
+                }
+            }
+            fresh = false;
+        }
+        let Some((i, j)) = t.top() else {
+            // Step 5, as often as it takes for a pair to become eligible.
+            let next = t.live.iter().map(|&i| t.next[i]).min().unwrap_or(NEVER);
+            assert!(next != NEVER, "bodies of NaN size never become eligible");
+            round = next;
+            fresh = true;
+            continue;
+        };
+        let (i, j) = (i.min(j), i.max(j));
+        let (a, b) = (body[i], body[j]);
+        let merged = a.aabb.merge(&b.aabb);
+        let d = merged.diameter();
+        let (fill, balance) = fill_balance(d, a.d, b.d);
+        let cost = w.cost(d, fill, balance);
+        let active = d <= ctx.dl.at(round);
+        let new = out.first_new + made as u32;
+        st.pops += 1;
+        // The new body takes slot i; slot j is gone.
+        body[i] = Body {
+            id: new,
+            aabb: merged,
+            d,
+        };
+        t.tag[i] = tie_tag(seed, new);
+        t.rd[i] = ctx.dl.first(d);
+        t.live.retain(|&k| k != j);
+        for &k in &t.live {
+            if k != i {
+                let (c, r) = eval(&body[i], &body[k], t.rd[i], t.rd[k]);
+                (t.cost[i * m + k], t.round[i * m + k]) = (c, r);
+                (t.cost[k * m + i], t.round[k * m + i]) = (c, r);
+            }
+        }
+        st.candidates += (t.live.len() - 1) as u64;
+        for idx in 0..t.live.len() {
+            let k = t.live[idx];
+            if k == i {
+                continue;
+            }
+            let bk = t.best[k];
+            if bk == i || bk == j {
+                t.scan_row(k, round);
+            } else {
+                let r = t.round[k * m + i];
+                if r <= round {
+                    if t.better(k, i, bk) {
+                        t.best[k] = i;
+                    }
+                } else if r < t.next[k] {
+                    t.next[k] = r;
+                }
+            }
+        }
+        t.scan_row(i, round);
+        let queued = if out.listens() {
+            t.live.iter().filter(|&&k| t.best[k] != NO).count() as u32
+        } else {
+            0
+        };
+        out.put(
+            made,
+            [a.id.min(b.id), a.id.max(b.id)],
+            merged,
+            d,
+            Info {
+                round,
+                fill,
+                balance,
+                cost,
+                queue_len: queued,
+                active,
+            },
+        );
+        made += 1;
+    }
+    st.rounds = round + 1;
+    out.stats.add(&st);
+    // Keep the live slots' bodies, in slot order.
+    let mut k = 0;
+    for i in 0..m {
+        if t.live.contains(&i) {
+            body[k] = body[i];
+            k += 1;
+        }
+    }
+    body.truncate(k);
+    body
+}

@@ -1,0 +1,106 @@
+//! The brute-force subproblem against the voxel-hash one on the same bodies.
+
+use super::{Body, Ctx, Info, Out, SubStats, big, small};
+use crate::geom::Aabb;
+use crate::grouping::{Budget, Params, Weights};
+use crate::scene::generate;
+use small::Limits;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicU64};
+
+/// Children, Cost bits and round of each merge, and the ids of the bodies left.
+type Solved = (Vec<([u32; 2], u64, u32)>, Vec<u32>);
+
+/// Runs `combine` on `bodies` (ids from 0, new ids from `n`) and returns the merges and the
+/// bodies left.
+fn solve(ctx: &Ctx, bodies: &[Body], keep: usize, n: u32, brute: bool) -> Solved {
+    let m = bodies.len() - keep;
+    let mut children = vec![[0u32; 2]; m];
+    let mut aabb = vec![Aabb::EMPTY; m];
+    let mut diameter = vec![0.0; m];
+    let mut info = vec![Info::default(); m];
+    let mut out = Out {
+        first_new: n,
+        children: &mut children,
+        aabb: &mut aabb,
+        diameter: &mut diameter,
+        info: Some(&mut info),
+        stats: SubStats::default(),
+    };
+    let left = if brute {
+        small::combine(ctx, bodies.to_vec(), keep, &mut out)
+    } else {
+        big::combine(ctx, bodies.to_vec(), keep, &mut out).unwrap()
+    };
+    let merges = (0..m)
+        .map(|i| (children[i], info[i].cost.to_bits(), info[i].round))
+        .collect();
+    let mut ids: Vec<u32> = left.iter().map(|b| b.id).collect();
+    ids.sort_unstable();
+    (merges, ids)
+}
+
+#[test]
+fn brute_force_equals_the_voxel_hash_run() {
+    let budget = Budget::default();
+    for (seed, n) in [(1u64, 64usize), (2, 40), (3, 17), (4, 64), (5, 2)] {
+        let scene = generate::soup(n, seed);
+        for weights in [
+            Weights {
+                a: 1.0,
+                b: 1.0,
+                c: 0.0,
+            },
+            Weights {
+                a: 2.0,
+                b: 0.5,
+                c: 1.0,
+            },
+        ] {
+            let params = Params {
+                weights,
+                seed: (seed % 2 == 0).then_some(seed),
+                ..Params::default()
+            }
+            .resolve(&scene);
+            let ctx = Ctx {
+                params,
+                dl: Limits::new(params.dlimit0),
+                gl: Limits::new(params.glimit0),
+                budget: &budget,
+                pairs: AtomicU64::new(0),
+                halt: AtomicBool::new(false),
+                reason: Mutex::new(None),
+            };
+            // Ids spread out as in a larger run: body i has id 3i + 1.
+            let bodies: Vec<Body> = (0..n)
+                .map(|i| {
+                    let aabb = scene.prim_aabb(i);
+                    Body {
+                        id: 3 * i as u32 + 1,
+                        aabb,
+                        d: aabb.diameter(),
+                    }
+                })
+                .collect();
+            for keep in [1, 2, n / 2, n].into_iter().filter(|&k| k >= 1 && k <= n) {
+                let next = 3 * n as u32 + 5;
+                let a = solve(&ctx, &bodies, keep, next, true);
+                let b = solve(&ctx, &bodies, keep, next, false);
+                assert_eq!(a, b, "soup {n} seed {seed} keep {keep} {weights:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn limits_give_the_first_round_that_admits_a_value() {
+    let l = Limits::new(0.3);
+    for x in [0.0, 0.3, 0.31, 0.6, 0.6000001, 1e-300, 7.5, 1e300, f64::MAX] {
+        let r = l.first(x);
+        assert!(x <= l.at(r), "{x} within round {r}");
+        assert!(r == 0 || x > l.at(r - 1), "{x}: round {r} is the first");
+    }
+    assert_eq!(l.first(f64::INFINITY), l.first(f64::INFINITY));
+    assert!(l.at(l.first(f64::INFINITY)).is_infinite());
+}

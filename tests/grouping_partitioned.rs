@@ -1,0 +1,334 @@
+//! The partitioned schedule: valid trees on bundled and property-generated scenes, the same
+//! result on 1 and 2 threads, the exact schedule's tree for a scene smaller than one chunk,
+//! parts announced before their merges, `replay --verify` of a partitioned recording; and the
+//! exact schedule's merge sequence unchanged by its parallel round-start scan.
+
+mod common;
+
+use common::{check_tree, run, wraptree};
+use proptest::prelude::*;
+use std::sync::atomic::AtomicBool;
+use wraptree::geom::P3;
+use wraptree::grouping::partitioned::{Chunking, group_with};
+use wraptree::grouping::{
+    Budget, EventLog, Mode, PSet, Params, PartKind, Schedule, StopReason, Weights, group,
+    group_within,
+};
+use wraptree::scene::{LoadOptions, PrimitiveKind, Scene, generate};
+
+fn partitioned(mut p: Params) -> Params {
+    p.mode = Mode {
+        schedule: Schedule::Partitioned,
+        ..Mode::default()
+    };
+    p
+}
+
+/// `f` in a rayon pool of `threads` threads.
+fn on<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
+fn scene_from(tris: &[([f64; 3], [f64; 3], [f64; 3])]) -> Scene {
+    let mut s = Scene::new("prop");
+    for (c, u, v) in tris {
+        let b = s.points.len() as u32;
+        let c = P3::new(c[0], c[1], c[2]);
+        s.points.push(c);
+        s.points.push(c + nalgebra::Vector3::from(*u));
+        s.points.push(c + nalgebra::Vector3::from(*v));
+        s.push(
+            PrimitiveKind::Polygon,
+            &[b, b + 1, b + 2],
+            &[[b, b + 1, b + 2]],
+        );
+    }
+    s
+}
+
+fn arb_scene(min_n: usize, max_n: usize) -> impl Strategy<Value = Scene> {
+    let coord = -50.0f64..50.0;
+    let edge = prop_oneof![Just(0.0f64), -3.0f64..3.0];
+    let tri = (
+        [coord.clone(), coord.clone(), coord],
+        [edge.clone(), edge.clone(), edge.clone()],
+        [edge.clone(), edge.clone(), edge],
+    );
+    prop::collection::vec(tri, min_n..max_n).prop_map(|t| scene_from(&t))
+}
+
+fn arb_params() -> impl Strategy<Value = Params> {
+    (
+        prop_oneof![Just(0.0), Just(1.0), Just(2.0)],
+        prop_oneof![Just(0.0), Just(0.5), Just(1.0)],
+        prop_oneof![Just(0.0), Just(1.0)],
+        prop::option::of(0.01f64..20.0),
+        prop::option::of(0.01f64..20.0),
+        prop::option::of(any::<u64>()),
+    )
+        .prop_map(|(a, b, c, dlimit, glimit, seed)| {
+            partitioned(Params {
+                weights: Weights { a, b, c },
+                dlimit,
+                glimit,
+                pset: PSet::Aabb,
+                seed,
+                mode: Mode::default(),
+            })
+        })
+}
+
+/// Parts come before their merges: each part's `first_step` is the number of merges before it,
+/// it makes `bodies - keep` merges (all the rest for the top, which comes last), ids in order.
+fn check_parts(n: usize, log: &EventLog) {
+    let mut step = 0u32;
+    for (i, p) in log.parts.iter().enumerate() {
+        assert_eq!(p.id as usize, i);
+        assert_eq!(p.first_step, step, "part {i} starts where the last ended");
+        let keep = match p.kind {
+            PartKind::Chunk { keep, .. } => keep,
+            PartKind::Top => {
+                assert_eq!(i + 1, log.parts.len(), "the top comes last");
+                1
+            }
+            k => panic!("unexpected part kind {k:?}"),
+        };
+        assert!(keep < p.bodies, "part {i} merges something");
+        step += p.bodies - keep;
+    }
+    assert_eq!(step as usize, n - 1, "the parts hold every merge");
+}
+
+#[test]
+fn bundled_scenes_give_valid_trees_on_1_and_2_threads() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 5);
+    for f in files {
+        let scene = wraptree::scene::load_path(&f, &LoadOptions::default())
+            .unwrap()
+            .scene;
+        let params = partitioned(Params::default());
+        let (g1, log1) = on(1, || run(&scene, &params));
+        check_tree(&scene, &g1, &log1);
+        if scene.len() > 1 {
+            check_parts(scene.len(), &log1);
+        }
+        let (g2, log2) = on(2, || run(&scene, &params));
+        assert_eq!(g1.tree, g2.tree, "{}", f.display());
+        assert_eq!(log1, log2, "{}", f.display());
+    }
+}
+
+#[test]
+fn large_soup_is_the_same_on_1_and_2_threads_and_close_to_exact() {
+    let scene = generate::soup(30_000, 7);
+    let params = partitioned(Params::default());
+    let (g1, log1) = on(1, || run(&scene, &params));
+    check_tree(&scene, &g1, &log1);
+    check_parts(scene.len(), &log1);
+    let (g2, log2) = on(2, || run(&scene, &params));
+    assert_eq!(g1.tree, g2.tree);
+    assert_eq!(log1, log2);
+    // Without a listener the tree is the same.
+    let silent = on(2, || group(&scene, &params, ()));
+    assert_eq!(silent.tree, g1.tree);
+    assert_eq!(silent.rounds, g1.rounds);
+    // The chunks' trees are the exact grouping's in quality terms (SAH within 5 %).
+    let exact = group(&scene, &Params::default(), ());
+    let (s_p, s_e) = (
+        wraptree::metrics::sah(&g1.tree),
+        wraptree::metrics::sah(&exact.tree),
+    );
+    assert!(s_p < 1.05 * s_e, "SAH partitioned {s_p} vs exact {s_e}");
+}
+
+#[test]
+fn exact_schedule_is_the_same_with_the_parallel_scan() {
+    // Above the parallel scan's threshold of active bodies, with and without ties by seed.
+    let scene = generate::soup(20_000, 3);
+    for seed in [None, Some(11)] {
+        let params = Params {
+            seed,
+            ..Params::default()
+        };
+        let (g1, log1) = on(1, || run(&scene, &params));
+        let (g2, log2) = on(2, || run(&scene, &params));
+        assert_eq!(log1, log2, "seed {seed:?}");
+        assert_eq!(g1.stats, g2.stats, "seed {seed:?}");
+        assert_eq!(g1.tree, g2.tree);
+    }
+}
+
+#[test]
+fn a_scene_smaller_than_a_chunk_gets_the_exact_tree() {
+    // The default chunk (δ = 4) and a wide one, so that the brute-force step meets scenes of
+    // up to 63 primitives.
+    for (chunking, max_n) in [
+        (Chunking::DEFAULT, Chunking::DEFAULT.delta as usize),
+        (
+            Chunking {
+                delta: 64,
+                ..Chunking::DEFAULT
+            },
+            64,
+        ),
+    ] {
+        let mut runner = proptest::test_runner::TestRunner::deterministic();
+        runner
+            .run(&(arb_scene(1, max_n), arb_params()), |(scene, params)| {
+                let exact = Params {
+                    mode: Mode::default(),
+                    ..params.clone()
+                };
+                let resolved = params.resolve(&scene);
+                let mut lp = EventLog::default();
+                let gp =
+                    group_with(&scene, &resolved, &chunking, &mut lp, &Budget::default()).unwrap();
+                let (ge, le) = run(&scene, &exact);
+                prop_assert_eq!(&gp.tree, &ge.tree);
+                let pairs = |l: &EventLog| {
+                    l.merges
+                        .iter()
+                        .map(|m| (m.a, m.b, m.round, m.cost.to_bits(), m.active))
+                        .collect::<Vec<_>>()
+                };
+                prop_assert_eq!(pairs(&lp), pairs(&le));
+                prop_assert_eq!(&lp.dormant, &le.dormant);
+                prop_assert_eq!(gp.rounds, ge.rounds);
+                prop_assert_eq!(le.parts.len(), 0);
+                prop_assert_eq!(lp.parts.len(), usize::from(scene.len() > 1));
+                Ok(())
+            })
+            .unwrap();
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    #[test]
+    fn generated_scenes_give_valid_trees_identical_on_1_and_2_threads(
+        scene in arb_scene(1, 400),
+        params in arb_params(),
+    ) {
+        let (g1, log1) = on(1, || run(&scene, &params));
+        check_tree(&scene, &g1, &log1);
+        if scene.len() > 1 {
+            check_parts(scene.len(), &log1);
+        }
+        let (g2, log2) = on(2, || run(&scene, &params));
+        prop_assert_eq!(&g1.tree, &g2.tree);
+        prop_assert_eq!(&log1, &log2);
+    }
+}
+
+#[test]
+fn hull_pset_runs_the_exact_schedule() {
+    let scene = generate::soup(200, 5);
+    let params = partitioned(Params {
+        pset: PSet::Hull,
+        ..Params::default()
+    });
+    let exact = Params {
+        pset: PSet::Hull,
+        ..Params::default()
+    };
+    let (gp, lp) = run(&scene, &params);
+    let (ge, le) = run(&scene, &exact);
+    assert_eq!(gp.tree, ge.tree);
+    assert_eq!(lp.merges, le.merges);
+}
+
+#[test]
+fn a_stopped_run_reports_a_prefix_of_the_merges() {
+    let scene = generate::soup(5_000, 9);
+    let params = partitioned(Params::default()).resolve(&scene);
+    let stop = AtomicBool::new(true);
+    let budget = Budget {
+        stop: Some(&stop),
+        ..Budget::default()
+    };
+    let mut log = EventLog::default();
+    let s = group_within(&scene, &params, &mut log, &budget).unwrap_err();
+    assert_eq!(s.reason, StopReason::Interrupted);
+    assert_eq!(s.merges as usize, log.merges.len());
+    assert_eq!(log.root, None);
+    let budget = Budget {
+        max_pairs: Some(100),
+        ..Budget::default()
+    };
+    let mut cut = EventLog::default();
+    let s = group_within(&scene, &params, &mut cut, &budget).unwrap_err();
+    assert_eq!(s.reason, StopReason::MaxPairs);
+    let (_, full) = run(&scene, &partitioned(Params::default()));
+    assert!(cut.merges.len() < full.merges.len());
+    assert_eq!(cut.merges[..], full.merges[..cut.merges.len()]);
+}
+
+#[test]
+fn replay_verifies_a_partitioned_recording() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut obj = Vec::new();
+    generate::soup(3_000, 4).write_obj(&mut obj).unwrap();
+    std::fs::write(dir.path().join("s.obj"), obj).unwrap();
+    let scene = wraptree::scene::load_path(&dir.path().join("s.obj"), &LoadOptions::default())
+        .unwrap()
+        .scene;
+    let out = wraptree(
+        &[
+            "record",
+            "s.obj",
+            "-o",
+            "p",
+            "--schedule",
+            "partitioned",
+            "--detail",
+            "merges",
+            "--threads",
+            "2",
+        ],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rec = wraptree::record::mcap::read_recording(&dir.path().join("p.mcap")).unwrap();
+    assert_eq!(rec.params.mode.schedule, Schedule::Partitioned);
+    assert!(rec.parts.len() > 10, "{} parts recorded", rec.parts.len());
+    let (_, log) = run(&scene, &partitioned(Params::default()));
+    assert_eq!(rec.parts, log.parts);
+    let out = wraptree(&["replay", "p.mcap", "--verify"], dir.path());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && text.contains("verified"),
+        "{text} {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = wraptree(
+        &[
+            "group",
+            "s.obj",
+            "--schedule",
+            "partitioned",
+            "--threads",
+            "1",
+        ],
+        dir.path(),
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("Partitioned on 1 thread"), "{text}");
+    let out = wraptree(&["group", "s.obj", "--threads", "0"], dir.path());
+    common::assert_one_line_error(&out, "--threads");
+}
