@@ -346,6 +346,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             rounds: round,
             params: self.params,
             stats: self.stats,
+            pregrouping: None,
         })
     }
 

@@ -381,6 +381,7 @@ pub fn group_with<O: Observer>(
             stale_pops: sub.stale_pops,
             peak_queue: sub.peak_queue,
         },
+        pregrouping: None,
     })
 }
 
