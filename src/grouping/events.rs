@@ -179,14 +179,12 @@ pub enum Event<'a> {
 
 /// Receives every [`Event`] of a grouping run, in order.
 pub trait Observer {
-    /// Whether this observer may use events at all. `false` (the silent `()`) lets schedules
-    /// that would buffer events (the partitioned one) skip that work.
-    const LISTENS: bool = true;
     /// Called once per event.
     fn on_event(&mut self, event: &Event<'_>);
 
     /// Whether this observer ignores every event, so that the algorithm may skip preparing
-    /// them (pre-grouping then buffers no events of its parallel parts). Default: false.
+    /// them (the partitioned schedule and pre-grouping then buffer no events of their parallel
+    /// parts). Default: false.
     fn is_silent(&self) -> bool {
         false
     }
@@ -194,7 +192,6 @@ pub trait Observer {
 
 /// The silent observer.
 impl Observer for () {
-    const LISTENS: bool = false;
     #[inline(always)]
     fn on_event(&mut self, _: &Event<'_>) {}
 
@@ -204,7 +201,6 @@ impl Observer for () {
 }
 
 impl<O: Observer + ?Sized> Observer for &mut O {
-    const LISTENS: bool = O::LISTENS;
     #[inline]
     fn on_event(&mut self, event: &Event<'_>) {
         (**self).on_event(event)
@@ -217,7 +213,6 @@ impl<O: Observer + ?Sized> Observer for &mut O {
 
 /// An optional observer (e.g. a progress bar shown only on a terminal).
 impl<O: Observer> Observer for Option<O> {
-    const LISTENS: bool = O::LISTENS;
     #[inline]
     fn on_event(&mut self, event: &Event<'_>) {
         if let Some(o) = self {
@@ -234,7 +229,6 @@ impl<O: Observer> Observer for Option<O> {
 pub struct Tee<A, B>(pub A, pub B);
 
 impl<A: Observer, B: Observer> Observer for Tee<A, B> {
-    const LISTENS: bool = A::LISTENS || B::LISTENS;
     #[inline]
     fn on_event(&mut self, event: &Event<'_>) {
         self.0.on_event(event);

@@ -31,7 +31,7 @@
 //! `RoundStart` or `Doubling` is emitted; each merge carries its subproblem's round, and a
 //! brute-force subproblem's `queue_len` is the number of its bodies that have an eligible
 //! partner after the merge. Events are buffered only when the observer listens
-//! ([`Observer::LISTENS`]). [`Grouping::rounds`] is the most rounds any subproblem ran.
+//! ([`Observer::is_silent`]). [`Grouping::rounds`] is the most rounds any subproblem ran.
 //!
 //! Budget: the stop flag and the deadline are checked before every subproblem and, in
 //! voxel-hash subproblems, as in the exact run. `max_pairs` caps the eligible pairs found at
@@ -274,7 +274,8 @@ pub fn group_with<O: Observer>(
     let mut children = vec![[0u32; 2]; merges];
     aabb.resize(2 * n - 1, Aabb::EMPTY);
     diameter.resize(2 * n - 1, 0.0);
-    let mut info = if O::LISTENS {
+    let listens = !observer.is_silent();
+    let mut info = if listens {
         vec![Info::default(); merges]
     } else {
         Vec::new()
@@ -293,7 +294,7 @@ pub fn group_with<O: Observer>(
         children: &mut children,
         aabb: new_aabb,
         diameter: new_d,
-        info: O::LISTENS.then_some(&mut info[..]),
+        info: listens.then_some(&mut info[..]),
         stats: SubStats::default(),
     };
     let (result, sub) = exec.node(nodes.len() as u32 - 1, (leaf_aabb, leaf_d), out);
@@ -305,7 +306,7 @@ pub fn group_with<O: Observer>(
             break;
         }
         let made = node.inputs - node.keep;
-        if O::LISTENS && made > 0 {
+        if listens && made > 0 {
             let kind = if node.level == 0 {
                 PartKind::Top
             } else {
