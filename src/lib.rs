@@ -12,5 +12,6 @@ pub mod peers;
 pub mod query;
 pub mod record;
 pub mod render;
+pub mod replay;
 pub mod scene;
 pub mod wrap;

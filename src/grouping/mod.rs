@@ -38,11 +38,14 @@
 mod cluster;
 pub mod events;
 mod hull_pset;
+mod limits;
 pub mod mpairs;
+mod pset;
 pub mod subset_tree;
 pub mod voxel_hash;
 
 pub use events::{Event, EventLog, Merge, Observer, Tee};
+pub use limits::Limits;
 pub use subset_tree::{NONE, SubsetTree};
 
 use crate::scene::Scene;

@@ -38,11 +38,12 @@ pub mod sphere;
 pub mod tightness;
 pub mod welzl;
 
+pub use crate::geom::Sphere;
 pub use hull::{HULL_TOL_REL, Hull, hull_tree};
 pub use kind::{WrapperKind, WrapperTree, Wrappers};
 pub use obb::{Obb, obb_tree};
 pub use order::LeafOrder;
-pub use sphere::{Sphere, SphereMethod, sphere_tree};
+pub use sphere::{SphereMethod, sphere_tree};
 pub use tightness::{
     DEFAULT_SAMPLES, LevelStats, NodeStats, containment_excess, level_tightness, node_tightness,
 };
