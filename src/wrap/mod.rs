@@ -9,7 +9,8 @@
 //! - [`obb`] — oriented boxes from the principal axes ([`crate::geom::pca`]);
 //! - [`kind`] — [`WrapperKind`] (`--wrapper`) and [`Wrappers`], several trees built together;
 //! - [`tightness`] — per-level volume, volume ratio and surface-to-geometry error;
-//! - [`distance`] — exact point–primitive distances with the Subset Tree as BVH.
+//! - [`distance`] — exact point–primitive distances with the Subset Tree as BVH;
+//! - [`report`] — build time, containment check and tightness of several trees together.
 //!
 //! Everything is `f64` except parry's hull decision (`f32`). Containment of every vertex below
 //! a node holds up to rounding for spheres, boxes and OBBs (tests allow 1e-9 × the scene
@@ -34,6 +35,7 @@ pub mod hull;
 pub mod kind;
 pub mod obb;
 pub mod order;
+pub mod report;
 pub mod sphere;
 pub mod tightness;
 pub mod welzl;
