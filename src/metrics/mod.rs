@@ -14,9 +14,8 @@
 //!
 //! Wrapper tightness per level comes from [`crate::wrap::level_tightness`]. [`compare`] runs
 //! every hierarchy builder × wrapper on a scene, [`sweep`] the A/B/C grid of the grouping
-//! phase, [`bench`] the targets table and the cost of recording, [`stress`] every builder on
-//! pathological scenes, and [`report`] writes their
-//! CSV, charts and `.rrd`.
+//! phase, [`bench`](mod@bench) the targets table and the cost of recording, [`stress`] every
+//! builder on pathological scenes, and [`report`] writes their CSV, charts and `.rrd`.
 
 pub mod bench;
 pub mod compare;

@@ -1,7 +1,7 @@
 //! Results of `bench`, `sweep` and `stress` as files: CSV tables, charts (SVG + PNG) and `.rrd` series.
 //!
-//! - [`bench`](mod@bench): `results.csv`, the two charts per scene and `bench.rrd`;
-//! - [`sweep`](mod@sweep): `sweep.csv`, the heat maps and `sweep.rrd`;
+//! - `bench`: `results.csv`, the two charts per scene and `bench.rrd`;
+//! - `sweep`: `sweep.csv`, the heat maps and `sweep.rrd`;
 //! - `stress`: `stress.csv` and the spaghetti sweep charts.
 
 mod bench;
