@@ -57,11 +57,13 @@ fn assert_png(path: &Path) {
 #[test]
 fn bench_writes_one_row_per_method_and_wrapper_with_charts_and_rrd() {
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("out");
+    let file = dir.path().join("file");
+    std::fs::write(&file, "not a directory").unwrap();
+    let not_dir = wraptree(&["bench", "robot-base", "-o", file.to_str().unwrap()]);
+    common::assert_one_line_error(&not_dir, "cannot create the output directory");
+    // A missing output directory is created with its parents.
+    let out = dir.path().join("new").join("out");
     let o = out.to_str().unwrap();
-    let missing = wraptree(&["bench", "robot-base", "-o", o]);
-    common::assert_one_line_error(&missing, "output directory does not exist");
-    std::fs::create_dir(&out).unwrap();
     let r = wraptree(&["bench", "robot-base", "soup:300", "-o", o, "--repeat", "1"]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();

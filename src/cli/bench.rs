@@ -1,22 +1,19 @@
 //! `wraptree bench`: every hierarchy builder × wrapper on given scenes (CSV, charts, `.rrd`),
 //! the targets table against obvhs PLOC and parry Binned measured in the same run, and (with
-//! `--record`) what recording costs.
+//! `--record`) what recording costs ([`wraptree::metrics::bench`]).
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Result, anyhow};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::Instant;
-use wraptree::grouping::{self, Params};
-use wraptree::metrics::{
-    self,
-    compare::{Options, Row, Wrapper, evaluate},
-    report::write_bench,
-};
-use wraptree::peers::{self, Method};
-use wraptree::query::{self, Bv, Workload};
+use wraptree::metrics::bench::{record_cost, record_scenes, target_rows, target_scenes};
+use wraptree::metrics::compare::{Options, Wrapper, evaluate};
+use wraptree::metrics::report::{bench_table, write_bench};
+use wraptree::peers::Method;
 use wraptree::record::Detail;
-use wraptree::scene::{LoadOptions, Loaded, Scene, generate, load_bytes, load_path};
+use wraptree::record::output::output_dir;
+use wraptree::scene::generate;
+use wraptree::scene::spec::{as_loaded, scene_spec};
 
 /// Arguments of `wraptree bench`.
 #[derive(Args, Debug)]
@@ -25,8 +22,8 @@ pub struct BenchCmd {
     /// KIND[:COUNT] (soup:100000, robot-bases:44, lamps:5, robot-base, lamp). Without scenes:
     /// the targets table on the standard scenes and the bundled meshes.
     scenes: Vec<String>,
-    /// Output directory for results.csv, charts and bench.rrd (with SCENEs) [default:
-    /// recordings/bench, created if missing; a given directory must exist].
+    /// Output directory for results.csv, charts and bench.rrd (with SCENEs), created with its
+    /// parents if missing [default: recordings/bench].
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Replace existing result files.
@@ -58,69 +55,12 @@ pub struct BenchCmd {
     record: bool,
 }
 
-fn best_of(repeat: u32, mut f: impl FnMut()) -> f64 {
-    (0..repeat.max(1))
-        .map(|_| {
-            let t = Instant::now();
-            f();
-            t.elapsed().as_secs_f64()
-        })
-        .fold(f64::INFINITY, f64::min)
-}
-
-/// The output directory: `given`, which must exist, or `default`, created if missing.
-pub(super) fn output_dir(given: Option<&std::path::Path>, default: &str) -> Result<PathBuf> {
-    match given {
-        Some(d) if d.is_dir() => Ok(d.to_path_buf()),
-        Some(d) => anyhow::bail!("{}: output directory does not exist", d.display()),
-        None => {
-            let d = PathBuf::from(default);
-            std::fs::create_dir_all(&d)
-                .with_context(|| format!("{}: cannot create the output directory", d.display()))?;
-            Ok(d)
-        }
+/// Loads a KIND[:COUNT] or OBJ scene spec, printing loader warnings to stderr.
+pub(super) fn load_spec(spec: &str) -> Result<wraptree::scene::Scene> {
+    let (scene, warnings) = scene_spec(spec)?;
+    for w in &warnings {
+        eprintln!("warning: {w}");
     }
-}
-
-/// A generated scene as if loaded from its OBJ (so recordings can embed it).
-fn as_loaded(scene: &Scene) -> Result<Loaded> {
-    let mut bytes = Vec::new();
-    scene.write_obj(&mut bytes)?;
-    Ok(load_bytes(
-        &format!("{}.obj", scene.name),
-        bytes,
-        &LoadOptions::default(),
-    )?)
-}
-
-/// Loads an OBJ path, or generates KIND[:COUNT] (COUNT = triangles for soup, copies for
-/// lamps/robot-bases).
-pub(super) fn scene_spec(spec: &str) -> Result<Scene> {
-    let path = std::path::Path::new(spec);
-    if path.exists() || spec.ends_with(".obj") {
-        let loaded = load_path(path, &LoadOptions::default())?;
-        for w in &loaded.warnings {
-            eprintln!("warning: {w}");
-        }
-        return Ok(loaded.scene);
-    }
-    let (kind, count) = match spec.split_once(':') {
-        Some((k, c)) => {
-            let c: usize = c
-                .parse()
-                .map_err(|_| anyhow!("{spec}: COUNT must be a whole number"))?;
-            (k, Some(c))
-        }
-        None => (spec, None),
-    };
-    let (copies, n) = if kind == "soup" {
-        (None, count)
-    } else {
-        (count, None)
-    };
-    let mut scene = generate::by_name(kind, copies, n, 1)
-        .map_err(|e| anyhow!("{spec}: not a file, and {e}"))?;
-    scene.name = spec.replace(':', "-");
     Ok(scene)
 }
 
@@ -146,7 +86,7 @@ impl BenchCmd {
         let scenes = self
             .scenes
             .iter()
-            .map(|s| scene_spec(s))
+            .map(|s| load_spec(s))
             .collect::<Result<Vec<_>>>()?;
         let opts = Options {
             methods: if self.methods.is_empty() {
@@ -173,7 +113,7 @@ impl BenchCmd {
             })
             .map_err(|e| anyhow!(e))?;
             bar.finish_and_clear();
-            print_rows(&r);
+            print!("{}", bench_table(&r.iter().collect::<Vec<_>>()));
             rows.extend(r);
         }
         for p in write_bench(&output, &rows, self.force)? {
@@ -184,24 +124,7 @@ impl BenchCmd {
 
     /// The targets: grouping time against obvhs PLOC, SAH and query cost against parry Binned.
     fn run_targets(&self) -> Result<ExitCode> {
-        let mut cases: Vec<Scene> = vec![generate::soup(10_000, 1)];
-        cases.push(generate::replicate(&generate::robot_base(), 44, 1));
-        for n in [100_000, 1_000_000] {
-            if n <= self.max_soup {
-                cases.push(generate::soup(n, 1));
-            }
-        }
-        let bundled = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
-        let mut meshes: Vec<_> = std::fs::read_dir(&bundled)
-            .map(|d| d.filter_map(|e| Some(e.ok()?.path())).collect())
-            .unwrap_or_default();
-        meshes.retain(|p: &PathBuf| p.extension().is_some_and(|e| e == "obj"));
-        meshes.sort();
-        for m in meshes {
-            let mut s = load_path(&m, &LoadOptions::default())?.scene;
-            s.name = m.file_stem().unwrap_or_default().to_string_lossy().into();
-            cases.push(s);
-        }
+        let cases = target_scenes(self.max_soup)?;
         println!(
             "{:<18} {:>8} {:>9} {:>9} {:>7} {:>9} {:>7} {:>8} {:>8} {:>6} {:>8}",
             "scene",
@@ -216,90 +139,26 @@ impl BenchCmd {
             "depth",
             "peak MB"
         );
-        let params = Params::default();
         let mut refined = Vec::new();
         let mut sped_up = Vec::new();
         for scene in &cases {
-            let n = scene.len();
-            let repeat = if n >= 1_000_000 {
-                self.repeat.min(2)
-            } else {
-                self.repeat
-            };
-            let workload = Workload::standard(scene, 1);
-            let run = |m: Method| -> Result<(f64, f64, f64, u32, peers::Built)> {
-                let mut best: Option<peers::Built> = None;
-                for _ in 0..repeat.max(1) {
-                    let b = peers::build(m, scene, &params).map_err(|e| anyhow!(e))?;
-                    if best.as_ref().is_none_or(|x| b.seconds < x.seconds) {
-                        best = Some(b);
-                    }
-                }
-                let b = best.expect("ran at least once");
-                let q = query::measure(&b.tree, scene, Bv::Aabb, &workload);
-                let tests = wraptree::metrics::compare::query_values(&q)[6];
-                let (sah, depth) = (metrics::sah(&b.tree), b.tree.depth_max());
-                Ok((b.seconds, sah, tests, depth, b))
-            };
-            let (t, sah, qc, depth, plain) = run(Method::Grouping)?;
-            let (tp, ..) = run(Method::ObvhsPloc)?;
-            let (tb, sah_b, qc_b, _, _) = run(Method::ParryBinned)?;
-            let (_, sah_r, qc_r, _, built_r) = run(Method::GroupingRefine)?;
-            let (_, sah_o, qc_o, ..) = run(Method::ObvhsPlocReinsert)?;
-            refined.push((
-                scene.name.clone(),
-                built_r.refine_seconds / tp,
-                sah_r / sah_b.min(sah_o),
-                qc_r / qc_b.min(qc_o),
-            ));
-            // The §1.3 speed-ups with 1 and 2 threads, against the plain grouping.
-            let volumes = n <= 50_000;
-            let vol = |b: &peers::Built| metrics::level_volume(&b.tree, scene, 3);
-            let (box8, hull8) = if volumes { vol(&plain) } else { (1.0, 1.0) };
-            for m in [
-                Method::GroupingPregroup,
-                Method::GroupingInstanced,
-                Method::GroupingObjects,
-            ] {
-                for threads in [1, 2] {
-                    let pool = rayon::ThreadPoolBuilder::new()
-                        .num_threads(threads)
-                        .build()?;
-                    let (tm, sah_m, qc_m, depth_m, built) = pool.install(|| run(m))?;
-                    let (bm, hm) = if volumes {
-                        vol(&built)
-                    } else {
-                        (f64::NAN, f64::NAN)
-                    };
-                    sped_up.push(format!(
-                        "{:<18} {:<19} {:>3} {:>9.2} {:>7.2} {:>7.2} {:>8.3} {:>8.3} {:>6} {:>8.3} {:>8.3}",
-                        scene.name,
-                        m.name(),
-                        threads,
-                        tm * 1e3,
-                        tm / tp,
-                        tm / t,
-                        sah_m / sah,
-                        qc_m / qc,
-                        depth_m,
-                        bm / box8,
-                        hm / hull8
-                    ));
-                }
-            }
+            let (r, refine, speedups) = target_rows(scene, self.repeat)?;
+            let (t, tp, tb) = (r.group_seconds, r.ploc_seconds, r.binned_seconds);
+            refined.push(refine);
+            sped_up.extend(speedups);
             println!(
                 "{:<18} {:>8} {:>9.2} {:>9.2} {:>7.2} {:>9.2} {:>7.2} {:>8.3} {:>8.3} {:>6} {:>8.0}",
-                scene.name,
-                n,
+                r.scene,
+                r.n,
                 t * 1e3,
                 tp * 1e3,
                 t / tp,
                 tb * 1e3,
                 t / tb,
-                sah / sah_b,
-                qc / qc_b,
-                depth,
-                super::peak_rss_bytes().unwrap_or(0) as f64 / 1e6
+                r.sah_ratio,
+                r.query_ratio,
+                r.depth,
+                r.peak_rss_bytes.unwrap_or(0) as f64 / 1e6
             );
         }
         println!("t/PLOC = grouping time / obvhs PLOC build time; t/bin = / parry3d Bvh Binned.");
@@ -313,8 +172,11 @@ impl BenchCmd {
             "{:<18} {:>10} {:>9} {:>9}",
             "scene", "ref/PLOC", "SAH/best", "qry/best"
         );
-        for (name, t, s, q) in &refined {
-            println!("{name:<18} {t:>10.2} {s:>9.3} {q:>9.3}");
+        for r in &refined {
+            println!(
+                "{:<18} {:>10.2} {:>9.3} {:>9.3}",
+                r.scene, r.refine_per_ploc, r.sah_per_best, r.query_per_best
+            );
         }
         println!("grouping+refine: ref/PLOC = refinement time alone / obvhs PLOC build time;");
         println!(
@@ -336,8 +198,21 @@ impl BenchCmd {
             "box8/grp",
             "hull8/grp"
         );
-        for line in &sped_up {
-            println!("{line}");
+        for r in &sped_up {
+            println!(
+                "{:<18} {:<19} {:>3} {:>9.2} {:>7.2} {:>7.2} {:>8.3} {:>8.3} {:>6} {:>8.3} {:>8.3}",
+                r.scene,
+                r.method.name(),
+                r.threads,
+                r.seconds * 1e3,
+                r.per_ploc,
+                r.per_grouping,
+                r.sah_ratio,
+                r.query_ratio,
+                r.depth,
+                r.box8_ratio,
+                r.hull8_ratio
+            );
         }
         println!("The paper's §1.3 speed-ups (pregroup: connected components grouped first;");
         println!("instanced: and rigid copies copy-moved; objects: the scene's objects as");
@@ -357,12 +232,6 @@ impl BenchCmd {
     }
 
     fn run_record(&self) -> Result<ExitCode> {
-        let lamp = generate::lamp();
-        let cases = [
-            generate::replicate(&lamp, 5, 1),
-            generate::replicate(&generate::robot_base(), 44, 1),
-            generate::soup(100_000, 1),
-        ];
         let details = [Detail::Levels, Detail::Merges, Detail::Full];
         let dir = tempfile::tempdir()?;
         // The fixed cost of a recording: two triangles, one merge.
@@ -370,8 +239,7 @@ impl BenchCmd {
         let mut fixed = [0.0; 3];
         for (f, &detail) in fixed.iter_mut().zip(&details) {
             let prefix = dir.path().join(format!("fixed-{detail:?}"));
-            let (pairs, _) = self.record_pairs(&tiny, detail, &prefix)?;
-            *f = pairs.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+            *f = record_cost(&tiny, detail, &prefix, self.repeat)?.record_seconds;
         }
         println!(
             "{:<16} {:>7} {:>8} {:>9} {:>10} {:>7} {:>7} {:>8} {:>8} {:>8}",
@@ -386,21 +254,12 @@ impl BenchCmd {
             "rrd MB",
             "mcap MB"
         );
-        for scene in &cases {
+        for scene in &record_scenes() {
             let loaded = as_loaded(scene)?;
             for (&detail, &fixed) in details.iter().zip(&fixed) {
                 let prefix = dir.path().join(format!("{}-{detail:?}", scene.name));
-                let (pairs, w) = self.record_pairs(&loaded, detail, &prefix)?;
-                let t_group = pairs.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
-                let t_rec = pairs.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
-                let mut ratios: Vec<f64> = pairs.iter().map(|(g, r)| r / g).collect();
-                ratios.sort_by(f64::total_cmp);
-                let median = ratios[ratios.len() / 2];
-                let mb = |p: &std::path::Path| {
-                    std::fs::metadata(p)
-                        .map(|m| m.len() as f64 / 1e6)
-                        .unwrap_or(0.0)
-                };
+                let c = record_cost(&loaded, detail, &prefix, self.repeat)?;
+                let (t_group, t_rec) = (c.group_seconds, c.record_seconds);
                 println!(
                     "{:<16} {:>7} {:>8} {:>9.1} {:>10.1} {:>7.2} {:>7.2} {:>8.2} {:>8.2} {:>8.2}",
                     scene.name,
@@ -409,10 +268,10 @@ impl BenchCmd {
                     t_group * 1e3,
                     t_rec * 1e3,
                     t_rec / t_group,
-                    median,
+                    c.median_ratio,
                     (t_rec - fixed).max(0.0) / t_group,
-                    mb(&w.rrd),
-                    mb(&w.mcap)
+                    c.rrd_bytes as f64 / 1e6,
+                    c.mcap_bytes as f64 / 1e6
                 );
             }
         }
@@ -431,39 +290,6 @@ impl BenchCmd {
         );
         Ok(ExitCode::SUCCESS)
     }
-
-    /// `repeat` pairs of (grouping alone, grouping recorded) wall times for `loaded`, each
-    /// recorded run just after its grouping-only run so that a slow spell of the machine weighs
-    /// on both sides of a pair; and where the last recording went.
-    fn record_pairs(
-        &self,
-        loaded: &Loaded,
-        detail: Detail,
-        prefix: &std::path::Path,
-    ) -> Result<(Vec<(f64, f64)>, super::record::Written)> {
-        let params = Params::default().resolve(&loaded.scene);
-        let mut written = None;
-        let pairs = (0..self.repeat.max(1))
-            .map(|_| {
-                let t_group = best_of(1, || {
-                    std::hint::black_box(grouping::group(&loaded.scene, &Params::default(), ()));
-                });
-                let t_rec = best_of(1, || {
-                    written = Some(super::record::record(
-                        &loaded.scene,
-                        &loaded.source,
-                        &params,
-                        detail,
-                        prefix,
-                        true,
-                        true,
-                    ));
-                });
-                (t_group, t_rec)
-            })
-            .collect();
-        Ok((pairs, written.expect("ran at least once")?))
-    }
 }
 
 /// A bar over methods on stderr, hidden when stderr is not a terminal.
@@ -480,10 +306,4 @@ pub(super) fn method_bar(len: usize, scene: &str) -> indicatif::ProgressBar {
     }
     bar.set_prefix(scene.to_string());
     bar
-}
-
-/// Prints one scene's comparison rows as a markdown table.
-fn print_rows(rows: &[Row]) {
-    let rows: Vec<&Row> = rows.iter().collect();
-    print!("{}", wraptree::metrics::report::bench_table(&rows));
 }

@@ -4,9 +4,8 @@ use super::{GroupArgs, SceneArgs};
 use anyhow::Result;
 use clap::Args;
 use std::process::ExitCode;
-use std::sync::atomic::AtomicBool;
-use std::time::{Duration, Instant};
-use wraptree::grouping::{self, Budget, Event, Observer, StopReason, Stopped};
+use std::time::Instant;
+use wraptree::grouping::{self, Event, Limits, Observer, StopReason};
 
 /// Exit code of a run stopped by `--max-seconds` or `--max-pairs`.
 pub const EXIT_BUDGET: u8 = 3;
@@ -26,48 +25,14 @@ pub struct BudgetArgs {
 }
 
 impl BudgetArgs {
-    /// Checks the values: `--max-seconds` must be a finite number > 0.
-    pub fn check(&self) -> Result<()> {
-        if let Some(s) = self.max_seconds
-            && !(s.is_finite() && s > 0.0)
-        {
-            anyhow::bail!("--max-seconds must be a finite number > 0, got {s}");
-        }
-        Ok(())
-    }
-
-    /// The budget of a grouping starting now, with the stop flag `stop` if any.
-    pub fn budget<'a>(&self, stop: Option<&'a AtomicBool>) -> Budget<'a> {
-        Budget {
-            stop,
-            // Beyond ~10^10 s `checked_add` fails: no deadline, as good as none.
-            deadline: self
-                .max_seconds
-                .and_then(|s| Instant::now().checked_add(Duration::from_secs_f64(s.min(1e10)))),
+    /// Checks the values and turns them into [`Limits`].
+    pub fn limits(&self) -> Result<Limits> {
+        let limits = Limits {
+            max_seconds: self.max_seconds,
             max_pairs: self.max_pairs,
-        }
-    }
-
-    /// One line saying what stopped a run of `n` primitives, e.g. `grouping stopped by
-    /// --max-pairs 1000 after 12 of 275 merges (1043 eligible pairs found)`.
-    pub fn message(&self, s: &Stopped, n: usize) -> String {
-        let by = match s.reason {
-            StopReason::Interrupted => "grouping interrupted".to_string(),
-            StopReason::MaxSeconds => format!(
-                "grouping stopped by --max-seconds {}",
-                self.max_seconds.unwrap_or(f64::NAN)
-            ),
-            StopReason::MaxPairs => format!(
-                "grouping stopped by --max-pairs {}",
-                self.max_pairs.unwrap_or(0)
-            ),
         };
-        format!(
-            "{by} after {} of {} merges ({} eligible pairs found)",
-            s.merges,
-            n.saturating_sub(1),
-            s.eligible_pairs
-        )
+        limits.check().map_err(anyhow::Error::msg)?;
+        Ok(limits)
     }
 
     /// The exit code of a run stopped for `reason`.
@@ -131,17 +96,17 @@ impl GroupCmd {
         let loaded = self.scene.load()?;
         let params = self.group.params()?;
         let threads = self.group.threads()?;
-        self.limits.check()?;
+        let limits = self.limits.limits()?;
         let scene = &loaded.scene;
         let start = Instant::now();
-        let g = if self.limits.max_seconds.is_none() && self.limits.max_pairs.is_none() {
+        let g = if limits.is_none() {
             match Progress::for_merges(scene.len() as u64) {
                 Some(p) => grouping::group(scene, &params, p),
                 None => grouping::group(scene, &params, ()),
             }
         } else {
             let resolved = params.resolve(scene);
-            let budget = self.limits.budget(None);
+            let budget = limits.budget(None);
             let run = match Progress::for_merges(scene.len() as u64) {
                 Some(p) => grouping::group_within(scene, &resolved, p, &budget),
                 None => grouping::group_within(scene, &resolved, (), &budget),
@@ -150,7 +115,7 @@ impl GroupCmd {
                 Ok(g) => g,
                 Err(s) => {
                     let file = self.scene.scene.display();
-                    eprintln!("error: {file}: {}", self.limits.message(&s, scene.len()));
+                    eprintln!("error: {file}: {}", limits.message(&s, scene.len()));
                     return Ok(BudgetArgs::exit_code(s.reason));
                 }
             }
@@ -169,7 +134,7 @@ impl GroupCmd {
                 "params": g.params,
                 "stats": g.stats,
                 "pregrouping": g.pregrouping,
-                "peak_rss_bytes": super::peak_rss_bytes(),
+                "peak_rss_bytes": wraptree::metrics::peak_rss_bytes(),
                 "parent": t.parent_i64(),
             });
             println!("{out}");

@@ -1,20 +1,17 @@
-//! `wraptree replay`: rebuild, verify or re-weight a run from its `.mcap` recording.
+//! `wraptree replay`: rebuild, verify or re-weight a run from its `.mcap` recording
+//! ([`wraptree::replay`]).
 
-use super::group::BudgetArgs;
-use super::record::{Logged, Options, exit_code, output_prefix, record_with, report};
-use anyhow::{Context, Result, bail};
+use super::group::{BudgetArgs, Progress};
+use super::record::{exit_code, report, stop_flag};
+use anyhow::{Context, Result};
 use clap::Args;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
-use wraptree::grouping::{
-    Event, EventLog, Merge, Observer, ResolvedParams, Stopped, SubsetTree, Weights, group_within,
-};
-use wraptree::record::Detail;
-use wraptree::record::mcap::{Recorded, metadata, read_recording};
-use wraptree::refine;
-use wraptree::scene::{Loaded, load_bytes};
-use wraptree::wrap::WrapperKind;
+use wraptree::grouping::{Merge, Part};
+use wraptree::record::mcap::metadata;
+use wraptree::record::output::output_prefix;
+use wraptree::record::{Detail, RecordOptions};
+use wraptree::replay::{self, RefineVerified, Replay, Verified, balance_stats};
 
 /// Arguments of `wraptree replay`.
 #[derive(Args, Debug)]
@@ -33,7 +30,8 @@ pub struct ReplayCmd {
     /// Re-run with this Balance weight C.
     #[arg(long)]
     c: Option<f64>,
-    /// Output prefix for the re-weighted recordings [default: recordings/<stem>-a<A>-b<B>-c<C>].
+    /// Output prefix for the re-weighted recordings [default: recordings/<stem>-a<A>-b<B>-c<C>];
+    /// the prefix's directory must exist.
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// What the re-weighted recordings hold.
@@ -45,113 +43,6 @@ pub struct ReplayCmd {
     /// Limits on the re-run of --verify and --a/--b/--c.
     #[command(flatten)]
     limits: BudgetArgs,
-}
-
-/// The magic bytes that open every Rerun `.rrd` stream, and the 8 bytes before the entry count
-/// that close a finished one (`RRF2FOOT`).
-const RRD_MAGIC: &[u8; 4] = b"RRF2";
-const RRD_FOOTER: &[u8; 8] = b"RRF2FOOT";
-/// The magic bytes that open an MCAP file.
-const MCAP_MAGIC: &[u8; 8] = b"\x89MCAP0\r\n";
-
-/// Why `path` cannot be what `replay` reads, when its first and last bytes say so: a Rerun
-/// `.rrd` file (finished, truncated or with a bad magic) or an empty file. `None` for anything
-/// else, which the MCAP reader then judges.
-pub fn not_an_mcap(path: &Path) -> Option<String> {
-    use std::io::{Read, Seek, SeekFrom};
-    let mut f = std::fs::File::open(path).ok()?;
-    let len = f.metadata().ok()?.len();
-    let name = path.display();
-    if len == 0 {
-        return Some(format!("{name}: empty file (not a recording)"));
-    }
-    let mut head = [0u8; 8];
-    let n = f.read(&mut head).ok()?;
-    let head = &head[..n];
-    let is_rrd = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("rrd"));
-    let mcap = path.with_extension("mcap");
-    let hint = if mcap != path && mcap.is_file() {
-        format!("replay reads the .mcap beside it ({})", mcap.display())
-    } else {
-        "replay reads the .mcap that `record` writes beside the .rrd".to_string()
-    };
-    if head.starts_with(RRD_MAGIC) {
-        let mut tail = [0u8; 12];
-        let finished = len >= 24
-            && f.seek(SeekFrom::End(-12)).is_ok()
-            && f.read_exact(&mut tail).is_ok()
-            && tail.starts_with(RRD_FOOTER);
-        let what = if finished {
-            "a Rerun .rrd recording"
-        } else {
-            "a truncated Rerun .rrd recording (no footer)"
-        };
-        return Some(format!("{name}: {what}, not an MCAP file; {hint}"));
-    }
-    if is_rrd && !head.starts_with(MCAP_MAGIC) {
-        return Some(format!(
-            "{name}: not a Rerun recording (bad magic, expected RRF2) nor an MCAP file"
-        ));
-    }
-    None
-}
-
-/// An observer that keeps the event log and sets `stop` once `limit` merges are made, so a
-/// re-run of an incomplete recording ends where the recording did.
-struct UpTo<'a> {
-    log: EventLog,
-    limit: Option<usize>,
-    stop: &'a AtomicBool,
-}
-
-impl Observer for UpTo<'_> {
-    fn on_event(&mut self, event: &Event<'_>) {
-        self.log.on_event(event);
-        if self.limit.is_some_and(|k| self.log.merges.len() >= k) {
-            self.stop.store(true, Ordering::Relaxed);
-        }
-    }
-}
-
-/// The Subset Tree rebuilt from the recorded merges alone (leaf boxes from the embedded scene).
-fn tree_of(rec: &Recorded, loaded: &Loaded) -> Result<SubsetTree> {
-    rec.tree(&loaded.scene).map_err(anyhow::Error::msg)
-}
-
-/// Re-runs the grouping within `limits`, up to `merges` merges when given (the length of an
-/// incomplete recording). Err: the stop, when a limit of `limits` ended the re-run first.
-fn rerun(
-    loaded: &Loaded,
-    params: &ResolvedParams,
-    limits: &BudgetArgs,
-    merges: Option<usize>,
-) -> Result<EventLog, Stopped> {
-    let stop = AtomicBool::new(merges == Some(0));
-    let mut obs = UpTo {
-        log: EventLog::default(),
-        limit: merges,
-        stop: &stop,
-    };
-    let budget = limits.budget(Some(&stop));
-    match group_within(&loaded.scene, params, &mut obs, &budget) {
-        Ok(_) => Ok(obs.log),
-        // Our own flag, set at the recorded length: the re-run went as far as the recording.
-        Err(s) if s.reason == wraptree::grouping::StopReason::Interrupted => Ok(obs.log),
-        Err(s) => Err(s),
-    }
-}
-
-/// A merge without `queue_len`, which depends on how MPairs stores pairs (it changed between
-/// versions), not on which pair merges.
-fn decision(m: &Merge) -> Merge {
-    Merge { queue_len: 0, ..*m }
-}
-
-/// Index of the first merge where two timelines make a different decision, if any.
-fn first_divergence(a: &[Merge], b: &[Merge]) -> Option<usize> {
-    (0..a.len().max(b.len())).find(|&i| a.get(i).map(decision) != b.get(i).map(decision))
 }
 
 /// A table row: field name and how to print it from a merge.
@@ -179,34 +70,13 @@ fn side_by_side(i: usize, left: (&str, Option<&Merge>), right: (&str, Option<&Me
     }
 }
 
-/// Mean and largest Balance over a run's merges.
-fn balance_stats(m: &[Merge]) -> (f64, f64) {
-    let mean = m.iter().map(|x| x.balance).sum::<f64>() / m.len().max(1) as f64;
-    (mean, m.iter().map(|x| x.balance).fold(1.0, f64::max))
-}
-
 impl ReplayCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
-        self.limits.check()?;
-        if let Some(why) = not_an_mcap(&self.file) {
-            bail!("{why}");
-        }
-        let rec = read_recording(&self.file)?;
+        let limits = self.limits.limits()?;
+        let replay = replay::open(&self.file)?;
+        let (rec, loaded) = (&replay.rec, &replay.loaded);
         let name = self.file.display().to_string();
-        let loaded = load_bytes(
-            &rec.scene_file_name,
-            rec.scene_bytes.clone(),
-            &rec.load_options,
-        )
-        .with_context(|| format!("{name}: the embedded scene does not load"))?;
-        if loaded.scene.len() as u32 != rec.primitives {
-            bail!(
-                "{name}: the embedded scene has {} primitives, the metadata says {}",
-                loaded.scene.len(),
-                rec.primitives
-            );
-        }
         let n = rec.primitives;
         let p = &rec.params;
         println!(
@@ -214,10 +84,9 @@ impl ReplayCmd {
             rec.scene_name, p.weights.a, p.weights.b, p.weights.c, p.dlimit0, p.glimit0, p.pset
         );
         if rec.complete {
-            let mut t = tree_of(&rec, &loaded)
+            let t = replay::final_tree(&replay)
                 .with_context(|| format!("{name}: the merge events do not form a tree"))?;
             if let Some(r) = &rec.refine {
-                t = refine::refine(&t, &r.params, ()).tree;
                 println!(
                     "refined ({} passes at most, first batch {}): {} moves, SAH {:.6} -> {:.6}",
                     r.params.passes, r.params.batch, r.steps, r.sah_before, r.sah_after
@@ -242,127 +111,90 @@ impl ReplayCmd {
             );
         }
         if self.verify {
-            let upto = (!rec.complete).then_some(rec.merges.len());
-            let log = match rerun(&loaded, &rec.params, &self.limits, upto) {
-                Ok(log) => log,
+            match replay::verify(&replay, &limits) {
                 Err(s) => {
-                    let msg = self.limits.message(&s, loaded.scene.len());
+                    let msg = limits.message(&s, loaded.scene.len());
                     eprintln!("error: {name}: --verify re-run: {msg}");
                     return Ok(BudgetArgs::exit_code(s.reason));
                 }
-            };
-            let k = rec.parts.len();
-            if log.parts.get(..k) != Some(&rec.parts[..]) || (rec.complete && log.parts.len() != k)
-            {
-                let i = (0..k)
-                    .find(|&i| log.parts.get(i) != Some(&rec.parts[i]))
-                    .unwrap_or(k);
-                let show = |p: Option<&wraptree::grouping::Part>| {
-                    p.map_or("none".to_string(), |p| p.to_string())
-                };
-                eprintln!(
-                    "error: {name}: --verify: part {i} differs: recorded {}, re-run {}",
-                    show(rec.parts.get(i)),
-                    show(log.parts.get(i))
-                );
-                return Ok(ExitCode::FAILURE);
-            }
-            match first_divergence(&rec.merges, &log.merges) {
-                None if !rec.complete => println!(
-                    "verified: the {0} recorded merges match the re-run's first {0} (the recording stopped there)",
-                    rec.merges.len()
+                Ok(Verified::Prefix { merges }) => println!(
+                    "verified: the {merges} recorded merges match the re-run's first {merges} (the recording stopped there)"
                 ),
-                None => {
-                    println!(
-                        "verified: the merge sequence is identical ({} merges)",
-                        log.merges.len()
-                    );
-                    if rec
-                        .merges
-                        .iter()
-                        .zip(&log.merges)
-                        .any(|(r, l)| r.queue_len != l.queue_len)
-                    {
+                Ok(Verified::Identical {
+                    merges,
+                    queue_lengths_differ,
+                }) => {
+                    println!("verified: the merge sequence is identical ({merges} merges)");
+                    if queue_lengths_differ {
                         println!(
                             "note: MPairs queue lengths differ (the queue's storage changed between versions)"
                         );
                     }
                 }
-                Some(i) => {
+                Ok(Verified::PartDiffers {
+                    index,
+                    recorded,
+                    rerun,
+                }) => {
+                    let show = |p: Option<Part>| p.map_or("none".to_string(), |p| p.to_string());
+                    eprintln!(
+                        "error: {name}: --verify: part {index} differs: recorded {}, re-run {}",
+                        show(recorded),
+                        show(rerun)
+                    );
+                    return Ok(ExitCode::FAILURE);
+                }
+                Ok(Verified::Diverged { step, rerun }) => {
                     side_by_side(
-                        i,
-                        ("recorded", rec.merges.get(i)),
-                        ("re-run", log.merges.get(i)),
+                        step,
+                        ("recorded", rec.merges.get(step)),
+                        ("re-run", rerun.merges.get(step)),
                     );
                     return Ok(ExitCode::FAILURE);
                 }
             }
-            if let (Some(r), true) = (&rec.refine, rec.complete) {
-                let t = tree_of(&rec, &loaded)?;
-                let mut steps = EventLog::default();
-                refine::refine(&t, &r.params, &mut steps);
-                match (0..rec.refine_steps.len().max(steps.refine.len()))
-                    .find(|&i| rec.refine_steps.get(i) != steps.refine.get(i))
-                {
-                    None => println!(
-                        "verified: the refinement's moves are identical ({} moves)",
-                        steps.refine.len()
-                    ),
-                    Some(i) => {
-                        println!("first refinement divergence at step {i}:");
-                        println!("  recorded: {:?}", rec.refine_steps.get(i));
-                        println!("  re-run:   {:?}", steps.refine.get(i));
-                        return Ok(ExitCode::FAILURE);
-                    }
+            match replay::verify_refinement(&replay)? {
+                None => {}
+                Some(RefineVerified::Identical { moves }) => {
+                    println!("verified: the refinement's moves are identical ({moves} moves)")
+                }
+                Some(RefineVerified::Diverged {
+                    step,
+                    recorded,
+                    rerun,
+                }) => {
+                    println!("first refinement divergence at step {step}:");
+                    println!("  recorded: {recorded:?}");
+                    println!("  re-run:   {rerun:?}");
+                    return Ok(ExitCode::FAILURE);
                 }
             }
         }
         if self.a.is_some() || self.b.is_some() || self.c.is_some() {
-            return self.reweight(&rec, &loaded);
+            return self.reweight(&replay, limits);
         }
         Ok(ExitCode::SUCCESS)
     }
 
-    fn reweight(&self, rec: &Recorded, loaded: &Loaded) -> Result<ExitCode> {
-        let w = rec.params.weights;
-        let weights = Weights {
-            a: self.a.unwrap_or(w.a),
-            b: self.b.unwrap_or(w.b),
-            c: self.c.unwrap_or(w.c),
-        };
-        weights.check().map_err(|e| anyhow::anyhow!("--{e}"))?;
-        let params = ResolvedParams {
-            weights,
-            ..rec.params
-        };
+    fn reweight(&self, replay: &Replay, limits: wraptree::grouping::Limits) -> Result<ExitCode> {
+        let (rec, loaded) = (&replay.rec, &replay.loaded);
+        let weights = replay::weights(rec, self.a, self.b, self.c)?;
         let suffix = format!("-a{}-b{}-c{}", weights.a, weights.b, weights.c);
         let prefix = output_prefix(self.output.as_deref(), &rec.scene_file_name, &suffix)?;
-        let kinds = [WrapperKind::Sphere];
-        let logged = Logged {
-            kinds: &kinds,
-            cover: None,
+        let opts = RecordOptions {
+            detail: self.detail,
+            force: self.force,
+            limits,
+            stop: Some(stop_flag()),
+            refine: rec.refine.map(|r| r.params),
+            ..RecordOptions::default()
         };
-        let written = record_with(
-            &loaded.scene,
-            &loaded.source,
-            &params,
-            self.detail,
-            &prefix,
-            Options {
-                force: self.force,
-                reproducible: false,
-                limits: self.limits,
-                refine: rec.refine.map(|r| r.params),
-            },
-            logged,
-        )?;
-        let Some(g) = &written.grouping else {
-            report(&written, &loaded.scene);
-            return Ok(exit_code(&written));
+        let progress = Progress::for_merges(loaded.scene.len() as u64);
+        let r = replay::reweight(replay, weights, &prefix, &opts, progress)?;
+        let (Some(g), Some(log)) = (&r.written.grouping, &r.log) else {
+            report(&r.written, &loaded.scene);
+            return Ok(exit_code(&r.written));
         };
-        // The same run again for its events: it finished within the limits just now.
-        let log = rerun(loaded, &params, &BudgetArgs::default(), None)
-            .expect("an unlimited re-run is never stopped");
         let pairs = |m: &[Merge]| m.iter().map(|x| (x.a, x.b)).collect::<Vec<_>>();
         let (old_pairs, new_pairs) = (pairs(&rec.merges), pairs(&log.merges));
         match (0..old_pairs.len().max(new_pairs.len()))
@@ -378,7 +210,7 @@ impl ReplayCmd {
                 ("re-weighted", log.merges.get(i)),
             ),
         }
-        let old = tree_of(rec, loaded)?;
+        let old = replay.tree()?;
         let (ob, obmax) = balance_stats(&rec.merges);
         let (nb, nbmax) = balance_stats(&log.merges);
         println!("  {:<22} {:>12} {:>12}", "", "recorded", "re-weighted");
@@ -397,7 +229,7 @@ impl ReplayCmd {
         println!("  {:<22} {:>12.3} {:>12.3}", "Balance mean", ob, nb);
         println!("  {:<22} {:>12.3} {:>12.3}", "Balance max", obmax, nbmax);
         println!("  {:<22} {:>12} {:>12}", "rounds", rec.rounds, g.rounds);
-        report(&written, &loaded.scene);
-        Ok(ExitCode::SUCCESS)
+        report(&r.written, &loaded.scene);
+        Ok(exit_code(&r.written))
     }
 }

@@ -1,44 +1,20 @@
-//! `wraptree stress`: every builder on every pathological scene ([`pathological`]), each case
-//! under a time budget, and a sweep of the spaghetti aspect ratio with and without
-//! `--split-aspect` (the §2.3 worst case, "a box of spaghetti", and the §4 mitigation).
-//!
-//! Per case it records whether the build finished within the budget, whether the tree is valid
-//! (every leaf once under the root, each leaf box holding its primitive, each child box inside
-//! its parent's, depths consistent; for Wrapper Trees, every vertex below a node inside its
-//! wrapper), the time, the depth, and for the grouping phase k = eligible pairs per body
-//! (`Stats::eligible_pairs / N`, the paper's k of §2.3) and candidates examined per body.
-//!
-//! A case runs on its own thread. Groupings get a stop flag that is set when the budget runs
-//! out (the run then returns within one merge or scan block); other builders cannot be stopped,
-//! so a case past its budget is reported as a timeout and its thread left to finish in the
-//! background (of the default cases, only the hull Wrapper Tree of 1,024-vertex polygons does).
-//!
-//! Two sweeps group parallel spaghetti with the AABB p-set as it is and split at `--split`:
-//! against the aspect ratio at fixed N (`spaghetti.{svg,png}`) and against N at aspect 64
-//! (`spaghetti-n.{svg,png}`); their rows are also in `stress.csv`.
-
-mod report;
+//! `wraptree stress`: every builder on pathological scenes under a time budget
+//! ([`wraptree::metrics::stress`]).
 
 use anyhow::Result;
 use clap::Args;
-use report::{Row, csv, print_table, sweep_chart};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, mpsc};
-use std::time::{Duration, Instant};
-use wraptree::grouping::{self, Grouping, PSet, Params, SubsetTree};
-use wraptree::peers;
-use wraptree::scene::pathological::{self, Layout};
-use wraptree::scene::{Scene, split};
-use wraptree::wrap::{
-    HULL_TOL_REL, SphereMethod, WrapperTree, containment_excess, hull_tree, obb_tree, sphere_tree,
-};
+use std::time::Duration;
+use wraptree::metrics::report::stress_table;
+use wraptree::metrics::stress::{self, Step, StressOptions, check_outputs};
+use wraptree::record::output::output_dir;
 
 /// Arguments of `wraptree stress`.
 #[derive(Args, Debug)]
 pub struct StressCmd {
-    /// Output directory for stress.csv, spaghetti{,-n}.{svg,png} [default: recordings/stress].
+    /// Output directory for stress.csv, spaghetti{,-n}.{svg,png}, created with its parents if
+    /// missing [default: recordings/stress].
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Small scenes (300 primitives, 10 n-gons) and three aspect ratios: seconds, not minutes.
@@ -55,364 +31,28 @@ pub struct StressCmd {
     force: bool,
 }
 
-/// How a case on a thread ended.
-enum Outcome<T> {
-    Done(T, f64),
-    Timeout,
-    Panicked,
-}
-
-/// Runs `f` on a thread; `Timeout` if it takes longer than `budget` (after setting `stop`, if
-/// given, and allowing the run another second to notice it).
-fn on_thread<T: Send + 'static>(
-    budget: Duration,
-    stop: Option<Arc<AtomicBool>>,
-    f: impl FnOnce() -> T + Send + 'static,
-) -> Outcome<T> {
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        let t = Instant::now();
-        let r = f();
-        let _ = tx.send((r, t.elapsed().as_secs_f64()));
-    });
-    let got = match rx.recv_timeout(budget) {
-        Err(mpsc::RecvTimeoutError::Timeout) => match &stop {
-            Some(s) => {
-                s.store(true, Ordering::Relaxed);
-                rx.recv_timeout(Duration::from_secs(1))
-            }
-            None => Err(mpsc::RecvTimeoutError::Timeout),
-        },
-        r => r,
-    };
-    match got {
-        Ok((r, s)) => Outcome::Done(r, s),
-        Err(mpsc::RecvTimeoutError::Timeout) => Outcome::Timeout,
-        Err(mpsc::RecvTimeoutError::Disconnected) => Outcome::Panicked,
-    }
-}
-
-/// Checks a Subset Tree over `scene`; returns its depth or the first violation.
-fn check_tree(scene: &Scene, t: &SubsetTree) -> Result<u32, String> {
-    let n = scene.len();
-    if t.len() != 2 * n - 1 || t.leaves() != n {
-        return Err(format!("{} nodes for {n} leaves", t.len()));
-    }
-    let mut leaves = t.leaves_under(t.root());
-    leaves.sort_unstable();
-    if leaves.len() != n || leaves.iter().enumerate().any(|(i, &l)| l as usize != i) {
-        return Err("not every leaf exactly once under the root".into());
-    }
-    for leaf in 0..n {
-        if !scene
-            .prim_vertices(leaf)
-            .all(|p| t.aabb[leaf].contains_point(p, 0.0))
-        {
-            return Err(format!("leaf {leaf}'s box misses a vertex"));
-        }
-    }
-    for x in n as u32..t.len() as u32 {
-        let [a, b] = t
-            .children_of(x)
-            .ok_or(format!("node {x} has no children"))?;
-        for c in [a, b] {
-            if !t.aabb[x as usize].contains_aabb(&t.aabb[c as usize], 0.0) {
-                return Err(format!("node {c}'s box is not inside its parent {x}'s"));
-            }
-            if t.depth[c as usize] != t.depth[x as usize] + 1 || t.parent[c as usize] != x {
-                return Err(format!("node {c}: parent or depth inconsistent"));
-            }
-        }
-    }
-    Ok(t.depth_max())
-}
-
-/// A row for a grouping of `scene` with `pset`, and the grouping if it finished.
-fn group_case(
-    scene: &Arc<Scene>,
-    pset: PSet,
-    split_r: Option<f64>,
-    budget: Duration,
-) -> (Row, Option<Grouping>) {
-    let name = match pset {
-        PSet::Aabb => "group-aabb",
-        PSet::Hull => "group-hull",
-    };
-    let mut row = Row {
-        scene: scene.name.clone(),
-        n: scene.len(),
-        method: name.into(),
-        split_r,
-        ..Row::default()
-    };
-    let params = Params {
-        pset,
-        ..Params::default()
-    }
-    .resolve(scene);
-    let stop = Arc::new(AtomicBool::new(false));
-    let (s, flag) = (Arc::clone(scene), Arc::clone(&stop));
-    let out = on_thread(budget, Some(stop), move || {
-        grouping::group_until(&s, &params, (), &flag)
-    });
-    let n = scene.len() as f64;
-    match out {
-        Outcome::Done(Ok(g), secs) => {
-            row.finished = true;
-            row.seconds = Some(secs);
-            row.k_eligible = Some(g.stats.eligible_pairs as f64 / n);
-            row.k_candidates = Some(g.stats.candidates as f64 / n);
-            validity(&mut row, check_tree(scene, &g.tree));
-            return (row, Some(g));
-        }
-        Outcome::Done(Err(stopped), _) => {
-            row.note = format!("over budget: stopped after {} merges", stopped.merges);
-        }
-        Outcome::Timeout => row.note = "over budget (did not stop)".into(),
-        Outcome::Panicked => row.note = "panicked".into(),
-    }
-    (row, None)
-}
-
-/// Fills `valid`, `depth` and `note` from a tree check.
-fn validity(row: &mut Row, check: Result<u32, String>) {
-    match check {
-        Ok(d) => {
-            row.valid = Some(true);
-            row.depth = Some(d);
-        }
-        Err(e) => {
-            row.valid = Some(false);
-            row.note = e;
-        }
-    }
-}
-
-/// The Wrapper Trees built on `tree`: which, and how to build each.
-const WRAPPERS: [&str; 6] = [
-    "sphere-merged",
-    "sphere-aabb-center",
-    "sphere-ritter",
-    "sphere-minimum",
-    "hull",
-    "obb",
-];
-
-/// Builds wrapper `kind` over `tree` and returns how far the worst vertex lies outside its
-/// node's wrapper beyond the tolerance (≤ 0: every vertex inside). Tolerances: 1e-9 × scene
-/// diagonal plus 16 ulps of the largest coordinate for spheres and OBBs (`f64` throughout),
-/// plus [`HULL_TOL_REL`] × the node's box diameter for hulls (parry decides in `f32`).
-fn wrapper_excess(kind: &str, tree: &SubsetTree, scene: &Scene) -> f64 {
-    let far = scene
-        .points
-        .iter()
-        .flat_map(|p| p.iter().map(|c| c.abs()))
-        .fold(0.0, f64::max);
-    let base = 1e-9 * scene.aabb().diameter() + 16.0 * f64::EPSILON * far;
-    let sphere = |m| {
-        let s = sphere_tree(tree, scene, m);
-        containment_excess(tree, scene, WrapperTree::Spheres(&s))
-    };
-    let (ex, hull) = match kind {
-        "sphere-merged" => (sphere(SphereMethod::Merged), false),
-        "sphere-aabb-center" => (sphere(SphereMethod::AabbCenter), false),
-        "sphere-ritter" => (sphere(SphereMethod::Ritter), false),
-        "sphere-minimum" => (sphere(SphereMethod::Minimum), false),
-        "hull" => {
-            let h = hull_tree(tree, scene);
-            (
-                containment_excess(tree, scene, WrapperTree::Hulls(&h)),
-                true,
-            )
-        }
-        _ => {
-            let o = obb_tree(tree, scene, None);
-            (
-                containment_excess(tree, scene, WrapperTree::Obbs(&o)),
-                false,
-            )
-        }
-    };
-    ex.iter()
-        .enumerate()
-        .map(|(x, e)| {
-            let tol = base
-                + if hull {
-                    HULL_TOL_REL * tree.aabb[x].diameter()
-                } else {
-                    0.0
-                };
-            e - tol
-        })
-        .fold(f64::NEG_INFINITY, f64::max)
-}
-
-/// Every case on one scene: both groupings, the split grouping, the wrappers on the AABB
-/// grouping's tree and the peers.
-fn scene_cases(scene: Scene, r: f64, budget: Duration) -> Vec<Row> {
-    let scene = Arc::new(scene);
-    let mut rows = Vec::new();
-    let (row, g) = group_case(&scene, PSet::Aabb, None, budget);
-    rows.push(row);
-    rows.push(group_case(&scene, PSet::Hull, None, budget).0);
-    let (s, _) = split::split_aspect(&scene, r);
-    rows.push(group_case(&Arc::new(s), PSet::Aabb, Some(r), budget).0);
-    if let Some(g) = g {
-        let tree = Arc::new(g.tree);
-        for kind in WRAPPERS {
-            let (t, s) = (Arc::clone(&tree), Arc::clone(&scene));
-            let mut row = Row {
-                scene: scene.name.clone(),
-                n: scene.len(),
-                method: format!("wrap-{kind}"),
-                depth: Some(tree.depth_max()),
-                ..Row::default()
-            };
-            match on_thread(budget, None, move || wrapper_excess(kind, &t, &s)) {
-                Outcome::Done(ex, secs) => {
-                    row.finished = true;
-                    row.seconds = Some(secs);
-                    row.valid = Some(ex <= 0.0);
-                    if ex > 0.0 {
-                        row.note = format!("a vertex lies {ex:.3e} outside beyond tolerance");
-                    }
-                }
-                Outcome::Timeout => row.note = "over budget".into(),
-                Outcome::Panicked => row.note = "panicked".into(),
-            }
-            rows.push(row);
-        }
-    }
-    for m in peers::Method::ALL.into_iter().filter(|m| !m.is_grouping()) {
-        let s = Arc::clone(&scene);
-        let mut row = Row {
-            scene: scene.name.clone(),
-            n: scene.len(),
-            method: m.name().into(),
-            ..Row::default()
-        };
-        match on_thread(budget, None, move || {
-            peers::build(m, &s, &Params::default())
-        }) {
-            Outcome::Done(Ok(b), _) => {
-                row.finished = true;
-                row.seconds = Some(b.seconds);
-                validity(&mut row, check_tree(&scene, &b.tree));
-            }
-            Outcome::Done(Err(e), _) => row.note = e,
-            Outcome::Timeout => row.note = "over budget".into(),
-            Outcome::Panicked => row.note = "panicked".into(),
-        }
-        rows.push(row);
-    }
-    rows
-}
-
-/// Groups every `(x, scene)` with the AABB p-set, as it is and split at aspect `r`.
-fn sweep(cases: Vec<(f64, Scene)>, r: f64, budget: Duration) -> Vec<(f64, Row)> {
-    let mut out = Vec::new();
-    for (x, scene) in cases {
-        eprintln!("stress: sweep {} ({} primitives)", scene.name, scene.len());
-        let (split, _) = split::split_aspect(&scene, r);
-        for (sc, r) in [(scene, None), (split, Some(r))] {
-            out.push((x, group_case(&Arc::new(sc), PSet::Aabb, r, budget).0));
-        }
-    }
-    out
-}
-
-/// The files `stress` writes into its output directory.
-const OUTPUTS: [&str; 5] = [
-    "stress.csv",
-    "spaghetti.svg",
-    "spaghetti.png",
-    "spaghetti-n.svg",
-    "spaghetti-n.png",
-];
-
 impl StressCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         if !(self.budget.is_finite() && self.budget > 0.0) {
             anyhow::bail!("--budget must be a finite number > 0, got {}", self.budget);
         }
-        if self.split.is_nan() || self.split < split::MIN_ASPECT_LIMIT {
+        if self.split.is_nan() || self.split < wraptree::scene::split::MIN_ASPECT_LIMIT {
             anyhow::bail!("--split must be a number ≥ 2, got {}", self.split);
         }
-        let dir = super::bench::output_dir(self.output.as_deref(), "recordings/stress")?;
-        for name in OUTPUTS {
-            let p = dir.join(name);
-            if !self.force && p.exists() {
-                anyhow::bail!(
-                    "{}: already exists (use --force to replace it)",
-                    p.display()
-                );
-            }
-        }
-        let budget = Duration::from_secs_f64(self.budget);
-        let (n, aspects, sizes): (usize, &[f64], &[usize]) = if self.quick {
-            (300, &[1.0, 16.0, 256.0], &[100, 200, 400])
-        } else {
-            (
-                2_000,
-                &[1.0, 4.0, 16.0, 64.0, 256.0, 1024.0],
-                &[500, 1_000, 2_000, 4_000, 8_000],
-            )
+        let dir = output_dir(self.output.as_deref(), "recordings/stress")?;
+        check_outputs(&dir, self.force)?;
+        let opts = StressOptions {
+            quick: self.quick,
+            budget: Duration::from_secs_f64(self.budget),
+            split: self.split,
         };
-        let mut rows = Vec::new();
-        for kind in pathological::KINDS {
-            // 1,024-vertex polygons: hulling them is slow (see the module documentation).
-            let n = if kind == "ngons" { n / 30 } else { n };
-            let scene = pathological::by_name(kind, Some(n), 1).expect("a known kind");
-            eprintln!("stress: {} ({} primitives)", scene.name, scene.len());
-            rows.extend(scene_cases(scene, self.split, budget));
-        }
-        let parallel = |n, a| pathological::spaghetti(n, a, Layout::Parallel, 1);
-        let by_aspect = sweep(
-            aspects.iter().map(|&a| (a, parallel(n, a))).collect(),
-            self.split,
-            budget,
-        );
-        let by_n = sweep(
-            sizes
-                .iter()
-                .map(|&m| (m as f64, parallel(m, 64.0)))
-                .collect(),
-            self.split,
-            budget,
-        );
-        rows.extend(by_aspect.iter().chain(&by_n).map(|(_, r)| r.clone()));
-        print_table(&rows);
-        let charts = [
-            (
-                "spaghetti",
-                sweep_chart(
-                    &by_aspect,
-                    format!("Box of spaghetti: {n} parallel strands, AABB p-set"),
-                    "strand aspect ratio (length / width)",
-                    self.split,
-                ),
-            ),
-            (
-                "spaghetti-n",
-                sweep_chart(
-                    &by_n,
-                    "Box of spaghetti: parallel strands of aspect 64, AABB p-set".into(),
-                    "strands N",
-                    self.split,
-                ),
-            ),
-        ];
-        let mut files = vec![("stress.csv".to_string(), csv(&rows).into_bytes())];
-        for (name, chart) in charts {
-            let svg = chart.to_svg(900, 600).map_err(anyhow::Error::msg)?;
-            let png = wraptree::render::svg_to_png(&svg).map_err(anyhow::Error::msg)?;
-            files.push((format!("{name}.svg"), svg.into_bytes()));
-            files.push((format!("{name}.png"), png));
-        }
-        for (name, bytes) in &files {
-            wraptree::record::output::write_atomic(&dir.join(name), bytes, self.force)?;
-        }
+        let report = stress::run(&opts, &mut |step| match step {
+            Step::Scene(s) => eprintln!("stress: {} ({} primitives)", s.name, s.len()),
+            Step::Sweep(s) => eprintln!("stress: sweep {} ({} primitives)", s.name, s.len()),
+        })?;
+        print!("{}", stress_table(&report.rows));
+        report.write(&dir, self.force)?;
         eprintln!(
             "wrote {}/stress.csv, spaghetti.{{svg,png}} and spaghetti-n.{{svg,png}}",
             dir.display()

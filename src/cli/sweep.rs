@@ -8,6 +8,7 @@ use std::process::ExitCode;
 use wraptree::grouping::{CostMeasure, PSet, Params};
 use wraptree::metrics::report::{SweepRrd, setting_name, sweep_table, write_sweep};
 use wraptree::metrics::sweep::{grid, sweep};
+use wraptree::record::output::output_dir;
 
 /// Arguments of `wraptree sweep`.
 #[derive(Args, Debug)]
@@ -30,8 +31,8 @@ pub struct SweepCmd {
     /// P-set wrapper for every setting.
     #[arg(long, value_enum, default_value_t = PSet::Aabb)]
     pset: PSet,
-    /// Output directory [default: recordings/sweep-<scene>, created if missing; a given
-    /// directory must exist].
+    /// Output directory, created with its parents if missing [default:
+    /// recordings/sweep-<scene>].
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Replace existing result files.
@@ -45,15 +46,13 @@ pub struct SweepCmd {
 impl SweepCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
-        let scene = super::bench::scene_spec(&self.scene)?;
+        let scene = super::bench::load_spec(&self.scene)?;
         let settings = grid(&self.a, &self.b, &self.c, &self.cost);
         for s in &settings {
             s.weights.check().map_err(|e| anyhow!("--{e}"))?;
         }
-        let dir = super::bench::output_dir(
-            self.output.as_deref(),
-            &format!("recordings/sweep-{}", scene.name),
-        )?;
+        let default = format!("recordings/sweep-{}", scene.name);
+        let dir = output_dir(self.output.as_deref(), &default)?;
         let rrd = SweepRrd::create(&dir.join("sweep.rrd"), &settings, self.force)?;
         let base = Params {
             pset: self.pset,

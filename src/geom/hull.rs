@@ -16,7 +16,7 @@
 //! a closed, consistently oriented mesh whose every face plane has all the node's points behind
 //! it (within the tolerance). "Every point lies on or inside the mesh" is not enough: a folded
 //! mesh through all the hull's vertices passes it. When parry's hull fails, parry is retried
-//! with uniform scaling, then an incremental hull in `f64` ([`incremental`]) is built; if that
+//! with uniform scaling, then an incremental hull in `f64` (`incremental`) is built; if that
 //! fails too (ill-conditioned input), the node gets its principal-axes box ([`Hull::exact`] is
 //! false): a correct but looser convex wrapper, and the parent is built from the node's points.
 //! Nothing here panics.

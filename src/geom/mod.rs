@@ -7,6 +7,9 @@
 pub mod distance;
 pub mod hull;
 pub mod pca;
+pub mod sphere;
+
+pub use sphere::Sphere;
 
 use nalgebra::{Point3, Vector3};
 

@@ -10,7 +10,7 @@
 //! body may drop points that far from its hull; a merge's own diameter is always computed from
 //! both children's full vertex sets.
 
-use super::cluster::PSetBodies;
+use super::pset::PSetBodies;
 use crate::geom::hull::hull_of;
 use crate::geom::{Aabb, P3, to_glam_local};
 use crate::scene::Scene;

@@ -38,13 +38,16 @@
 mod cluster;
 pub mod events;
 mod hull_pset;
+mod limits;
 pub mod mpairs;
 pub mod partitioned;
 pub mod pregroup;
+mod pset;
 pub mod subset_tree;
 pub mod voxel_hash;
 
 pub use events::{Event, EventLog, Merge, Observer, Part, PartKind, Tee};
+pub use limits::Limits;
 pub use pregroup::Pregrouping;
 pub use subset_tree::{NONE, SubsetTree};
 

@@ -14,10 +14,13 @@
 //!
 //! Wrapper tightness per level comes from [`crate::wrap::level_tightness`]. [`compare`] runs
 //! every hierarchy builder × wrapper on a scene, [`sweep`] the A/B/C grid of the grouping
-//! phase, and [`report`] writes their CSV, charts and `.rrd`.
+//! phase, [`bench`](mod@bench) the targets table and the cost of recording, [`stress`] every
+//! builder on pathological scenes, and [`report`] writes their CSV, charts and `.rrd`.
 
+pub mod bench;
 pub mod compare;
 pub mod report;
+pub mod stress;
 pub mod sweep;
 
 use crate::geom::Aabb;
@@ -35,6 +38,14 @@ pub fn area(b: &Aabb) -> f64 {
         return 0.0;
     }
     2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+}
+
+/// Peak resident memory of this process in bytes (Linux `VmHWM`), if known.
+pub fn peak_rss_bytes() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
 }
 
 /// Quality measures of one hierarchy.

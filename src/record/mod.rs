@@ -1,12 +1,16 @@
 //! Recordings of a grouping run: `.rrd` for the Rerun viewer ([`rrd`]) and `.mcap` for Foxglove
 //! ([`mcap`]). Both recorders are [`Observer`](crate::grouping::Observer)s fed the same events
 //! and share nothing else; [`output`] makes their files appear atomically, and [`background`]
-//! lets a recorder consume the events on another thread while the grouping runs.
+//! lets a recorder consume the events on another thread while the grouping runs; [`record()`]
+//! runs a grouping with both recorders listening.
 
 pub mod background;
 pub mod mcap;
 pub mod output;
 pub mod rrd;
+mod run;
+
+pub use run::{RecordOptions, Written, record};
 
 use crate::grouping::{Grouping, ResolvedParams, Stopped};
 use crate::scene::{Scene, SceneSource};

@@ -129,3 +129,35 @@ pub fn write_atomic(dest: &Path, bytes: &[u8], force: bool) -> Result<()> {
     p.commit()?;
     Ok(())
 }
+
+/// The output prefix: `given`, or `recordings/<stem of scene_file><suffix>` (creating
+/// `recordings/`). A given prefix's directory must exist ([`Pending::create`] says so).
+pub fn output_prefix(given: Option<&Path>, scene_file: &str, suffix: &str) -> Result<PathBuf> {
+    if let Some(p) = given {
+        return Ok(p.to_path_buf());
+    }
+    let stem = Path::new(scene_file)
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_else(|| "scene".into());
+    std::fs::create_dir_all("recordings")
+        .context("recordings: cannot create the default output directory")?;
+    Ok(PathBuf::from("recordings").join(format!("{stem}{suffix}")))
+}
+
+/// `prefix` with `ext` appended (`recordings/lamp` + `.rrd`).
+pub fn with_ext(prefix: &Path, ext: &str) -> PathBuf {
+    let mut s = prefix.as_os_str().to_owned();
+    s.push(ext);
+    PathBuf::from(s)
+}
+
+/// The output directory: `given` or `default`, created with its parents if missing.
+pub fn output_dir(given: Option<&Path>, default: &str) -> Result<PathBuf> {
+    let d = given.map_or_else(|| PathBuf::from(default), Path::to_path_buf);
+    if !d.is_dir() {
+        std::fs::create_dir_all(&d)
+            .with_context(|| format!("{}: cannot create the output directory", d.display()))?;
+    }
+    Ok(d)
+}

@@ -4,13 +4,15 @@
 //! orthographic [`Camera`], sorted far to near (painter's algorithm, translucent fills so what is
 //! inside a wrapper shows through) and written as SVG ([`svg`]); PNG is the same SVG rendered by
 //! `resvg` with the bundled DejaVu Sans font ([`png`]). [`figure`] builds the frames of a Subset
-//! Tree: the input, then levels with leaves as polygons and interior nodes as wrappers.
+//! Tree: the input, then levels with leaves as polygons and interior nodes as wrappers;
+//! [`snapshot`] draws and writes them all (`wraptree snapshot`).
 
 pub mod camera;
 pub mod chart;
 pub mod figure;
 pub mod png;
 pub mod shape;
+pub mod snapshot;
 pub mod svg;
 
 pub use camera::{Camera, View};

@@ -8,12 +8,16 @@
 //! - [`obj`] loads Wavefront OBJ (via `tobj`) as polygons or as polyhedra, with validation;
 //! - [`generate`] makes the seeded synthetic scenes (robot base, lamp, replicas, soups);
 //! - [`pathological`] makes the seeded scenes that stress builders (spaghetti, slabs, …);
+//! - [`soup`] makes random triangle soups (used by both);
+//! - [`spec`] turns a command line's `KIND[:COUNT]` or OBJ path into a scene;
 //! - [`split`] cuts long thin polygons into pieces of limited aspect (§4).
 
 pub mod components;
 pub mod generate;
 pub mod obj;
 pub mod pathological;
+pub mod soup;
+pub mod spec;
 pub mod split;
 
 pub use obj::{LoadError, LoadOptions, Loaded, SceneSource, load_bytes, load_path};

@@ -1,7 +1,7 @@
 //! Wavefront OBJ loading (via `tobj`) into a [`Scene`] of convex primitives, with validation.
 //!
 //! Each file goes through two passes:
-//! 1. [`scan`] reads the text once and reports the first problem with its line: not UTF-8,
+//! 1. `scan` reads the text once and reports the first problem with its line: not UTF-8,
 //!    malformed `v`/`f` statements, non-finite or out-of-range coordinates, face indices out
 //!    of range (including relative ones reaching before the first vertex). It parses the
 //!    coordinates in `f64` and produces a cleaned copy for `tobj` in which each `v` line holds

@@ -13,7 +13,8 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::{PrimitiveKind, Scene, generate};
+use super::soup::soup;
+use super::{PrimitiveKind, Scene};
 use crate::geom::{P3, V3};
 
 /// The scene kinds [`by_name`] knows.
@@ -173,11 +174,11 @@ pub fn coincident(n: usize) -> Scene {
     s
 }
 
-/// A random soup of `n` / `copies` triangles ([`generate::soup`]) repeated `copies` times
+/// A random soup of `n` / `copies` triangles ([`soup`]) repeated `copies` times
 /// without moving it: every primitive has `copies − 1` exact duplicates.
 pub fn duplicates(n: usize, copies: usize, seed: u64) -> Scene {
     let copies = copies.max(1);
-    let base = generate::soup((n / copies).max(1), seed);
+    let base = soup((n / copies).max(1), seed);
     let mut s = Scene::new(format!("duplicates{}x{copies}", base.len()));
     for _ in 0..copies {
         for i in 0..base.len() {
@@ -191,7 +192,7 @@ pub fn duplicates(n: usize, copies: usize, seed: u64) -> Scene {
 /// A random soup of `n` triangles flattened into the plane z = 0 (every AABB is flat, every
 /// hull two-dimensional).
 pub fn coplanar(n: usize, seed: u64) -> Scene {
-    let mut s = generate::soup(n, seed);
+    let mut s = soup(n, seed);
     for p in &mut s.points {
         p.z = 0.0;
     }
@@ -225,7 +226,7 @@ pub fn translated(scene: &Scene, by: V3) -> Scene {
 
 /// A random soup of `n` triangles moved by (1e7, −1e7, 1e7).
 pub fn offset(n: usize, seed: u64) -> Scene {
-    let mut s = translated(&generate::soup(n, seed), V3::new(1e7, -1e7, 1e7));
+    let mut s = translated(&soup(n, seed), V3::new(1e7, -1e7, 1e7));
     s.name = format!("offset{n}");
     s
 }
@@ -274,8 +275,8 @@ pub fn ngons(n: usize, vertices: usize, seed: u64) -> Scene {
 /// must double GLimit about twenty times before the clusters can join.
 pub fn two_clusters(n: usize, seed: u64) -> Scene {
     let half = (n / 2).max(1);
-    let a = generate::soup(half, seed);
-    let b = translated(&generate::soup(n - half, seed + 1), V3::new(1e6, 0.0, 0.0));
+    let a = soup(half, seed);
+    let b = translated(&soup(n - half, seed + 1), V3::new(1e6, 0.0, 0.0));
     let mut s = Scene::new(format!("two-clusters{n}"));
     for src in [&a, &b] {
         for i in 0..src.len() {

@@ -26,9 +26,10 @@
 //! `size(T) ≤ K` is exact, in O(N log N); the cut returned is then the smallest one with that
 //! error.
 //!
-//! [`export`] writes a cover as JSON and OBJ.
+//! [`export`] writes a cover as JSON and OBJ; [`solve`] computes one end to end.
 
 pub mod export;
+pub mod solve;
 
 use super::hull::{Hull, hull_tree};
 use super::kind::{WrapperKind, Wrappers};

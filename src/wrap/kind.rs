@@ -2,8 +2,9 @@
 
 use super::hull::{Hull, hull_tree};
 use super::obb::{Obb, obb_tree};
-use super::sphere::{Sphere, SphereMethod, sphere_tree};
+use super::sphere::{SphereMethod, sphere_tree};
 use crate::geom::Aabb;
+use crate::geom::Sphere;
 use crate::grouping::SubsetTree;
 use crate::scene::Scene;
 

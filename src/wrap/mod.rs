@@ -9,7 +9,8 @@
 //! - [`obb`] — oriented boxes from the principal axes ([`crate::geom::pca`]);
 //! - [`kind`] — [`WrapperKind`] (`--wrapper`) and [`Wrappers`], several trees built together;
 //! - [`tightness`] — per-level volume, volume ratio and surface-to-geometry error;
-//! - [`distance`] — exact point–primitive distances with the Subset Tree as BVH.
+//! - [`distance`] — exact point–primitive distances with the Subset Tree as BVH;
+//! - [`report`] — build time, containment check and tightness of several trees together.
 //!
 //! Everything is `f64` except parry's hull decision (`f32`). Containment of every vertex below
 //! a node holds up to rounding for spheres, boxes and OBBs (tests allow 1e-9 × the scene
@@ -34,15 +35,17 @@ pub mod hull;
 pub mod kind;
 pub mod obb;
 pub mod order;
+pub mod report;
 pub mod sphere;
 pub mod tightness;
 pub mod welzl;
 
+pub use crate::geom::Sphere;
 pub use hull::{HULL_TOL_REL, Hull, hull_tree};
 pub use kind::{WrapperKind, WrapperTree, Wrappers};
 pub use obb::{Obb, obb_tree};
 pub use order::LeafOrder;
-pub use sphere::{Sphere, SphereMethod, sphere_tree};
+pub use sphere::{SphereMethod, sphere_tree};
 pub use tightness::{
     DEFAULT_SAMPLES, LevelStats, NodeStats, containment_excess, level_tightness, node_tightness,
 };

@@ -11,7 +11,7 @@
 //! the largest distance from the centre to any input point, so containment never depends on
 //! rounding.
 
-use super::sphere::Sphere;
+use crate::geom::Sphere;
 use crate::geom::{P3, V3};
 use std::cmp::Ordering::Greater;
 

@@ -1,12 +1,15 @@
-//! Results of `bench` and `sweep` as files: CSV tables, charts (SVG + PNG) and `.rrd` series.
+//! Results of `bench`, `sweep` and `stress` as files: CSV tables, charts (SVG + PNG) and `.rrd` series.
 //!
-//! - [`bench`](mod@bench): `results.csv`, the two charts per scene and `bench.rrd`;
-//! - [`sweep`](mod@sweep): `sweep.csv`, the heat maps and `sweep.rrd`.
+//! - `bench`: `results.csv`, the two charts per scene and `bench.rrd`;
+//! - `sweep`: `sweep.csv`, the heat maps and `sweep.rrd`;
+//! - `stress`: `stress.csv` and the spaghetti sweep charts.
 
 mod bench;
+mod stress;
 mod sweep;
 
 pub use bench::{bench_charts, bench_csv, bench_table, write_bench};
+pub use stress::{StressRow, stress_csv, stress_sweep_chart, stress_table};
 pub use sweep::{SweepRrd, setting_name, sweep_csv, sweep_heat_maps, sweep_table, write_sweep};
 
 use crate::query::QueryCost;

@@ -1,11 +1,11 @@
-//! The table, CSV and charts of `wraptree stress`.
+//! The table, CSV and charts of `wraptree stress` ([`crate::metrics::stress`]).
 
+use crate::render::chart::{Scatter, Series};
 use std::fmt::Write as _;
-use wraptree::render::chart::{Scatter, Series};
 
 /// One measured case: a row of the table and of stress.csv.
 #[derive(Clone, Debug, Default)]
-pub struct Row {
+pub struct StressRow {
     /// Scene name.
     pub scene: String,
     /// Primitives grouped (after the split, if any).
@@ -31,12 +31,12 @@ pub struct Row {
 }
 
 /// Formats an optional number, blank when absent.
-pub fn opt(v: Option<f64>, prec: usize) -> String {
+fn opt(v: Option<f64>, prec: usize) -> String {
     v.map(|x| format!("{x:.prec$}")).unwrap_or_default()
 }
 
 /// The CSV text of `rows` (header first).
-pub fn csv(rows: &[Row]) -> String {
+pub fn stress_csv(rows: &[StressRow]) -> String {
     let mut s = String::from(
         "scene,n,method,split_r,finished,valid,depth_max,seconds,k_eligible,k_candidates,note\n",
     );
@@ -60,14 +60,17 @@ pub fn csv(rows: &[Row]) -> String {
     s
 }
 
-/// Prints `rows` as a table.
-pub fn print_table(rows: &[Row]) {
-    println!(
+/// `rows` as a text table (header first).
+pub fn stress_table(rows: &[StressRow]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
         "{:<28} {:>7} {:<22} {:>5} {:>4} {:>5} {:>5} {:>10} {:>9} {:>9}  note",
         "scene", "N", "method", "split", "done", "valid", "depth", "ms", "k", "cand/N"
     );
     for r in rows {
-        println!(
+        let _ = writeln!(
+            s,
             "{:<28} {:>7} {:<22} {:>5} {:>4} {:>5} {:>5} {:>10} {:>9} {:>9}  {}",
             r.scene,
             r.n,
@@ -86,12 +89,18 @@ pub fn print_table(rows: &[Row]) {
             r.note
         );
     }
+    s
 }
 
 /// A log–log chart of grouping time and k against the `x` of a sweep, with and without the
 /// split at `r`.
-pub fn sweep_chart(sweep: &[(f64, Row)], title: String, x_label: &str, r: f64) -> Scatter {
-    let series = |label: String, split: bool, f: fn(&Row) -> Option<f64>| Series {
+pub fn stress_sweep_chart(
+    sweep: &[(f64, StressRow)],
+    title: String,
+    x_label: &str,
+    r: f64,
+) -> Scatter {
+    let series = |label: String, split: bool, f: fn(&StressRow) -> Option<f64>| Series {
         label,
         hollow: false,
         points: sweep

@@ -1,0 +1,287 @@
+//! The measurements of `wraptree bench` besides the builder × wrapper comparison
+//! ([`compare`](super::compare)): the targets table against obvhs PLOC and parry Binned
+//! ([`target_row`]) and what recording costs ([`record_cost`]).
+
+use crate::grouping::{self, Params};
+use crate::peers::{self, Method};
+use crate::query::{self, Bv, Workload};
+use crate::record::{Detail, RecordOptions, Written, record};
+use crate::scene::obj::{LoadOptions, Loaded, load_path};
+use crate::scene::{Scene, generate};
+use anyhow::{Result, anyhow};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The best wall time of `repeat` (at least one) runs of `f`, in seconds.
+pub fn best_of(repeat: u32, mut f: impl FnMut()) -> f64 {
+    (0..repeat.max(1))
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The scenes of the targets table: soups of 10^4 and (up to `max_soup`) 10^5 and 10^6
+/// triangles, 44 robot bases, and every OBJ in the crate's `scenes/` folder.
+pub fn target_scenes(max_soup: usize) -> Result<Vec<Scene>> {
+    let mut cases: Vec<Scene> = vec![generate::soup(10_000, 1)];
+    cases.push(generate::replicate(&generate::robot_base(), 44, 1));
+    for n in [100_000, 1_000_000] {
+        if n <= max_soup {
+            cases.push(generate::soup(n, 1));
+        }
+    }
+    let bundled = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut meshes: Vec<_> = std::fs::read_dir(&bundled)
+        .map(|d| d.filter_map(|e| Some(e.ok()?.path())).collect())
+        .unwrap_or_default();
+    meshes.retain(|p: &PathBuf| p.extension().is_some_and(|e| e == "obj"));
+    meshes.sort();
+    for m in meshes {
+        let mut s = load_path(&m, &LoadOptions::default())?.scene;
+        s.name = m.file_stem().unwrap_or_default().to_string_lossy().into();
+        cases.push(s);
+    }
+    Ok(cases)
+}
+
+/// One scene of the targets table.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TargetRow {
+    /// Scene name.
+    pub scene: String,
+    /// Primitives.
+    pub n: usize,
+    /// Best grouping time (s).
+    pub group_seconds: f64,
+    /// Best obvhs PLOC build time (s).
+    pub ploc_seconds: f64,
+    /// Best parry Binned build time (s).
+    pub binned_seconds: f64,
+    /// SAH of the grouping tree / parry Binned's.
+    pub sah_ratio: f64,
+    /// Node tests per query (AABB BVs, standard workload) of the grouping tree / parry
+    /// Binned's.
+    pub query_ratio: f64,
+    /// Largest depth of the grouping tree.
+    pub depth: u32,
+    /// Process peak RSS after the case, if known.
+    pub peak_rss_bytes: Option<u64>,
+}
+
+/// Measures `scene` for the targets table: the best of `repeat` builds (at most 2 from 10^6
+/// primitives) of the grouping phase, obvhs PLOC and parry Binned, and their trees' SAH and
+/// query cost.
+pub fn target_row(scene: &Scene, repeat: u32) -> Result<TargetRow> {
+    Ok(target_rows(scene, repeat)?.0)
+}
+
+/// One measured build: best time (s), SAH, node tests per query, depth and the tree.
+type Measured = (f64, f64, f64, u32, peers::Built);
+
+/// The best of `repeat` builds of `m` on `scene` (at most 2 from 10^6 primitives), with its
+/// SAH and node tests per query on `workload`, on the current rayon pool.
+fn measure(m: Method, scene: &Scene, repeat: u32, workload: &Workload) -> Result<Measured> {
+    let repeat = if scene.len() >= 1_000_000 {
+        repeat.min(2)
+    } else {
+        repeat
+    };
+    let params = Params::default();
+    let mut best: Option<peers::Built> = None;
+    for _ in 0..repeat.max(1) {
+        let b = peers::build(m, scene, &params).map_err(|e| anyhow!(e))?;
+        if best.as_ref().is_none_or(|x| b.seconds < x.seconds) {
+            best = Some(b);
+        }
+    }
+    let b = best.expect("ran at least once");
+    let q = query::measure(&b.tree, scene, Bv::Aabb, workload);
+    let tests = super::compare::query_values(&q)[6];
+    Ok((b.seconds, super::sah(&b.tree), tests, b.tree.depth_max(), b))
+}
+
+/// Grouping + refinement against the best peer on one scene.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct RefineRow {
+    /// Scene name.
+    pub scene: String,
+    /// Refinement time alone / obvhs PLOC build time.
+    pub refine_per_ploc: f64,
+    /// SAH / the best of parry Binned and obvhs PLOC + reinsertion.
+    pub sah_per_best: f64,
+    /// Node tests per query / the best of the same two.
+    pub query_per_best: f64,
+}
+
+/// The §1.3 speed-ups (pre-grouping, instancing) on one scene and thread count, against obvhs
+/// PLOC and the plain grouping.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct SpeedupRow {
+    /// Scene name.
+    pub scene: String,
+    /// The method.
+    pub method: Method,
+    /// Rayon threads.
+    pub threads: usize,
+    /// Best build time (s).
+    pub seconds: f64,
+    /// Time / obvhs PLOC's.
+    pub per_ploc: f64,
+    /// Time / the plain grouping's.
+    pub per_grouping: f64,
+    /// SAH / the plain grouping's.
+    pub sah_ratio: f64,
+    /// Node tests per query / the plain grouping's.
+    pub query_ratio: f64,
+    /// Largest depth.
+    pub depth: u32,
+    /// Volume of the depth-3 cut as boxes / the plain grouping's (NaN above 50,000 primitives).
+    pub box8_ratio: f64,
+    /// The same as convex hulls.
+    pub hull8_ratio: f64,
+}
+
+/// Measures `scene` for the three targets tables: the main row, grouping + refinement against
+/// the best peer, and the pre-grouped and instanced groupings on 1 and 2 threads.
+pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, Vec<SpeedupRow>)> {
+    let n = scene.len();
+    let workload = Workload::standard(scene, 1);
+    let run = |m: Method| measure(m, scene, repeat, &workload);
+    let (t, sah, qc, depth, plain) = run(Method::Grouping)?;
+    let (tp, ..) = run(Method::ObvhsPloc)?;
+    let (tb, sah_b, qc_b, _, _) = run(Method::ParryBinned)?;
+    let (_, sah_r, qc_r, _, refined) = run(Method::GroupingRefine)?;
+    let (_, sah_o, qc_o, ..) = run(Method::ObvhsPlocReinsert)?;
+    let refine = RefineRow {
+        scene: scene.name.clone(),
+        refine_per_ploc: refined.refine_seconds / tp,
+        sah_per_best: sah_r / sah_b.min(sah_o),
+        query_per_best: qc_r / qc_b.min(qc_o),
+    };
+    let volumes = n <= 50_000;
+    let vol = |b: &peers::Built| super::level_volume(&b.tree, scene, 3);
+    let (box8, hull8) = if volumes { vol(&plain) } else { (1.0, 1.0) };
+    let mut sped_up = Vec::new();
+    for m in [
+        Method::GroupingPregroup,
+        Method::GroupingInstanced,
+        Method::GroupingObjects,
+    ] {
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()?;
+            let (tm, sah_m, qc_m, depth_m, built) = pool.install(|| run(m))?;
+            let (bm, hm) = if volumes {
+                vol(&built)
+            } else {
+                (f64::NAN, f64::NAN)
+            };
+            sped_up.push(SpeedupRow {
+                scene: scene.name.clone(),
+                method: m,
+                threads,
+                seconds: tm,
+                per_ploc: tm / tp,
+                per_grouping: tm / t,
+                sah_ratio: sah_m / sah,
+                query_ratio: qc_m / qc,
+                depth: depth_m,
+                box8_ratio: bm / box8,
+                hull8_ratio: hm / hull8,
+            });
+        }
+    }
+    let row = TargetRow {
+        scene: scene.name.clone(),
+        n,
+        group_seconds: t,
+        ploc_seconds: tp,
+        binned_seconds: tb,
+        sah_ratio: sah / sah_b,
+        query_ratio: qc / qc_b,
+        depth,
+        peak_rss_bytes: super::peak_rss_bytes(),
+    };
+    Ok((row, refine, sped_up))
+}
+
+/// The scenes `bench --record` measures: lamps × 5 (3,130 polygons), robot bases × 44 (12,144)
+/// and a 10^5-triangle soup.
+pub fn record_scenes() -> [Scene; 3] {
+    [
+        generate::replicate(&generate::lamp(), 5, 1),
+        generate::replicate(&generate::robot_base(), 44, 1),
+        generate::soup(100_000, 1),
+    ]
+}
+
+/// `repeat` pairs of (grouping alone, grouping recorded) wall times for `loaded`, each
+/// recorded run just after its grouping-only run so that a slow spell of the machine weighs
+/// on both sides of a pair; and where the last recording went (`PREFIX.rrd`/`.mcap`, replaced,
+/// reproducible, sphere Wrapper Trees).
+pub fn record_pairs(
+    loaded: &Loaded,
+    detail: Detail,
+    prefix: &Path,
+    repeat: u32,
+) -> Result<(Vec<(f64, f64)>, Written)> {
+    let params = Params::default().resolve(&loaded.scene);
+    let opts = RecordOptions {
+        detail,
+        force: true,
+        reproducible: true,
+        ..RecordOptions::default()
+    };
+    let mut written = None;
+    let pairs = (0..repeat.max(1))
+        .map(|_| {
+            let t_group = best_of(1, || {
+                std::hint::black_box(grouping::group(&loaded.scene, &Params::default(), ()));
+            });
+            let t_rec = best_of(1, || {
+                written = Some(record(loaded, &params, prefix, &opts, ()));
+            });
+            (t_group, t_rec)
+        })
+        .collect();
+    Ok((pairs, written.expect("ran at least once")?))
+}
+
+/// What recording one scene at one detail costs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecordCost {
+    /// Best grouping-only time (s).
+    pub group_seconds: f64,
+    /// Best recorded time (s): grouping with both recorders listening, sphere tree, both files.
+    pub record_seconds: f64,
+    /// Median over the pairs of recorded / grouping-only time.
+    pub median_ratio: f64,
+    /// `.rrd` size in bytes.
+    pub rrd_bytes: u64,
+    /// `.mcap` size in bytes.
+    pub mcap_bytes: u64,
+}
+
+/// Measures [`record_pairs`] of `loaded` at `detail` into `prefix`, `repeat` times.
+pub fn record_cost(
+    loaded: &Loaded,
+    detail: Detail,
+    prefix: &Path,
+    repeat: u32,
+) -> Result<RecordCost> {
+    let (pairs, w) = record_pairs(loaded, detail, prefix, repeat)?;
+    let mut ratios: Vec<f64> = pairs.iter().map(|(g, r)| r / g).collect();
+    ratios.sort_by(f64::total_cmp);
+    let size = |p: &Path| std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
+    Ok(RecordCost {
+        group_seconds: pairs.iter().map(|p| p.0).fold(f64::INFINITY, f64::min),
+        record_seconds: pairs.iter().map(|p| p.1).fold(f64::INFINITY, f64::min),
+        median_ratio: ratios[ratios.len() / 2],
+        rrd_bytes: size(&w.rrd),
+        mcap_bytes: size(&w.mcap),
+    })
+}

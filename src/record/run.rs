@@ -1,0 +1,298 @@
+//! Recording a grouping run to both files: the scene is grouped on the calling thread while
+//! the Rerun and MCAP recorders each consume the events on their own thread; the files appear
+//! only when complete (`wraptree record`, `replay --a/--b/--c`, `bench --record`).
+//!
+//! ```no_run
+//! use wraptree::grouping::Params;
+//! use wraptree::record::{RecordOptions, record};
+//! let loaded = wraptree::scene::load_path("scenes/lamp.obj".as_ref(), &Default::default())?;
+//! let params = Params::default().resolve(&loaded.scene);
+//! let w = record(&loaded, &params, "/tmp/lamp".as_ref(), &RecordOptions::default(), ())?;
+//! println!("{} and {}", w.rrd.display(), w.mcap.display());
+//! # Ok::<(), anyhow::Error>(())
+//! ```
+
+use super::mcap::McapRecorder;
+use super::output::{Pending, with_ext};
+use super::rrd::RrdRecorder;
+use super::{CoverLevel, Detail, Outcome, RunInfo, background};
+use crate::grouping::{self, Grouping, Limits, Observer, ResolvedParams, Stopped, Tee};
+use crate::scene::{Loaded, Scene};
+use crate::wrap::cover::Cover;
+use crate::wrap::cover::export::WrapperRecord;
+use crate::wrap::cover::solve::{CoverLimit, solve};
+use crate::wrap::{Sphere, SphereMethod, WrapperKind, Wrappers};
+use anyhow::{Context, Result, anyhow, bail};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+/// How a recording is made and what it holds besides the scene and the grouping.
+#[derive(Clone, Debug)]
+pub struct RecordOptions {
+    /// What to write.
+    pub detail: Detail,
+    /// Replace existing recordings.
+    pub force: bool,
+    /// Leave wall-clock timing out of the `.mcap` so identical runs give identical bytes.
+    pub reproducible: bool,
+    /// Limits on the grouping.
+    pub limits: Limits,
+    /// Stops the grouping when set (e.g. by Ctrl-C); the files are then set aside as
+    /// incomplete.
+    pub stop: Option<Arc<AtomicBool>>,
+    /// Wrapper Trees drawn at every level.
+    pub wrappers: Vec<WrapperKind>,
+    /// A cover logged as one more level, within this limit, from these kinds (needs `detail`
+    /// with levels).
+    pub cover: Option<(CoverLimit, Vec<WrapperKind>)>,
+    /// Refine the finished tree with these parameters ([`crate::refine`]), recording each
+    /// move; the levels are then the refined tree's.
+    pub refine: Option<crate::refine::RefineParams>,
+}
+
+impl Default for RecordOptions {
+    /// Full detail, sphere Wrapper Trees, no cover, no limits, existing files kept.
+    fn default() -> Self {
+        RecordOptions {
+            detail: Detail::Full,
+            force: false,
+            reproducible: false,
+            limits: Limits::default(),
+            stop: None,
+            wrappers: vec![WrapperKind::Sphere],
+            cover: None,
+            refine: None,
+        }
+    }
+}
+
+/// Where a pair of recordings went, and the outcome of the run.
+#[derive(Debug)]
+pub struct Written {
+    /// The `.rrd` path.
+    pub rrd: PathBuf,
+    /// The `.mcap` path.
+    pub mcap: PathBuf,
+    /// The grouping, unless stopped.
+    pub grouping: Option<Grouping>,
+    /// Why the grouping stopped before the root, if it did.
+    pub stopped: Option<Stopped>,
+    /// The limits the grouping ran under.
+    pub limits: Limits,
+    /// Grouping + recording wall time.
+    pub seconds: f64,
+}
+
+/// Groups `loaded.scene` with `params` while both recorders listen, writing `PREFIX.rrd` and
+/// `PREFIX.mcap`; `progress` sees every event too. The levels show the Wrapper Trees of
+/// `opts.wrappers`, and the cover of `opts.cover`, computed after a finished grouping, as one
+/// more level.
+///
+/// The files are committed when the grouping finishes, or set aside as `PREFIX.incomplete.*`
+/// when `opts.stop` or a limit of `opts.limits` stops it (an existing recording is never
+/// replaced by a partial one; the partial files say why they stopped). Err: an existing file
+/// without `opts.force`, a missing directory, a cover without levels, a write error.
+pub fn record<O: Observer>(
+    loaded: &Loaded,
+    params: &ResolvedParams,
+    prefix: &Path,
+    opts: &RecordOptions,
+    progress: O,
+) -> Result<Written> {
+    let (scene, source, detail) = (&loaded.scene, &loaded.source, opts.detail);
+    let (force, reproducible, limits) = (opts.force, opts.reproducible, opts.limits);
+    if opts.cover.is_some() && !detail.levels() {
+        bail!(
+            "--cover-tolerance/--cover-budget need --detail levels or full (the cover is a level)"
+        );
+    }
+    let (rrd_path, mcap_path) = (with_ext(prefix, ".rrd"), with_ext(prefix, ".mcap"));
+    let rrd_file = Pending::create(&rrd_path, force)?;
+    let mcap_file = Pending::create(&mcap_path, force)?;
+    let info = RunInfo {
+        scene,
+        source,
+        params,
+        detail,
+    };
+    let mcap_out = mcap_file.file()?;
+    let never = AtomicBool::new(false);
+    let stop = opts.stop.as_deref().unwrap_or(&never);
+    let start = Instant::now();
+    // Each recorder runs on its own thread: it starts its file while the grouping starts here,
+    // consumes the events as they come, then writes its tail (levels, footer, sync) at the
+    // same time as the other. The grouping thread only copies events into shared batches.
+    let (rrd_done, mcap_done, grouping, stopped) = std::thread::scope(|s| -> Result<_> {
+        let (mut events, workers) = background::fan_out(2);
+        let [rrd_worker, mcap_worker]: [background::Worker; 2] = workers
+            .try_into()
+            .map_err(|_| anyhow!("two event channels"))?;
+        let info = &info;
+        let (rrd_tmp, rrd_name) = (rrd_file.path(), rrd_path.as_path());
+        let rrd_thread = std::thread::Builder::new()
+            .name("rrd-recorder".into())
+            .spawn_scoped(s, move || {
+                let mut rrd = RrdRecorder::with_name(rrd_tmp, rrd_name, info)?;
+                rrd_worker.run(&mut rrd);
+                Ok::<_, anyhow::Error>(rrd)
+            })
+            .context("cannot start the Rerun recorder thread")?;
+        let mcap_thread = std::thread::Builder::new()
+            .name("mcap-recorder".into())
+            .spawn_scoped(s, move || {
+                let writer = std::io::BufWriter::new(mcap_out);
+                let mut mcap = McapRecorder::start(writer, info)?;
+                mcap.set_reproducible(reproducible);
+                mcap.write_scene();
+                mcap_worker.run(&mut mcap);
+                Ok::<_, anyhow::Error>(mcap)
+            })
+            .context("cannot start the MCAP recorder thread")?;
+        // The grouping starts without waiting for either recorder: a recorder that fails to
+        // start drops its worker (the grouping stops sending to it) and its error is reported
+        // after the grouping, like a write error during the run. Missing or unwritable
+        // destinations were already refused by `Pending::create`.
+        let mut result = grouping::group_within(
+            scene,
+            params,
+            Tee(&mut events, progress),
+            &limits.budget(Some(stop)),
+        );
+        // The refinement's events follow the grouping's on the same channels; the levels
+        // below are the refined tree's.
+        if let (Ok(g), Some(rp)) = (&mut result, &opts.refine) {
+            g.tree = crate::refine::refine(&g.tree, rp, &mut events).tree;
+        }
+        events.close();
+        let seconds = start.elapsed().as_secs_f64();
+        let (grouping, stopped, merges, rounds) = match result {
+            Ok(g) => {
+                let m = g.tree.leaves() as u32 - 1;
+                let r = g.rounds;
+                (Some(g), None, m, r)
+            }
+            Err(s) => (None, Some(s), s.merges, s.rounds),
+        };
+        let extras = Extras::build(scene, grouping.as_ref(), opts)?;
+        let outcome = extras.outcome(grouping.as_ref(), merges, rounds, seconds, stopped);
+        let (rrd_done, mcap_done) = std::thread::scope(|t| {
+            let mcap_tail = std::thread::Builder::new()
+                .name("mcap-tail".into())
+                .spawn_scoped(t, || {
+                    let mcap = mcap_thread
+                        .join()
+                        .unwrap_or_else(|_| Err(anyhow!("the MCAP recorder failed")))
+                        .with_context(|| mcap_path.display().to_string())?;
+                    mcap.finish(&outcome)
+                        .with_context(|| mcap_path.display().to_string())?;
+                    mcap_file.sync()
+                });
+            let rrd_done = rrd_thread
+                .join()
+                .unwrap_or_else(|_| bail!("{}: the Rerun recorder failed", rrd_path.display()))
+                .and_then(|rrd| rrd.finish(&outcome))
+                .and_then(|()| rrd_file.sync());
+            let mcap_done = match mcap_tail {
+                Ok(h) => h
+                    .join()
+                    .unwrap_or_else(|_| bail!("{}: the MCAP recorder failed", mcap_path.display())),
+                Err(e) => Err(anyhow!(
+                    "{}: cannot start a thread: {e}",
+                    mcap_path.display()
+                )),
+            };
+            (rrd_done, mcap_done)
+        });
+        Ok((rrd_done, mcap_done, grouping, stopped))
+    })?;
+    rrd_done?;
+    mcap_done?;
+    let (rrd_dest, mcap_dest) = if grouping.is_some() {
+        (rrd_file.commit()?, mcap_file.commit()?)
+    } else {
+        let r = with_ext(prefix, ".incomplete.rrd");
+        let m = with_ext(prefix, ".incomplete.mcap");
+        (
+            rrd_file.commit_to(Some(&r))?,
+            mcap_file.commit_to(Some(&m))?,
+        )
+    };
+    Ok(Written {
+        rrd: rrd_dest,
+        mcap: mcap_dest,
+        grouping,
+        stopped,
+        limits,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// What the levels show besides the tree, built after the grouping: the Wrapper Trees and the
+/// cover.
+struct Extras {
+    wrappers: Option<Wrappers>,
+    /// Spheres travel in `Outcome::spheres`; empty = levels without spheres.
+    spheres: Option<Vec<Sphere>>,
+    cover: Option<(Cover, Vec<WrapperRecord>)>,
+    budget: Option<usize>,
+}
+
+impl Extras {
+    fn build(scene: &Scene, grouping: Option<&Grouping>, opts: &RecordOptions) -> Result<Extras> {
+        let mut wrappers = match (grouping, opts.detail.levels()) {
+            (Some(g), true) => Some(Wrappers::build(
+                &g.tree,
+                scene,
+                &opts.wrappers,
+                SphereMethod::AabbCenter,
+            )),
+            _ => None,
+        };
+        let spheres = wrappers
+            .as_mut()
+            .map(|w| w.spheres.take().unwrap_or_default());
+        let cover = match (grouping, &opts.cover) {
+            (Some(g), Some((limit, kinds))) => {
+                let s = solve(&g.tree, scene, *limit, kinds)?;
+                Some((s.cover, s.records))
+            }
+            _ => None,
+        };
+        let budget = match opts.cover {
+            Some((CoverLimit::Budget(k), _)) => Some(k),
+            _ => None,
+        };
+        Ok(Extras {
+            wrappers,
+            spheres,
+            cover,
+            budget,
+        })
+    }
+
+    fn outcome<'a>(
+        &'a self,
+        grouping: Option<&'a Grouping>,
+        merges: u32,
+        rounds: u32,
+        seconds: f64,
+        stopped: Option<Stopped>,
+    ) -> Outcome<'a> {
+        Outcome {
+            grouping,
+            spheres: self.spheres.as_deref(),
+            wrappers: self.wrappers.as_ref(),
+            cover: self.cover.as_ref().map(|(cover, wrappers)| CoverLevel {
+                cover,
+                wrappers,
+                budget: self.budget,
+            }),
+            merges,
+            rounds,
+            seconds,
+            stopped,
+        }
+    }
+}

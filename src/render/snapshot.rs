@@ -1,0 +1,230 @@
+//! Snapshots (`wraptree snapshot`): the input and chosen tree levels of a grouping drawn as
+//! PNG + SVG frames and one figure sheet, like the paper's Figures 1–4.
+//!
+//! ```no_run
+//! use wraptree::grouping::Params;
+//! use wraptree::render::snapshot::{SnapshotOptions, draw, regroup};
+//! let loaded = wraptree::scene::load_path("scenes/lamp.obj".as_ref(), &Default::default())?;
+//! let params = Params::default().resolve(&loaded.scene);
+//! let (g, _) = regroup(&loaded.scene, &params, None)?;
+//! let s = draw(&loaded.scene, &g.tree, &SnapshotOptions::default(), "/tmp/lamp-figures".as_ref())?;
+//! println!("{}", s.captions.join(" | "));
+//! # Ok::<(), anyhow::Error>(())
+//! ```
+
+use super::{Frame, View};
+use crate::grouping::{self, EventLog, Grouping, Merge, ResolvedParams, SubsetTree};
+use crate::record::mcap::read_recording;
+use crate::record::output::Pending;
+use crate::scene::{Scene, load_bytes};
+use crate::wrap::{SphereMethod, WrapperKind, Wrappers};
+use anyhow::{Context, Result, bail};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+/// What a kind is called in titles and captions.
+fn kind_title(k: WrapperKind) -> &'static str {
+    match k {
+        WrapperKind::Sphere => "bounding-sphere",
+        WrapperKind::Hull => "convex-hull",
+        WrapperKind::Box => "box",
+        WrapperKind::Obb => "oriented-box",
+    }
+}
+
+/// What to draw and how.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SnapshotOptions {
+    /// Tree levels to draw (depths, root = 0); when empty, the levels whose node counts are
+    /// closest to `nodes`.
+    pub levels: Vec<u32>,
+    /// Node counts to pick levels by; when empty too, 90 % and 40 % of the primitives, and 8.
+    pub nodes: Vec<usize>,
+    /// Wrappers drawn for interior nodes; several draw the levels once per kind.
+    pub kinds: Vec<WrapperKind>,
+    /// Eye azimuth in degrees around +Z, from −Y.
+    pub azimuth: f64,
+    /// Eye elevation in degrees above the XY plane.
+    pub elevation: f64,
+    /// Size of one frame's picture in pixels (the caption band is added below).
+    pub size: (u32, u32),
+    /// Replace existing images.
+    pub force: bool,
+}
+
+impl Default for SnapshotOptions {
+    /// Default levels, spheres, the iso view, 800 × 600.
+    fn default() -> Self {
+        let (azimuth, elevation) = View::Iso.angles();
+        SnapshotOptions {
+            levels: Vec::new(),
+            nodes: Vec::new(),
+            kinds: vec![WrapperKind::Sphere],
+            azimuth,
+            elevation,
+            size: (800, 600),
+            force: false,
+        }
+    }
+}
+
+/// The embedded scene and parameters of the `.mcap` recording at `path`, and its merges when
+/// it is complete and holds them.
+pub fn from_recording(path: &Path) -> Result<(Scene, ResolvedParams, Option<Vec<Merge>>)> {
+    let rec = read_recording(path)?;
+    let loaded = load_bytes(
+        &rec.scene_file_name,
+        rec.scene_bytes.clone(),
+        &rec.load_options,
+    )
+    .map_err(|e| anyhow::anyhow!("{}: embedded scene: {e}", path.display()))?;
+    let merges = (rec.complete && rec.detail.merges()).then_some(rec.merges);
+    Ok((loaded.scene, rec.params, merges))
+}
+
+/// Groups `scene` with `params`; also says whether its merges differ from `recorded`, when
+/// given.
+pub fn regroup(
+    scene: &Scene,
+    params: &ResolvedParams,
+    recorded: Option<&[Merge]>,
+) -> Result<(Grouping, bool)> {
+    let mut log = EventLog::default();
+    let never = AtomicBool::new(false);
+    let g = grouping::group_until(scene, params, &mut log, &never)
+        .map_err(|_| anyhow::anyhow!("grouping stopped unexpectedly"))?;
+    let differs = recorded.is_some_and(|m| m != log.merges.as_slice());
+    Ok((g, differs))
+}
+
+/// Levels to draw (see [`SnapshotOptions::levels`]), validated against the tree; repeats
+/// dropped, order kept.
+pub fn choose_levels(tree: &SubsetTree, levels: &[u32], nodes: &[usize]) -> Result<Vec<u32>> {
+    let dmax = tree.depth_max();
+    let counts = super::level_counts(tree);
+    let mut levels = levels.to_vec();
+    if levels.is_empty() {
+        let n = tree.leaves() as f64;
+        let targets = if nodes.is_empty() {
+            vec![(0.9 * n).round() as usize, (0.4 * n).round() as usize, 8]
+        } else {
+            nodes.to_vec()
+        };
+        levels = targets
+            .iter()
+            .map(|&k| super::level_for_nodes(&counts, k))
+            .collect();
+    }
+    if let Some(bad) = levels.iter().find(|&&d| d > dmax) {
+        bail!("level {bad} is beyond the tree's depth (max depth {dmax}: valid levels 0..={dmax})");
+    }
+    let mut seen = Vec::new();
+    levels.retain(|d| {
+        let new = !seen.contains(d);
+        seen.push(*d);
+        new
+    });
+    Ok(levels)
+}
+
+/// The destinations of `names` in `dir`, each as a `.png`/`.svg` pair, all checked before any
+/// is written so an existing file without `force` stops the run before it writes anything.
+fn pendings(dir: &Path, names: &[String], force: bool) -> Result<Vec<(Pending, Pending)>> {
+    names
+        .iter()
+        .map(|n| {
+            Ok((
+                Pending::create(&dir.join(format!("{n}.png")), force)?,
+                Pending::create(&dir.join(format!("{n}.svg")), force)?,
+            ))
+        })
+        .collect()
+}
+
+fn write(p: Pending, bytes: &[u8]) -> Result<PathBuf> {
+    use std::io::Write;
+    let dest = p.dest().to_path_buf();
+    p.file()?
+        .write_all(bytes)
+        .with_context(|| format!("{}: write failed", dest.display()))?;
+    p.commit()
+}
+
+/// What [`draw`] wrote.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snapshot {
+    /// The (PNG, SVG) pair of every frame, then of the figure sheet.
+    pub written: Vec<(PathBuf, PathBuf)>,
+    /// Every frame's caption.
+    pub captions: Vec<String>,
+}
+
+/// Draws the input and the chosen levels of `tree` over `scene` into `dir` (created with its
+/// parents if missing): `frame-NN-….{png,svg}` per frame and `figure.{png,svg}`, the sheet of
+/// them all.
+pub fn draw(
+    scene: &Scene,
+    tree: &SubsetTree,
+    opts: &SnapshotOptions,
+    dir: &Path,
+) -> Result<Snapshot> {
+    let levels = choose_levels(tree, &opts.levels, &opts.nodes)?;
+    let mut kinds: Vec<WrapperKind> = Vec::new();
+    for k in &opts.kinds {
+        if !kinds.contains(k) {
+            kinds.push(*k);
+        }
+    }
+    let built = Wrappers::build(tree, scene, &kinds, SphereMethod::AabbCenter);
+    let mut frames: Vec<Frame> = vec![super::input_frame(scene)];
+    let mut names = vec!["frame-00-input".to_string()];
+    for &kind in &kinds {
+        let w = built
+            .get(kind)
+            .with_context(|| format!("no {} Wrapper Tree was built", kind.name()))?;
+        for &d in &levels {
+            let mut f = super::level_frame(scene, tree, d, &|x| super::wrapper_shape(w, x));
+            let mut name = format!("frame-{:02}-level-{d}", frames.len());
+            if kinds.len() > 1 || kind != WrapperKind::Sphere {
+                f.caption.push_str(&format!(" · {}s", kind.name()));
+                name.push_str(&format!("-{}", kind.name()));
+            }
+            frames.push(f);
+            names.push(name);
+        }
+    }
+    names.push("figure".into());
+    let cam = super::fit_camera(&frames, opts.azimuth, opts.elevation, opts.size);
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("{}: cannot create the directory", dir.display()))?;
+    let outs = pendings(dir, &names, opts.force)?;
+    let kind = kinds
+        .iter()
+        .map(|&k| kind_title(k))
+        .collect::<Vec<_>>()
+        .join(" / ");
+    let title = format!(
+        "{} · {kind} Wrapper Tree · depth {}",
+        scene.name,
+        tree.depth_max()
+    );
+    let mut svgs: Vec<String> = frames.iter().map(|f| super::frame_svg(f, &cam)).collect();
+    svgs.push(super::sheet_svg(
+        &frames,
+        &cam,
+        super::sheet_columns(frames.len()),
+        &title,
+    ));
+    let mut written = Vec::new();
+    for ((png, svg), text) in outs.into_iter().zip(&svgs) {
+        let dest = png.dest().display().to_string();
+        let bytes = super::svg_to_png(text).map_err(|e| anyhow::anyhow!("{dest}: {e}"))?;
+        let p = write(png, &bytes)?;
+        let s = write(svg, text.as_bytes())?;
+        written.push((p, s));
+    }
+    Ok(Snapshot {
+        written,
+        captions: frames.into_iter().map(|f| f.caption).collect(),
+    })
+}

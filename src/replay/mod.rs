@@ -1,0 +1,344 @@
+//! Replaying a run from its `.mcap` recording: [`open`] reads it and loads the embedded scene,
+//! [`Replay::tree`] rebuilds the Subset Tree from the recorded merges alone, [`verify`] re-runs
+//! the grouping and compares it merge by merge, [`reweight`] re-runs it with other Cost weights
+//! and records the new run (`wraptree replay`).
+//!
+//! ```no_run
+//! use wraptree::grouping::Limits;
+//! let replay = wraptree::replay::open("recordings/lamp.mcap".as_ref())?;
+//! match wraptree::replay::verify(&replay, &Limits::default()) {
+//!     Ok(v) => println!("{v:?}"),
+//!     Err(stopped) => println!("re-run stopped: {stopped:?}"),
+//! }
+//! # Ok::<(), anyhow::Error>(())
+//! ```
+
+use crate::grouping::{
+    self, Event, EventLog, Limits, Merge, Observer, Part, ResolvedParams, StopReason, Stopped,
+    SubsetTree, Weights,
+};
+use crate::record::mcap::{Recorded, read_recording};
+use crate::record::{RecordOptions, Written, record};
+use crate::refine::{self, Step};
+use crate::scene::{Loaded, load_bytes};
+use anyhow::{Context, Result, bail};
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// The magic bytes that open every Rerun `.rrd` stream, and the 8 bytes before the entry count
+/// that close a finished one (`RRF2FOOT`).
+const RRD_MAGIC: &[u8; 4] = b"RRF2";
+const RRD_FOOTER: &[u8; 8] = b"RRF2FOOT";
+/// The magic bytes that open an MCAP file.
+const MCAP_MAGIC: &[u8; 8] = b"\x89MCAP0\r\n";
+
+/// Why `path` cannot be what `replay` reads, when its first and last bytes say so: a Rerun
+/// `.rrd` file (finished, truncated or with a bad magic) or an empty file. `None` for anything
+/// else, which the MCAP reader then judges.
+pub fn not_an_mcap(path: &Path) -> Option<String> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut f = std::fs::File::open(path).ok()?;
+    let len = f.metadata().ok()?.len();
+    let name = path.display();
+    if len == 0 {
+        return Some(format!("{name}: empty file (not a recording)"));
+    }
+    let mut head = [0u8; 8];
+    let n = f.read(&mut head).ok()?;
+    let head = &head[..n];
+    let is_rrd = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("rrd"));
+    let mcap = path.with_extension("mcap");
+    let hint = if mcap != path && mcap.is_file() {
+        format!("replay reads the .mcap beside it ({})", mcap.display())
+    } else {
+        "replay reads the .mcap that `record` writes beside the .rrd".to_string()
+    };
+    if head.starts_with(RRD_MAGIC) {
+        let mut tail = [0u8; 12];
+        let finished = len >= 24
+            && f.seek(SeekFrom::End(-12)).is_ok()
+            && f.read_exact(&mut tail).is_ok()
+            && tail.starts_with(RRD_FOOTER);
+        let what = if finished {
+            "a Rerun .rrd recording"
+        } else {
+            "a truncated Rerun .rrd recording (no footer)"
+        };
+        return Some(format!("{name}: {what}, not an MCAP file; {hint}"));
+    }
+    if is_rrd && !head.starts_with(MCAP_MAGIC) {
+        return Some(format!(
+            "{name}: not a Rerun recording (bad magic, expected RRF2) nor an MCAP file"
+        ));
+    }
+    None
+}
+
+/// A recording read back with its embedded scene loaded.
+#[derive(Debug)]
+pub struct Replay {
+    /// What the `.mcap` holds.
+    pub rec: Recorded,
+    /// The embedded scene, loaded with the recorded options.
+    pub loaded: Loaded,
+}
+
+/// Reads the `.mcap` recording at `path` and loads its embedded scene. Err: not an MCAP file
+/// (a `.rrd`, an empty file: [`not_an_mcap`]), an unreadable recording, or an embedded scene
+/// that does not load or does not match the metadata.
+pub fn open(path: &Path) -> Result<Replay> {
+    if let Some(why) = not_an_mcap(path) {
+        bail!("{why}");
+    }
+    let rec = read_recording(path)?;
+    let name = path.display().to_string();
+    let loaded = load_bytes(
+        &rec.scene_file_name,
+        rec.scene_bytes.clone(),
+        &rec.load_options,
+    )
+    .with_context(|| format!("{name}: the embedded scene does not load"))?;
+    if loaded.scene.len() as u32 != rec.primitives {
+        bail!(
+            "{name}: the embedded scene has {} primitives, the metadata says {}",
+            loaded.scene.len(),
+            rec.primitives
+        );
+    }
+    Ok(Replay { rec, loaded })
+}
+
+impl Replay {
+    /// The Subset Tree rebuilt from the recorded merges alone (leaf boxes from the embedded
+    /// scene).
+    pub fn tree(&self) -> Result<SubsetTree> {
+        self.rec
+            .tree(&self.loaded.scene)
+            .map_err(anyhow::Error::msg)
+    }
+}
+
+/// An observer that keeps the event log and sets `stop` once `limit` merges are made, so a
+/// re-run of an incomplete recording ends where the recording did.
+struct UpTo<'a> {
+    log: EventLog,
+    limit: Option<usize>,
+    stop: &'a AtomicBool,
+}
+
+impl Observer for UpTo<'_> {
+    fn on_event(&mut self, event: &Event<'_>) {
+        self.log.on_event(event);
+        if self.limit.is_some_and(|k| self.log.merges.len() >= k) {
+            self.stop.store(true, Ordering::Relaxed);
+        }
+    }
+}
+
+/// Re-runs the grouping of `loaded` within `limits`, up to `merges` merges when given (the
+/// length of an incomplete recording), and returns its events. Err: the stop, when a limit of
+/// `limits` ended the re-run first.
+pub fn rerun(
+    loaded: &Loaded,
+    params: &ResolvedParams,
+    limits: &Limits,
+    merges: Option<usize>,
+) -> Result<EventLog, Stopped> {
+    let stop = AtomicBool::new(merges == Some(0));
+    let mut obs = UpTo {
+        log: EventLog::default(),
+        limit: merges,
+        stop: &stop,
+    };
+    let budget = limits.budget(Some(&stop));
+    match grouping::group_within(&loaded.scene, params, &mut obs, &budget) {
+        Ok(_) => Ok(obs.log),
+        // Our own flag, set at the recorded length: the re-run went as far as the recording.
+        Err(s) if s.reason == StopReason::Interrupted => Ok(obs.log),
+        Err(s) => Err(s),
+    }
+}
+
+/// A merge without `queue_len`, which depends on how MPairs stores pairs (it changed between
+/// versions), not on which pair merges.
+fn decision(m: &Merge) -> Merge {
+    Merge { queue_len: 0, ..*m }
+}
+
+/// Index of the first merge where two timelines make a different decision, if any.
+pub fn first_divergence(a: &[Merge], b: &[Merge]) -> Option<usize> {
+    (0..a.len().max(b.len())).find(|&i| a.get(i).map(decision) != b.get(i).map(decision))
+}
+
+/// Mean and largest Balance over a run's merges.
+pub fn balance_stats(m: &[Merge]) -> (f64, f64) {
+    let mean = m.iter().map(|x| x.balance).sum::<f64>() / m.len().max(1) as f64;
+    (mean, m.iter().map(|x| x.balance).fold(1.0, f64::max))
+}
+
+/// What [`verify`] found.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Verified {
+    /// The re-run made the same decisions at every merge.
+    Identical {
+        /// Merges compared.
+        merges: usize,
+        /// Whether MPairs queue lengths differ (the queue's storage changed between versions).
+        queue_lengths_differ: bool,
+    },
+    /// The recording is incomplete and its merges are the re-run's first ones.
+    Prefix {
+        /// Merges recorded.
+        merges: usize,
+    },
+    /// The parts of the run (chunks, components, copies) differ at this index.
+    PartDiffers {
+        /// Index of the first differing part.
+        index: usize,
+        /// The recorded part there, if any.
+        recorded: Option<Part>,
+        /// The re-run's part there, if any.
+        rerun: Option<Part>,
+    },
+    /// The first merge step where the two differ, and the re-run's events.
+    Diverged {
+        /// Merge step.
+        step: usize,
+        /// The re-run's events.
+        rerun: EventLog,
+    },
+}
+
+/// Re-runs the grouping from the embedded scene and recorded parameters within `limits` (up to
+/// the recorded length when the recording is incomplete) and compares it merge by merge. Err:
+/// the stop, when a limit ended the re-run first.
+pub fn verify(replay: &Replay, limits: &Limits) -> Result<Verified, Stopped> {
+    let rec = &replay.rec;
+    let upto = (!rec.complete).then_some(rec.merges.len());
+    let log = rerun(&replay.loaded, &rec.params, limits, upto)?;
+    let k = rec.parts.len();
+    if log.parts.get(..k) != Some(&rec.parts[..]) || (rec.complete && log.parts.len() != k) {
+        let index = (0..k)
+            .find(|&i| log.parts.get(i) != Some(&rec.parts[i]))
+            .unwrap_or(k);
+        return Ok(Verified::PartDiffers {
+            index,
+            recorded: rec.parts.get(index).copied(),
+            rerun: log.parts.get(index).copied(),
+        });
+    }
+    Ok(match first_divergence(&rec.merges, &log.merges) {
+        None if !rec.complete => Verified::Prefix {
+            merges: rec.merges.len(),
+        },
+        None => Verified::Identical {
+            merges: log.merges.len(),
+            queue_lengths_differ: rec
+                .merges
+                .iter()
+                .zip(&log.merges)
+                .any(|(r, l)| r.queue_len != l.queue_len),
+        },
+        Some(step) => Verified::Diverged { step, rerun: log },
+    })
+}
+
+/// What [`verify_refinement`] found: the moves re-run from the recorded tree and refinement
+/// parameters, or the first move where they differ from the recorded ones.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RefineVerified {
+    /// Every move is identical.
+    Identical {
+        /// Moves compared.
+        moves: usize,
+    },
+    /// The first differing move.
+    Diverged {
+        /// Move index.
+        step: usize,
+        /// The recorded move there, if any.
+        recorded: Option<Step>,
+        /// The re-run's move there, if any.
+        rerun: Option<Step>,
+    },
+}
+
+/// The Subset Tree the recording's levels show: the grouping's, refined again with the
+/// recorded refinement parameters when the recording was refined (`record --refine`).
+pub fn final_tree(replay: &Replay) -> Result<SubsetTree> {
+    let t = replay.tree()?;
+    Ok(match &replay.rec.refine {
+        Some(r) => refine::refine(&t, &r.params, ()).tree,
+        None => t,
+    })
+}
+
+/// Re-runs the recorded refinement on the grouping's tree rebuilt from the merges and compares
+/// the moves; `None` when the recording is incomplete or was not refined.
+pub fn verify_refinement(replay: &Replay) -> Result<Option<RefineVerified>> {
+    let rec = &replay.rec;
+    let Some(r) = rec.refine.filter(|_| rec.complete) else {
+        return Ok(None);
+    };
+    let mut log = EventLog::default();
+    refine::refine(&replay.tree()?, &r.params, &mut log);
+    let n = rec.refine_steps.len().max(log.refine.len());
+    Ok(Some(
+        match (0..n).find(|&i| rec.refine_steps.get(i) != log.refine.get(i)) {
+            None => RefineVerified::Identical {
+                moves: log.refine.len(),
+            },
+            Some(step) => RefineVerified::Diverged {
+                step,
+                recorded: rec.refine_steps.get(step).copied(),
+                rerun: log.refine.get(step).copied(),
+            },
+        },
+    ))
+}
+
+/// The recorded weights with `a`, `b`, `c` replaced where given. Err: a weight that is not a
+/// finite number ≥ 0 (named as the flag, e.g. `--a must be …`).
+pub fn weights(rec: &Recorded, a: Option<f64>, b: Option<f64>, c: Option<f64>) -> Result<Weights> {
+    let w = rec.params.weights;
+    let weights = Weights {
+        a: a.unwrap_or(w.a),
+        b: b.unwrap_or(w.b),
+        c: c.unwrap_or(w.c),
+    };
+    weights.check().map_err(|e| anyhow::anyhow!("--{e}"))?;
+    Ok(weights)
+}
+
+/// A re-weighted run: its recordings and, when it finished, its events.
+#[derive(Debug)]
+pub struct Reweighted {
+    /// The recordings of the re-weighted run.
+    pub written: Written,
+    /// The re-weighted run's events (`None` when it was stopped).
+    pub log: Option<EventLog>,
+}
+
+/// Re-runs the recording with `weights` (other parameters as recorded) and records the new run
+/// to `prefix` with `opts` (see [`record`]); `progress` sees the recorded run's events.
+pub fn reweight<O: Observer>(
+    replay: &Replay,
+    weights: Weights,
+    prefix: &Path,
+    opts: &RecordOptions,
+    progress: O,
+) -> Result<Reweighted> {
+    let params = ResolvedParams {
+        weights,
+        ..replay.rec.params
+    };
+    let written = record(&replay.loaded, &params, prefix, opts, progress)?;
+    // The same run again for its events: it finished within the limits just now.
+    let log = written.grouping.as_ref().map(|_| {
+        rerun(&replay.loaded, &params, &Limits::default(), None)
+            .expect("an unlimited re-run is never stopped")
+    });
+    Ok(Reweighted { written, log })
+}

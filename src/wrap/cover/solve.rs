@@ -1,0 +1,183 @@
+//! Computing a cover end to end, as `wraptree cover` and `record --cover-*` do: build the
+//! Wrapper Trees the kinds need, measure every node's [`Fits`], cut the tree within a
+//! [`CoverLimit`], and (for [`cover_scene`]) the summary `wraptree cover` writes as JSON.
+
+use super::export::{self, WrapperRecord};
+use super::{Cover, Fits, LevelRow, compare_levels};
+use crate::grouping::{self, Params, SubsetTree};
+use crate::scene::Scene;
+use crate::wrap::{DEFAULT_SAMPLES, SphereMethod, WrapperKind, Wrappers};
+use anyhow::Result;
+use std::time::Instant;
+
+/// A tolerance: a length in scene units, or a fraction of the scene diagonal.
+///
+/// ```
+/// use wraptree::wrap::cover::solve::Tolerance;
+/// assert_eq!(Tolerance::parse("2%").unwrap().length(10.0), 0.2);
+/// assert_eq!(Tolerance::parse("0.5").unwrap().length(10.0), 0.5);
+/// assert!(Tolerance::parse("-1").is_err());
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Tolerance {
+    /// A length in scene units.
+    Abs(f64),
+    /// A fraction of the scene diagonal.
+    Rel(f64),
+}
+
+impl Tolerance {
+    /// The length for a scene of diagonal `diagonal`.
+    pub fn length(self, diagonal: f64) -> f64 {
+        match self {
+            Tolerance::Abs(t) => t,
+            Tolerance::Rel(r) => r * diagonal,
+        }
+    }
+
+    /// Parses a length ≥ 0, or `P%` of the scene diagonal (`--tolerance`).
+    pub fn parse(s: &str) -> Result<Tolerance, String> {
+        let bad = || format!("invalid tolerance '{s}' (want a length ≥ 0, or P% of the diagonal)");
+        let t = s.trim();
+        let (num, rel) = match t.strip_suffix('%') {
+            Some(n) => (n, true),
+            None => (t, false),
+        };
+        let v: f64 = num.trim().parse().map_err(|_| bad())?;
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(bad());
+        }
+        Ok(if rel {
+            Tolerance::Rel(v / 100.0)
+        } else {
+            Tolerance::Abs(v)
+        })
+    }
+}
+
+/// How a cover is bounded.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CoverLimit {
+    /// Largest error per wrapper: the fewest wrappers within it ([`Fits::cover_tolerance`]).
+    Tolerance(Tolerance),
+    /// Largest number of wrappers: the smallest largest error ([`Fits::cover_budget`]).
+    Budget(usize),
+}
+
+/// A cover with what it was chosen from.
+#[derive(Debug)]
+pub struct Solved {
+    /// The chosen cut and kinds.
+    pub cover: Cover,
+    /// Every node's candidates and best error.
+    pub fits: Fits,
+    /// The Wrapper Trees measured (hulls included only when `kinds` has them).
+    pub wrappers: Wrappers,
+    /// One record per cover node, with its geometry.
+    pub records: Vec<WrapperRecord>,
+}
+
+/// The cover of `tree` within `limit`, choosing among `kinds` (spheres by
+/// [`SphereMethod::Minimum`], [`DEFAULT_SAMPLES`] surface samples per wrapper). Hulls are always
+/// built, as the reference the errors need. Err: a budget of 0.
+pub fn solve(
+    tree: &SubsetTree,
+    scene: &Scene,
+    limit: CoverLimit,
+    kinds: &[WrapperKind],
+) -> Result<Solved> {
+    let mut build = kinds.to_vec();
+    if !build.contains(&WrapperKind::Hull) {
+        build.push(WrapperKind::Hull);
+    }
+    let mut wrappers = Wrappers::build(tree, scene, &build, SphereMethod::Minimum);
+    let hulls = if kinds.contains(&WrapperKind::Hull) {
+        None
+    } else {
+        wrappers.hulls.take()
+    };
+    let fits = Fits::measure(tree, scene, &wrappers, hulls.as_deref(), DEFAULT_SAMPLES);
+    let cover = match limit {
+        CoverLimit::Tolerance(t) => fits.cover_tolerance(tree, t.length(scene.aabb().diameter())),
+        CoverLimit::Budget(k) => fits.cover_budget(tree, k).map_err(anyhow::Error::msg)?,
+    };
+    let records = export::records(&cover, tree, scene, &wrappers);
+    Ok(Solved {
+        cover,
+        fits,
+        wrappers,
+        records,
+    })
+}
+
+/// What `wraptree cover` reports and writes to `OUT.json`: the run, the cover and its
+/// wrappers, and each tree level against the cover of the same error.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CoverSummary {
+    /// Scene name.
+    pub scene: String,
+    /// Primitives in the scene.
+    pub primitives: usize,
+    /// Scene diagonal (the unit of relative tolerances).
+    pub diagonal: f64,
+    /// Kinds chosen from.
+    pub kinds: Vec<&'static str>,
+    /// How spheres were computed.
+    pub sphere_method: SphereMethod,
+    /// Surface samples per wrapper.
+    pub samples: usize,
+    /// The query-cost rule that breaks ties.
+    pub query_costs: &'static str,
+    /// The absolute error bound used.
+    pub tolerance: f64,
+    /// The wrapper budget, when asked for by budget.
+    pub budget: Option<usize>,
+    /// Wrappers in the cover.
+    pub size: usize,
+    /// Largest error of the cover.
+    pub max_error: f64,
+    /// Sum of the cover's query costs.
+    pub total_cost: f64,
+    /// Grouping + cover wall time.
+    pub seconds: f64,
+    /// Each uniform level against the cover of the same error.
+    pub levels: Vec<LevelRow>,
+    /// The cover's wrappers with their geometry.
+    pub wrappers: Vec<WrapperRecord>,
+}
+
+/// Groups `scene` with `params` and computes its cover within `limit` from `kinds`.
+pub fn cover_scene(
+    scene: &Scene,
+    params: &Params,
+    limit: CoverLimit,
+    kinds: &[WrapperKind],
+) -> Result<CoverSummary> {
+    let start = Instant::now();
+    let g = grouping::group(scene, params, ());
+    let tree = &g.tree;
+    let s = solve(tree, scene, limit, kinds)?;
+    let levels = compare_levels(tree, &s.fits.best);
+    let seconds = start.elapsed().as_secs_f64();
+    let c = &s.cover;
+    Ok(CoverSummary {
+        scene: scene.name.clone(),
+        primitives: scene.len(),
+        diagonal: scene.aabb().diameter(),
+        kinds: kinds.iter().map(|k| k.name()).collect(),
+        sphere_method: SphereMethod::Minimum,
+        samples: DEFAULT_SAMPLES,
+        query_costs: "sphere 1, box 2, obb 3, hull/primitive 4 + vertices/16",
+        tolerance: c.tolerance,
+        budget: match limit {
+            CoverLimit::Budget(k) => Some(k),
+            CoverLimit::Tolerance(_) => None,
+        },
+        size: c.nodes.len(),
+        max_error: c.max_error(),
+        total_cost: c.cost(),
+        seconds,
+        levels,
+        wrappers: s.records,
+    })
+}

@@ -1,0 +1,176 @@
+//! The report of `wraptree wrap`: each Wrapper Tree's build time, containment check (every
+//! vertex below a node inside its wrapper, within a tolerance) and per-level tightness.
+//!
+//! ```no_run
+//! use wraptree::wrap::{DEFAULT_SAMPLES, SphereMethod, WrapperKind, report::report};
+//! # fn demo(tree: &wraptree::grouping::SubsetTree, scene: &wraptree::scene::Scene) {
+//! for r in report(tree, scene, &[WrapperKind::Sphere, WrapperKind::Obb], SphereMethod::Minimum, DEFAULT_SAMPLES) {
+//!     println!("{}: containment holds: {}", r.kind.name(), r.containment.holds);
+//! }
+//! # }
+//! ```
+
+use super::{
+    HULL_TOL_REL, Hull, LevelStats, Obb, Sphere, SphereMethod, WrapperKind, WrapperTree,
+    containment_excess, hull_tree, level_tightness, obb_tree, sphere_tree,
+};
+use crate::geom::Aabb;
+use crate::grouping::SubsetTree;
+use crate::scene::Scene;
+use std::time::Instant;
+
+/// Containment tolerance of spheres, boxes and oriented boxes, relative to the scene diagonal.
+pub const TOL_REL: f64 = 1e-9;
+
+/// The containment check of one Wrapper Tree.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Containment {
+    /// Largest excess of a vertex outside its node's wrapper (≤ 0: all strictly inside).
+    pub max_excess: f64,
+    /// The tolerance rule.
+    pub tolerance_rule: &'static str,
+    /// The tolerance of the node with the largest excess over its tolerance.
+    pub tolerance_at_worst: f64,
+    /// Excess of that node.
+    pub excess_at_worst: f64,
+    /// Whether every node's excess is within its tolerance.
+    pub holds: bool,
+}
+
+/// One Wrapper Tree's report.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct KindReport {
+    /// The kind of wrapper.
+    pub kind: WrapperKind,
+    /// Build time of the Wrapper Tree.
+    pub build_seconds: f64,
+    /// Its containment check.
+    pub containment: Containment,
+    /// Its per-level tightness.
+    pub levels: Vec<LevelStats>,
+}
+
+/// The Wrapper Trees built for one tree, each with its build time.
+#[derive(Default)]
+struct Built {
+    spheres: Option<(Vec<Sphere>, f64)>,
+    hulls: Option<(Vec<Hull>, f64)>,
+    boxes: Option<(Vec<Aabb>, f64)>,
+    obbs: Option<(Vec<Obb>, f64)>,
+}
+
+/// Runs `f`, returning its value and wall time in seconds.
+fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
+    let start = Instant::now();
+    let v = f();
+    (v, start.elapsed().as_secs_f64())
+}
+
+impl Built {
+    /// Builds the trees of `kinds` (OBB axes from the hulls when hulls are built too, as
+    /// [`Wrappers::build`](super::Wrappers::build) does).
+    fn new(tree: &SubsetTree, scene: &Scene, kinds: &[WrapperKind], method: SphereMethod) -> Built {
+        let want = |k| kinds.contains(&k);
+        let mut b = Built::default();
+        if want(WrapperKind::Sphere) {
+            b.spheres = Some(timed(|| sphere_tree(tree, scene, method)));
+        }
+        if want(WrapperKind::Hull) {
+            b.hulls = Some(timed(|| hull_tree(tree, scene)));
+        }
+        if want(WrapperKind::Box) {
+            b.boxes = Some(timed(|| tree.aabb.clone()));
+        }
+        if want(WrapperKind::Obb) {
+            let hulls = b.hulls.as_ref().map(|(h, _)| h.as_slice());
+            b.obbs = Some(timed(|| obb_tree(tree, scene, hulls)));
+        }
+        b
+    }
+
+    /// The trees built, in [`WrapperKind`] order, with their build times.
+    fn trees(&self) -> Vec<(WrapperTree<'_>, f64)> {
+        let mut v = Vec::new();
+        if let Some((w, s)) = &self.spheres {
+            v.push((WrapperTree::Spheres(w), *s));
+        }
+        if let Some((w, s)) = &self.hulls {
+            v.push((WrapperTree::Hulls(w), *s));
+        }
+        if let Some((w, s)) = &self.boxes {
+            v.push((WrapperTree::Boxes(w), *s));
+        }
+        if let Some((w, s)) = &self.obbs {
+            v.push((WrapperTree::Obbs(w), *s));
+        }
+        v
+    }
+}
+
+/// Checks that every vertex below each node is inside its wrapper: hulls within
+/// [`HULL_TOL_REL`] × the node's AABB diameter, the others within [`TOL_REL`] × the scene
+/// diagonal.
+pub fn containment(tree: &SubsetTree, scene: &Scene, w: WrapperTree<'_>) -> Containment {
+    let excess = containment_excess(tree, scene, w);
+    let diagonal = scene.aabb().diameter();
+    let (rule, tol): (&str, Box<dyn Fn(usize) -> f64>) = match w {
+        WrapperTree::Hulls(_) => (
+            "1e-5 x node AABB diameter",
+            Box::new(|i| HULL_TOL_REL * tree.aabb[i].diameter()),
+        ),
+        _ => ("1e-9 x scene diagonal", Box::new(|_| TOL_REL * diagonal)),
+    };
+    let worst =
+        (0..excess.len()).max_by(|&a, &b| (excess[a] - tol(a)).total_cmp(&(excess[b] - tol(b))));
+    let max_excess = excess.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    match worst {
+        Some(i) => Containment {
+            max_excess,
+            tolerance_rule: rule,
+            tolerance_at_worst: tol(i),
+            excess_at_worst: excess[i],
+            holds: excess[i] <= tol(i),
+        },
+        None => Containment {
+            max_excess,
+            tolerance_rule: rule,
+            tolerance_at_worst: 0.0,
+            excess_at_worst: max_excess,
+            holds: true,
+        },
+    }
+}
+
+/// Builds the Wrapper Trees of `kinds` (each once, in [`WrapperKind`] order) over `tree` and
+/// reports each one's build time, containment and tightness per level from `samples` surface
+/// samples per wrapper (the reference volumes are the hulls', built untimed when not asked for).
+pub fn report(
+    tree: &SubsetTree,
+    scene: &Scene,
+    kinds: &[WrapperKind],
+    method: SphereMethod,
+    samples: usize,
+) -> Vec<KindReport> {
+    let mut kinds = kinds.to_vec();
+    kinds.sort();
+    kinds.dedup();
+    let built = Built::new(tree, scene, &kinds, method);
+    let own_hulls;
+    let hulls = match &built.hulls {
+        Some((h, _)) => h.as_slice(),
+        None => {
+            own_hulls = hull_tree(tree, scene);
+            own_hulls.as_slice()
+        }
+    };
+    built
+        .trees()
+        .into_iter()
+        .map(|(w, build_seconds)| KindReport {
+            kind: w.kind(),
+            build_seconds,
+            containment: containment(tree, scene, w),
+            levels: level_tightness(tree, scene, w, hulls, samples),
+        })
+        .collect()
+}
