@@ -124,7 +124,7 @@ impl BenchCmd {
 
     /// The targets: grouping time against obvhs PLOC, SAH and query cost against parry Binned.
     fn run_targets(&self) -> Result<ExitCode> {
-        let cases = target_scenes(self.max_soup)?;
+        let mut cases = target_scenes(self.max_soup)?;
         println!(
             "{:<18} {:>8} {:>9} {:>9} {:>7} {:>9} {:>7} {:>8} {:>8} {:>6} {:>8}",
             "scene",

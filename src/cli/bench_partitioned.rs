@@ -21,7 +21,7 @@ fn reset_peak() -> bool {
 
 /// Peak resident memory in MB since the last [`reset_peak`].
 fn peak_mb() -> f64 {
-    super::peak_rss_bytes().unwrap_or(0) as f64 / 1e6
+    wraptree::metrics::peak_rss_bytes().unwrap_or(0) as f64 / 1e6
 }
 
 /// Best time of `repeat` builds of `m` on `threads` threads, its tree's SAH and node tests per
