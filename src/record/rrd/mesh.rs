@@ -1,4 +1,5 @@
-//! The primitives as one shaded triangle mesh, shared by `scene/primitives` and `levels/leaves`.
+//! The primitives as one shaded triangle mesh, shared by `scene/primitives` and
+//! `levels/leaves/<k>` (a subset per leaf depth).
 //!
 //! Every primitive gets its own copies of its vertices, each with the normalised sum of the
 //! area-weighted normals of the primitive's triangles at that vertex: a planar polygon is shaded
