@@ -42,6 +42,10 @@ pub struct RecordCmd {
     /// Leave wall-clock timing out of the .mcap so identical runs give identical bytes.
     #[arg(long)]
     reproducible: bool,
+    /// Write every level to the .mcap (default: from the root down to the first level whose cut
+    /// is half leaves or more; the .rrd always has every level).
+    #[arg(long)]
+    all_levels: bool,
     /// Wrapper Trees logged with the levels, comma-separated: sphere, hull, box (aabb), obb.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "sphere")]
     wrapper: Vec<WrapperKind>,
@@ -64,6 +68,8 @@ pub struct Options {
     pub force: bool,
     /// Leave wall-clock timing out of the `.mcap`.
     pub reproducible: bool,
+    /// Write every level to the `.mcap`, not only down to the first cut of half leaves.
+    pub all_levels: bool,
     /// Limits on the grouping (Ctrl-C/SIGTERM always stop it).
     pub limits: BudgetArgs,
 }
@@ -171,6 +177,7 @@ pub fn record(
         Options {
             force,
             reproducible,
+            all_levels: false,
             limits: BudgetArgs::default(),
         },
         Logged {
@@ -197,6 +204,7 @@ pub fn record_with(
     let Options {
         force,
         reproducible,
+        all_levels,
         limits,
     } = opts;
     if logged.cover.is_some() && !detail.levels() {
@@ -241,6 +249,7 @@ pub fn record_with(
                 let writer = std::io::BufWriter::new(mcap_out);
                 let mut mcap = McapRecorder::start(writer, info)?;
                 mcap.set_reproducible(reproducible);
+                mcap.set_all_levels(all_levels);
                 mcap.write_scene();
                 mcap_worker.run(&mut mcap);
                 Ok::<_, anyhow::Error>(mcap)
@@ -475,6 +484,7 @@ impl RecordCmd {
             Options {
                 force: self.force,
                 reproducible: self.reproducible,
+                all_levels: self.all_levels,
                 limits: self.limits,
             },
             Logged {

@@ -308,6 +308,7 @@ impl ReplayCmd {
             Options {
                 force: self.force,
                 reproducible: false,
+                all_levels: false,
                 limits: self.limits,
             },
             logged,

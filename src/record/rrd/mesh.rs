@@ -84,7 +84,8 @@ impl PrimMesh {
             let (i, base) = (i as usize, m.positions.len() as u32);
             let verts = self.vert_start[i] as usize..self.vert_start[i + 1] as usize;
             let shift = base.wrapping_sub(self.vert_start[i]);
-            m.positions.extend_from_slice(&self.positions[verts.clone()]);
+            m.positions
+                .extend_from_slice(&self.positions[verts.clone()]);
             m.normals.extend_from_slice(&self.normals[verts]);
             let tris = self.prim_tris(i as u32).iter();
             m.tris
