@@ -182,8 +182,14 @@ fn check(run: &Run, detail: Detail, kinds: &[WrapperKind]) {
     if detail.merges() {
         want.extend(["/grouping/merge", "/grouping/active"]);
     }
+    let tree = &run.grouping.tree;
+    let leaf_depths: BTreeSet<u32> = (0..n).map(|x| tree.depth[x]).collect();
+    let leaf_entities: Vec<String> = leaf_depths
+        .iter()
+        .map(|k| format!("/levels/leaves/{k}"))
+        .collect();
     if detail.levels() {
-        want.insert("/levels/leaves");
+        want.extend(leaf_entities.iter().map(String::as_str));
         want.extend(wrapper_entities(kinds));
     }
     let data: BTreeSet<&str> = s
@@ -250,16 +256,23 @@ fn check(run: &Run, detail: Detail, kinds: &[WrapperKind]) {
         );
     }
     if detail.levels() {
-        let levels = range(run.grouping.tree.depth_max() as usize + 1);
-        for e in wrapper_entities(kinds)
-            .into_iter()
-            .chain(["/levels/leaves"])
-        {
-            assert_eq!(
-                sorted(s.entities[e].level.clone()),
-                levels,
-                "{e}: one row per level"
-            );
+        let levels = range(tree.depth_max() as usize + 1);
+        // The preview level: the shallowest whose cut has 64 nodes, else the deepest.
+        let preview = (0..=tree.depth_max())
+            .find(|&d| tree.level(d).len() >= 64)
+            .unwrap_or(tree.depth_max());
+        for e in wrapper_entities(kinds) {
+            let e = &s.entities[e];
+            assert_eq!(sorted(e.level.clone()), levels, "one row per level");
+            assert_eq!(e.merge, [0, 0], "level 0 and the preview at merge 0");
+            assert_eq!(e.round, [0, 0], "level 0 and the preview at round 0");
+        }
+        for (k, e) in leaf_depths.iter().zip(&leaf_entities) {
+            let e = &s.entities[e];
+            assert_eq!(e.level, [i64::from(*k)], "{k}: one row, at its depth");
+            let preview_ticks = if *k <= preview { vec![0] } else { vec![] };
+            assert_eq!(e.merge, preview_ticks, "depth {k} in the preview");
+            assert_eq!(e.round, preview_ticks, "depth {k} in the preview");
         }
     }
 }
@@ -410,7 +423,13 @@ fn record_cli_logs_the_cover_as_one_more_level() {
         String::from_utf8_lossy(&out.stderr)
     );
     let s = summarize(&dir.path().join("rb.rrd"));
-    let last = *s.entities["/levels/leaves"].level.iter().max().unwrap();
+    let last = s
+        .entities
+        .iter()
+        .filter(|(e, _)| e.starts_with("/levels/leaves/"))
+        .flat_map(|(_, v)| v.level.iter().copied())
+        .max()
+        .unwrap();
     let cover: Vec<&str> = s
         .entities
         .keys()

@@ -51,6 +51,10 @@ pub struct RecordCmd {
     /// Wrapper kinds the cover chooses from, comma-separated: sphere, box (or aabb), obb, hull.
     #[arg(long, default_value = "sphere,box,hull", value_delimiter = ',', value_parser = WrapperKind::parse)]
     cover_kinds: Vec<WrapperKind>,
+    /// Write every level to the .mcap (default: from the root down to the first level whose cut
+    /// is half leaves or more; the .rrd always has every level).
+    #[arg(long)]
+    all_levels: bool,
     /// Refine the finished tree (reinsertion, see the README) and record each move on the
     /// `refine` timeline / `/refine/step` topic; the levels are then the refined tree's.
     #[arg(long)]
@@ -153,6 +157,7 @@ impl RecordCmd {
             stop: Some(stop),
             wrappers: self.wrapper,
             cover: limit.map(|l| (l, self.cover_kinds)),
+            all_levels: self.all_levels,
             refine: self.refine.then_some(RefineParams {
                 passes: self.refine_passes,
                 batch: self.refine_batch,

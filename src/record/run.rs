@@ -47,6 +47,8 @@ pub struct RecordOptions {
     /// A cover logged as one more level, within this limit, from these kinds (needs `detail`
     /// with levels).
     pub cover: Option<(CoverLimit, Vec<WrapperKind>)>,
+    /// Write every level to the `.mcap`, not only down to the first cut of half leaves.
+    pub all_levels: bool,
     /// Refine the finished tree with these parameters ([`crate::refine`]), recording each
     /// move; the levels are then the refined tree's.
     pub refine: Option<crate::refine::RefineParams>,
@@ -63,6 +65,7 @@ impl Default for RecordOptions {
             stop: None,
             wrappers: vec![WrapperKind::Sphere],
             cover: None,
+            all_levels: false,
             refine: None,
         }
     }
@@ -103,6 +106,7 @@ pub fn record<O: Observer>(
 ) -> Result<Written> {
     let (scene, source, detail) = (&loaded.scene, &loaded.source, opts.detail);
     let (force, reproducible, limits) = (opts.force, opts.reproducible, opts.limits);
+    let all_levels = opts.all_levels;
     if opts.cover.is_some() && !detail.levels() {
         bail!(
             "--cover-tolerance/--cover-budget need --detail levels or full (the cover is a level)"
@@ -145,6 +149,7 @@ pub fn record<O: Observer>(
                 let writer = std::io::BufWriter::new(mcap_out);
                 let mut mcap = McapRecorder::start(writer, info)?;
                 mcap.set_reproducible(reproducible);
+                mcap.set_all_levels(all_levels);
                 mcap.write_scene();
                 mcap_worker.run(&mut mcap);
                 Ok::<_, anyhow::Error>(mcap)

@@ -3,6 +3,7 @@
 
 pub mod readers;
 
+#[allow(unused_imports)]
 pub use readers::{python, rerun};
 
 use wraptree::geom::P3;

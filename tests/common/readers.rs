@@ -62,8 +62,8 @@ fn provision() -> Result<PathBuf, String> {
     let parent = dir.parent().expect("the venv has a parent");
     std::fs::create_dir_all(parent).map_err(|e| format!("{}: {e}", parent.display()))?;
     let lock_path = dir.with_extension("lock");
-    let lock = std::fs::File::create(&lock_path)
-        .map_err(|e| format!("{}: {e}", lock_path.display()))?;
+    let lock =
+        std::fs::File::create(&lock_path).map_err(|e| format!("{}: {e}", lock_path.display()))?;
     lock.lock()
         .map_err(|e| format!("{}: cannot lock: {e}", lock_path.display()))?;
     // Another test binary may have built it while this one waited for the lock.

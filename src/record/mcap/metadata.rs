@@ -131,6 +131,11 @@ pub fn refine(m: &BTreeMap<String, String>) -> Result<Option<RefineSummary>> {
     }
 }
 
+/// Key the `wraptree` record adds for a finished run recorded with levels: the number of
+/// `/levels/<d>` topics written (d = 0 up to it, exclusive; `depth_max + 1` with
+/// `record --all-levels`).
+pub const LEVELS_WRITTEN: &str = "levels_written";
+
 /// How log times map to grouping steps (also stored under `log_time`).
 pub const LOG_TIME: &str = "scene and attachment at 0 ms; the k-th grouping or refinement event (k = 1, 2, ...) at k ms; \
      /levels/<d> at (events + 1 + d) ms; /cover at (events + 2 + depth_max) ms";

@@ -18,7 +18,7 @@
 //! | `/grouping/active` | `foxglove.SceneUpdate` | entity `active`: one translucent green box per active body at each round start | `--detail merges` or `full` |
 //! | `/grouping/bodies` | `foxglove.SceneUpdate` | entity `merge`: the merged pair (red) and the new body (yellow) as boxes, per merge | `--detail full` (it repeats boxes the merge events already carry, and is the largest per-merge topic) |
 //! | `/grouping/dormant` | `dormantevent.DormantEvent` | round, body, diameter of each body going dormant | `--detail merges` or `full` |
-//! | `/levels/<d>` | `foxglove.SceneUpdate` | one snapshot of the cut at depth d of the finished tree (the refined one with `record --refine`) (d = 0..=depth max), one entity per wrapper kind chosen with `--wrapper` for the cut's interior nodes: `spheres` (`SpherePrimitive`s, size = diameter), `hulls` (one indexed `TriangleListPrimitive` per hull; a segment hull is one degenerate triangle `[a, b, b]`, a point hull `[a, a, a]`), `boxes` (axis-aligned `CubePrimitive`s), `obbs` (`CubePrimitive`s with orientation); and entity `leaves` (the cut's leaves as one orange `TriangleListPrimitive`) | `--detail levels` or `full`, finished runs |
+//! | `/levels/<d>` | `foxglove.SceneUpdate` | one snapshot of the cut at depth d of the finished tree (the refined one with `record --refine`) (d = 0 down to the first cut of half leaves, `LEVEL_LEAF_SHARE`; every depth with `set_all_levels`), one entity per wrapper kind chosen with `--wrapper` for the cut's interior nodes: `spheres` (`SpherePrimitive`s, size = diameter), `hulls` (one indexed `TriangleListPrimitive` per hull; a segment hull is one degenerate triangle `[a, b, b]`, a point hull `[a, a, a]`), `boxes` (axis-aligned `CubePrimitive`s), `obbs` (`CubePrimitive`s with orientation); and entity `leaves` (the cut's leaves as one orange `TriangleListPrimitive`) | `--detail levels` or `full`, finished runs |
 //! | `/cover` | `foxglove.SceneUpdate` | the cover (`--cover-tolerance` or `--cover-budget`) as one more level: entities `spheres`, `boxes` (oriented ones with orientation), `hulls` (one indexed `TriangleListPrimitive` per hull) and `leaves` (one `TriangleListPrimitive` per leaf drawn as itself), only those used | with a cover, `--detail levels` or `full`, finished runs |
 //!
 //! The input scene file is attached (name = its file name, media type `model/obj`, log time 0),
@@ -61,6 +61,17 @@ pub const PROFILE: &str = "";
 /// The MCAP header's library string.
 pub const LIBRARY: &str = concat!("wraptree ", env!("CARGO_PKG_VERSION"), " (mcap-rs 0.26)");
 const MS: u64 = 1_000_000;
+/// Without [`McapRecorder::set_all_levels`], levels are written from the root down to the first
+/// whose cut is at least this share leaves; deeper cuts are mostly the scene itself, and each
+/// repeats its leaves' geometry.
+pub const LEVEL_LEAF_SHARE: f64 = 0.5;
+/// A round start with more active bodies than this writes `/grouping/active` without boxes (the
+/// count is on `/grouping/round`): tens of thousands of boxes overload a 3D panel and the file.
+pub const ACTIVE_CAP: usize = 8192;
+/// `/grouping/bodies` is written for the last this many merges of the run: the merges of the
+/// top of the tree, large enough to be told apart at the scene's scale (the earlier ones are
+/// on `/grouping/merge`).
+pub const BODIES_CAP: u32 = 4096;
 
 /// A channel and its next sequence number.
 #[derive(Clone, Copy, Debug)]
@@ -101,6 +112,7 @@ pub struct McapRecorder<'a, W: Write + Seek> {
     /// The refinement seen so far (`record --refine`) and its `/refine/step` channel.
     refine: Option<(metadata::RefineSummary, Topic)>,
     reproducible: bool,
+    all_levels: bool,
     error: Option<anyhow::Error>,
     buf: Vec<u8>,
 }
@@ -201,6 +213,7 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             events: 0,
             refine: None,
             reproducible: false,
+            all_levels: false,
             error: None,
             buf: Vec::new(),
             scene_topic,
@@ -251,6 +264,12 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
         self.reproducible = on;
     }
 
+    /// Writes every level down to the deepest (`record --all-levels`) instead of stopping at
+    /// the first whose cut is [`LEVEL_LEAF_SHARE`] leaves.
+    pub fn set_all_levels(&mut self, on: bool) {
+        self.all_levels = on;
+    }
+
     fn record(&mut self, event: &Event<'_>) -> Result<()> {
         let t = self.events * MS;
         let (w, buf) = (&mut self.writer, &mut self.buf);
@@ -279,7 +298,11 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
                 if let Some([active_topic, _]) = detail {
                     let mut e = scene_msgs::entity("active", t);
                     let bodies = &self.bodies;
-                    e.cubes = active
+                    e.cubes = active[..if active.len() > ACTIVE_CAP {
+                        0
+                    } else {
+                        active.len()
+                    }]
                         .iter()
                         .map(|&id| {
                             let b = bodies.get(id as usize).copied().unwrap_or(Aabb::EMPTY);
@@ -296,7 +319,8 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
                     self.bodies.resize(new + 1, Aabb::EMPTY);
                 }
                 self.bodies[new] = m.aabb;
-                if let Some(bodies_topic) = bodies_topic {
+                let last = self.info.scene.len().saturating_sub(1) as u32;
+                if let Some(bodies_topic) = bodies_topic.filter(|_| m.step + BODIES_CAP >= last) {
                     let mut e = scene_msgs::entity("merge", t);
                     let get =
                         |id: u32| self.bodies.get(id as usize).copied().unwrap_or(Aabb::EMPTY);
@@ -388,10 +412,12 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
         Ok(())
     }
 
-    /// Writes one `/levels/<d>` snapshot per depth of the finished tree.
-    fn write_levels(&mut self, outcome: &Outcome<'_>) -> Result<()> {
+    /// Writes one `/levels/<d>` snapshot per depth of the finished tree, from the root down to
+    /// the first cut of [`LEVEL_LEAF_SHARE`] leaves (to the deepest with `all_levels`); returns
+    /// the number of levels written.
+    fn write_levels(&mut self, outcome: &Outcome<'_>) -> Result<u32> {
         let (Some(grouping), Some(spheres)) = (outcome.grouping, outcome.spheres) else {
-            return Ok(());
+            return Ok(0);
         };
         let tree = &grouping.tree;
         if !spheres.is_empty() && spheres.len() != tree.len() {
@@ -415,7 +441,9 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             leaves_by_depth[tree.depth[x] as usize].push(x);
         }
         let mut leaf_mesh = SceneMesh::new(scene);
+        let mut written = 0;
         for d in 0..=tree.depth_max() {
+            written = d + 1;
             let t = (self.events + 1 + u64::from(d)) * MS;
             let mut topic =
                 add_topic(&mut self.writer, self.scene_update, &format!("/levels/{d}"))?;
@@ -467,6 +495,10 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             let msg = scene_msgs::update(entities);
             emit(&mut self.writer, &mut self.buf, &mut topic, t, &msg)
                 .with_context(|| format!("writing level {d}"))?;
+            let leaves = cut.len() - interior.len();
+            if !self.all_levels && leaves as f64 >= LEVEL_LEAF_SHARE * cut.len() as f64 {
+                break;
+            }
         }
         if let Some(cover) = &outcome.cover {
             let t = (self.events + 2 + u64::from(tree.depth_max())) * MS;
@@ -475,13 +507,17 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             emit(&mut self.writer, &mut self.buf, &mut topic, t, &msg)
                 .context("writing the cover")?;
         }
-        Ok(())
+        Ok(written)
     }
 
     /// Levels, metadata records and the summary section.
     fn write_tail(&mut self, outcome: &Outcome<'_>) -> Result<()> {
+        let mut run = metadata::run_record(&self.info, outcome);
         if self.info.detail.levels() {
-            self.write_levels(outcome)?;
+            let written = self.write_levels(outcome)?;
+            if outcome.grouping.is_some() {
+                run.insert(metadata::LEVELS_WRITTEN.into(), written.to_string());
+            }
         }
         let mut run = metadata::run_record(&self.info, outcome);
         if let Some((summary, _)) = &self.refine {

@@ -1,4 +1,5 @@
-//! The primitives as one shaded triangle mesh, shared by `scene/primitives` and `levels/leaves`.
+//! The primitives as one shaded triangle mesh, shared by `scene/primitives` and
+//! `levels/leaves/<k>` (a subset per leaf depth).
 //!
 //! Every primitive gets its own copies of its vertices, each with the normalised sum of the
 //! area-weighted normals of the primitive's triangles at that vertex: a planar polygon is shaded
@@ -83,7 +84,8 @@ impl PrimMesh {
             let (i, base) = (i as usize, m.positions.len() as u32);
             let verts = self.vert_start[i] as usize..self.vert_start[i + 1] as usize;
             let shift = base.wrapping_sub(self.vert_start[i]);
-            m.positions.extend_from_slice(&self.positions[verts.clone()]);
+            m.positions
+                .extend_from_slice(&self.positions[verts.clone()]);
             m.normals.extend_from_slice(&self.normals[verts]);
             let tris = self.prim_tris(i as u32).iter();
             m.tris

@@ -40,11 +40,11 @@
 //!
 //! Each series entity carries static `SeriesLines` names and colours, one per scalar of its rows.
 //! | `log/doublings` | `TextLog` | `merge`, `round` | all | one line per round start (DLimit, GLimit, active, dormant, pairs), per doubling and at the finish |
-//! | `levels/spheres` | `Ellipsoids3D` | `level` | levels, full | interior nodes of the cut at depth d, as translucent blue spheres (`--wrapper sphere`) |
+//! | `levels/spheres` | `Ellipsoids3D` | `level` (and the preview level at `merge` 0, `round` 0) | levels, full | interior nodes of the cut at depth d, as translucent blue spheres (`--wrapper sphere`) |
 //! | `levels/hulls` | `Mesh3D` | `level` | levels, full | interior nodes' convex hulls, translucent green (`--wrapper hull`; every distinct hull vertex once at d = 0, then only the triangle indices of the cut's hulls) |
 //! | `levels/boxes` | `Boxes3D` | `level` | levels, full | interior nodes' axis-aligned boxes, translucent violet (`--wrapper box`) |
 //! | `levels/obbs` | `Boxes3D` | `level` | levels, full | interior nodes' oriented boxes (rotations as quaternions), translucent dark violet (`--wrapper obb`) |
-//! | `levels/leaves` | `Mesh3D` | `level` | levels, full | leaves in the cut at depth d, as their polygons (vertices once at d = 0, then only triangle indices) |
+//! | `levels/leaves/<k>` | `Mesh3D` | `level` (tick k; ticks ≤ the preview also at `merge` 0, `round` 0) | levels, full | the leaves at depth k, as their polygons, logged once and never cleared: at tick d the entities k ≤ d draw the cut's leaves |
 //! | `cover/spheres`, `cover/boxes` | `Ellipsoids3D`, `Boxes3D` | `level` (depth max + 1) | levels, full | the cover's spheres and boxes (oriented ones with rotations), colours as in `levels/*` (`--cover-tolerance`/`--cover-budget`) |
 //! | `cover/hulls`, `cover/leaves` | `Mesh3D` | `level` (depth max + 1) | levels, full | the cover's hulls, and its leaves drawn as themselves, each one mesh |
 //! | `cover/summary` | `TextLog` | static | levels, full | tolerance (and budget), size and largest error of the cover |
