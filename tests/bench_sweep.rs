@@ -103,7 +103,11 @@ fn bench_writes_one_row_per_method_and_wrapper_with_charts_and_rrd() {
     }
     let e = entities(&out.join("bench.rrd"));
     for m in Method::ALL {
-        let path = format!("/bench/robot-base/time_vs_query/{}", m.name());
+        // Rerun escapes `+` (the refined methods' names) in entity paths.
+        let path = format!(
+            "/bench/robot-base/time_vs_query/{}",
+            m.name().replace('+', "\\+")
+        );
         assert!(e.contains(&path), "{path}: {e:?}");
     }
     assert!(
