@@ -11,10 +11,10 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use wraptree::record::output::output_prefix;
 use wraptree::record::{Detail, RecordOptions, Written, record};
+use wraptree::refine::RefineParams;
 use wraptree::scene::Scene;
 use wraptree::wrap::WrapperKind;
 use wraptree::wrap::cover::solve::{CoverLimit, Tolerance};
-use wraptree::refine::RefineParams;
 
 /// Arguments of `wraptree record`.
 #[derive(Args, Debug)]

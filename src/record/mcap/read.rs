@@ -5,7 +5,9 @@
 //! data-section and summary CRC checks and a record length limit), so truncated or corrupted
 //! files give an error, never a panic, and no index offset from the file is trusted.
 
-use super::messages::{DormantEvent, FinishEvent, MergeEvent, PartEvent, RefineStepEvent, RoundEvent};
+use super::messages::{
+    DormantEvent, FinishEvent, MergeEvent, PartEvent, RefineStepEvent, RoundEvent,
+};
 use super::metadata;
 use crate::geom::Aabb;
 use crate::grouping::{EventLog, Merge, Part, ResolvedParams, SubsetTree};
