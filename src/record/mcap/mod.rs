@@ -519,7 +519,6 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
                 run.insert(metadata::LEVELS_WRITTEN.into(), written.to_string());
             }
         }
-        let mut run = metadata::run_record(&self.info, outcome);
         if let Some((summary, _)) = &self.refine {
             metadata::put_refine(&mut run, summary);
         }
