@@ -197,7 +197,8 @@ fn check(run: &Run, detail: Detail, kinds: &[WrapperKind]) {
         .keys()
         .map(String::as_str)
         .filter(|e| {
-            !e.starts_with("/__properties") && !["/", "/scene", "/grouping", "/levels"].contains(e)
+            !e.starts_with("/__properties")
+                && !["/", "/scene", "/grouping", "/levels", "/refine"].contains(e)
         })
         .collect();
     assert_eq!(data, want, "entity paths at {detail:?}");
