@@ -259,9 +259,9 @@ pub enum RefineVerified {
         /// Move index.
         step: usize,
         /// The recorded move there, if any.
-        recorded: Option<Step>,
+        recorded: Option<Box<Step>>,
         /// The re-run's move there, if any.
-        rerun: Option<Step>,
+        rerun: Option<Box<Step>>,
     },
 }
 
@@ -292,8 +292,8 @@ pub fn verify_refinement(replay: &Replay) -> Result<Option<RefineVerified>> {
             },
             Some(step) => RefineVerified::Diverged {
                 step,
-                recorded: rec.refine_steps.get(step).copied(),
-                rerun: log.refine.get(step).copied(),
+                recorded: rec.refine_steps.get(step).copied().map(Box::new),
+                rerun: log.refine.get(step).copied().map(Box::new),
             },
         },
     ))

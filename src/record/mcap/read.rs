@@ -88,7 +88,6 @@ impl Recorded {
             refine_start: self.refine.map(|r| (r.params, r.sah_before)),
             refine: self.refine_steps.clone(),
             parts: self.parts.clone(),
-            ..EventLog::default()
         }
     }
 }
