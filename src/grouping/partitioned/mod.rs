@@ -15,7 +15,7 @@
 //! 4. Each of those subproblems is the paper's step: Cost = diameter^A × (B·Fill + C·Balance),
 //!    the AABB p-set, DLimit/GLimit eligibility from DLimit0/GLimit0 with doubling, the
 //!    cheapest eligible pair first, ties by the pair's tie tags of the run's (global) ids. Up to
-//!    [`SMALL`](small::SMALL) bodies it is solved by brute force ([`small`]), above with the
+//!    `SMALL` bodies it is solved by brute force (`small`), above with the
 //!    voxel hash and MPairs of the exact schedule.
 //!
 //! The halves of the split are grouped in parallel (rayon, in the current thread pool). Every

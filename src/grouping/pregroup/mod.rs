@@ -9,7 +9,7 @@
 //!    triangle, a six-face box) stay as primitives in the top level, so a soup of tiny pieces
 //!    costs what the plain run costs (plus finding the components).
 //! 3. With instancing, parts that are rigid copies of an earlier part are found
-//!    ([`instancing`]); they are not grouped.
+//!    (`instancing`); they are not grouped.
 //! 4. Every other part is grouped by the grouping phase (`cluster::run_boxes`) on its own, in
 //!    parallel (rayon). Each part starts its rounds from its own bodies: DLimit0 = the median
 //!    diameter of its bodies, GLimit0 = DLimit0 × the run's GLimit0/DLimit0 (1/4 by default),
