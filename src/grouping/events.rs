@@ -240,6 +240,104 @@ impl<A: Observer, B: Observer> Observer for Tee<A, B> {
     }
 }
 
+/// An owned copy of an [`Event`]: the event itself with a round start's active list moved
+/// into `active` (the only borrowed field).
+#[derive(Clone, Debug)]
+pub struct OwnedEvent {
+    event: Event<'static>,
+    active: Vec<u32>,
+}
+
+impl OwnedEvent {
+    /// Copies `e`.
+    pub fn of(e: &Event<'_>) -> OwnedEvent {
+        match *e {
+            Event::RoundStart {
+                round,
+                dlimit,
+                glimit,
+                active,
+                dormant,
+                pairs,
+            } => OwnedEvent {
+                event: Event::RoundStart {
+                    round,
+                    dlimit,
+                    glimit,
+                    active: &[],
+                    dormant,
+                    pairs,
+                },
+                active: active.to_vec(),
+            },
+            Event::Merge(m) => OwnedEvent::plain(Event::Merge(m)),
+            Event::Part(p) => OwnedEvent::plain(Event::Part(p)),
+            Event::Refine(s) => OwnedEvent::plain(Event::Refine(s)),
+            Event::RefineStart { params, sah } => {
+                OwnedEvent::plain(Event::RefineStart { params, sah })
+            }
+            Event::Dormant {
+                round,
+                body,
+                diameter,
+            } => OwnedEvent::plain(Event::Dormant {
+                round,
+                body,
+                diameter,
+            }),
+            Event::Doubling {
+                round,
+                merges,
+                dlimit,
+                glimit,
+            } => OwnedEvent::plain(Event::Doubling {
+                round,
+                merges,
+                dlimit,
+                glimit,
+            }),
+            Event::Finish {
+                root,
+                rounds,
+                merges,
+            } => OwnedEvent::plain(Event::Finish {
+                root,
+                rounds,
+                merges,
+            }),
+        }
+    }
+
+    fn plain(event: Event<'static>) -> OwnedEvent {
+        OwnedEvent {
+            event,
+            active: Vec::new(),
+        }
+    }
+
+    /// The event, borrowing the active list from this copy.
+    pub fn event(&self) -> Event<'_> {
+        match self.event {
+            Event::RoundStart {
+                round,
+                dlimit,
+                glimit,
+                dormant,
+                pairs,
+                ..
+            } => Event::RoundStart {
+                round,
+                dlimit,
+                glimit,
+                active: &self.active,
+                dormant,
+                pairs,
+            },
+            e => e,
+        }
+    }
+}
+
 /// Collects an owned copy of every event; used by tests and by `replay --verify`.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct EventLog {

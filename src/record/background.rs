@@ -4,6 +4,7 @@
 //! list is the one allocation) into a batch and sends each full batch, shared, down one
 //! bounded channel per worker.
 
+use crate::grouping::events::OwnedEvent as Owned;
 use crate::grouping::{Event, Observer};
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
@@ -12,100 +13,6 @@ use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 const BATCH: usize = 1024;
 /// Batches in flight before the grouping thread waits for the worker.
 const IN_FLIGHT: usize = 64;
-
-/// An owned copy of an [`Event`]: the event itself with a round start's active list moved
-/// into `active` (the only borrowed field).
-#[derive(Clone, Debug)]
-struct Owned {
-    event: Event<'static>,
-    active: Vec<u32>,
-}
-
-impl Owned {
-    fn of(e: &Event<'_>) -> Owned {
-        match *e {
-            Event::RoundStart {
-                round,
-                dlimit,
-                glimit,
-                active,
-                dormant,
-                pairs,
-            } => Owned {
-                event: Event::RoundStart {
-                    round,
-                    dlimit,
-                    glimit,
-                    active: &[],
-                    dormant,
-                    pairs,
-                },
-                active: active.to_vec(),
-            },
-            Event::Merge(m) => Owned::plain(Event::Merge(m)),
-            Event::Part(p) => Owned::plain(Event::Part(p)),
-            Event::Refine(s) => Owned::plain(Event::Refine(s)),
-            Event::RefineStart { params, sah } => Owned::plain(Event::RefineStart { params, sah }),
-            Event::Dormant {
-                round,
-                body,
-                diameter,
-            } => Owned::plain(Event::Dormant {
-                round,
-                body,
-                diameter,
-            }),
-            Event::Doubling {
-                round,
-                merges,
-                dlimit,
-                glimit,
-            } => Owned::plain(Event::Doubling {
-                round,
-                merges,
-                dlimit,
-                glimit,
-            }),
-            Event::Finish {
-                root,
-                rounds,
-                merges,
-            } => Owned::plain(Event::Finish {
-                root,
-                rounds,
-                merges,
-            }),
-        }
-    }
-
-    fn plain(event: Event<'static>) -> Owned {
-        Owned {
-            event,
-            active: Vec::new(),
-        }
-    }
-
-    fn event(&self) -> Event<'_> {
-        match self.event {
-            Event::RoundStart {
-                round,
-                dlimit,
-                glimit,
-                dormant,
-                pairs,
-                ..
-            } => Event::RoundStart {
-                round,
-                dlimit,
-                glimit,
-                active: &self.active,
-                dormant,
-                pairs,
-            },
-            e => e,
-        }
-    }
-}
 
 /// The sending half: pass it to the grouping phase as its observer, then call
 /// [`Background::close`] so the workers see the last batch.

@@ -260,7 +260,7 @@ pub(super) fn run<O: Observer>(
     let rep_merges: Vec<Vec<Merge>> = runs
         .iter()
         .map(|r| match r {
-            Some((_, buf)) if listen => buf.merges().copied().collect(),
+            Some((_, buf)) if listen => buf.merges().collect(),
             _ => Vec::new(),
         })
         .collect();

@@ -1,82 +1,22 @@
 //! Events of a part run with local ids, buffered while parts run in parallel and passed on
 //! with global ids in the documented order.
 
-use crate::grouping::events::{Event, Merge, Observer};
+use crate::grouping::events::{Event, Merge, Observer, OwnedEvent};
 
 /// An owned copy of the events of one part run (no `Part`, no `Finish`).
 #[derive(Default)]
-pub(super) struct Buffer(pub Vec<Owned>);
-
-/// An owned [`Event`] of a part run.
-pub(super) enum Owned {
-    RoundStart {
-        round: u32,
-        dlimit: f64,
-        glimit: f64,
-        active: Vec<u32>,
-        dormant: u32,
-        pairs: u64,
-    },
-    Merge(Merge),
-    Dormant {
-        round: u32,
-        body: u32,
-        diameter: f64,
-    },
-    Doubling {
-        round: u32,
-        merges: u32,
-        dlimit: f64,
-        glimit: f64,
-    },
-}
+pub(super) struct Buffer(pub Vec<OwnedEvent>);
 
 impl Observer for Buffer {
     fn on_event(&mut self, event: &Event<'_>) {
-        let owned = match *event {
-            Event::RoundStart {
-                round,
-                dlimit,
-                glimit,
-                active,
-                dormant,
-                pairs,
-            } => Owned::RoundStart {
-                round,
-                dlimit,
-                glimit,
-                active: active.to_vec(),
-                dormant,
-                pairs,
-            },
-            Event::Merge(m) => Owned::Merge(m),
-            Event::Dormant {
-                round,
-                body,
-                diameter,
-            } => Owned::Dormant {
-                round,
-                body,
-                diameter,
-            },
-            Event::Doubling {
-                round,
-                merges,
-                dlimit,
-                glimit,
-            } => Owned::Doubling {
-                round,
-                merges,
-                dlimit,
-                glimit,
-            },
+        match event {
             // A part's own parts, finish and refinement (never inside a grouping) are not replayed.
             Event::Part(_)
             | Event::Finish { .. }
             | Event::RefineStart { .. }
-            | Event::Refine(_) => return,
-        };
-        self.0.push(owned);
+            | Event::Refine(_) => {}
+            e => self.0.push(OwnedEvent::of(e)),
+        }
     }
 }
 
@@ -84,52 +24,14 @@ impl Buffer {
     /// Passes the buffered events on to `to`.
     pub(super) fn replay<O: Observer>(&self, to: &mut O) {
         for e in &self.0 {
-            let event = match e {
-                Owned::RoundStart {
-                    round,
-                    dlimit,
-                    glimit,
-                    active,
-                    dormant,
-                    pairs,
-                } => Event::RoundStart {
-                    round: *round,
-                    dlimit: *dlimit,
-                    glimit: *glimit,
-                    active,
-                    dormant: *dormant,
-                    pairs: *pairs,
-                },
-                Owned::Merge(m) => Event::Merge(*m),
-                Owned::Dormant {
-                    round,
-                    body,
-                    diameter,
-                } => Event::Dormant {
-                    round: *round,
-                    body: *body,
-                    diameter: *diameter,
-                },
-                Owned::Doubling {
-                    round,
-                    merges,
-                    dlimit,
-                    glimit,
-                } => Event::Doubling {
-                    round: *round,
-                    merges: *merges,
-                    dlimit: *dlimit,
-                    glimit: *glimit,
-                },
-            };
-            to.on_event(&event);
+            to.on_event(&e.event());
         }
     }
 
     /// The buffered merges, in order.
-    pub(super) fn merges(&self) -> impl Iterator<Item = &Merge> {
-        self.0.iter().filter_map(|e| match e {
-            Owned::Merge(m) => Some(m),
+    pub(super) fn merges(&self) -> impl Iterator<Item = Merge> + '_ {
+        self.0.iter().filter_map(|e| match e.event() {
+            Event::Merge(m) => Some(m),
             _ => None,
         })
     }
