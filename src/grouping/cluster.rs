@@ -1,11 +1,13 @@
 //! The round loop of §2.2 (steps 2–5), generic over the p-set wrapper.
 //!
-//! Partner searches (the voxel scans of steps 3 and 4b) live in [`scan`].
+//! Partner searches (the voxel scans of steps 3 and 4b) live in [`scan`], Fill and Balance in
+//! [`fill`], and the runs on bodies given by their boxes (pre-grouping's parts, the partitioned
+//! schedule's chunks) in [`boxes`].
 
 use super::events::{Event, Merge, Observer};
 use super::hull_pset::HullBodies;
 use super::mpairs::{Entry, MPairs, Partners, order_bits};
-use super::pset::{AabbBodies, PSetBodies};
+use super::pset::PSetBodies;
 use super::subset_tree::{NONE, SubsetTree};
 use super::voxel_hash::VoxelHash;
 use super::{Budget, Grouping, PSet, ResolvedParams, Stats, StopReason, Stopped};
@@ -13,9 +15,13 @@ use crate::geom::Aabb;
 use crate::scene::Scene;
 use std::sync::atomic::Ordering;
 
+mod boxes;
+mod fill;
 mod keys;
 mod scan;
 
+pub(crate) use boxes::{run_boxes, run_boxes_until};
+pub(in crate::grouping) use fill::{box_area, fill_balance};
 pub(in crate::grouping) use keys::{spread_bits, tie_tag};
 
 /// Runs the grouping phase; see the module doc of [`super`] for the steps.
@@ -35,73 +41,6 @@ pub(super) fn run<O: Observer>(
             Clusterer::new(boxes, params, bodies, diameters, observer).run(budget)
         }
     }
-}
-
-/// Runs the grouping phase with the AABB p-set on bodies given by their boxes (leaf `i` has
-/// box `boxes[i]`; its diameter is the box diagonal): the primitives of a scene, or the roots
-/// of groupings made before (components, chunks). Merge ids are local: leaves `0..boxes.len()`.
-pub(crate) fn run_boxes<O: Observer>(
-    boxes: Vec<Aabb>,
-    params: &ResolvedParams,
-    observer: O,
-    budget: &Budget<'_>,
-) -> Result<Grouping, Stopped> {
-    assert!(!boxes.is_empty(), "grouping needs at least one body");
-    let diameters = boxes.iter().map(Aabb::diameter).collect();
-    Clusterer::new(boxes, params, AabbBodies, diameters, observer).run(budget)
-}
-
-/// What [`run_boxes_until`] leaves: the merges made (local ids, as in [`run_boxes`]) and the
-/// bodies still without a parent.
-pub(crate) struct Partial {
-    /// Children of each new body, in merge order (new body `i` has local id `boxes.len() + i`).
-    pub children: Vec<[u32; 2]>,
-    /// Box of each new body, in merge order.
-    pub aabb: Vec<Aabb>,
-    /// Diameter of each new body, in merge order.
-    pub diameter: Vec<f64>,
-    /// Local ids of the bodies left without a parent, in increasing order.
-    pub roots: Vec<u32>,
-    /// Rounds run.
-    pub rounds: u32,
-    /// Work counters.
-    pub stats: Stats,
-}
-
-/// Like [`run_boxes`], but stops as soon as only `keep` (≥ 1) parent-less bodies remain, and
-/// breaks ties by the tags of the ids `tag_id(local id)` (so a subproblem whose local ids map
-/// increasingly onto a larger run's ids breaks ties as that run would). No `Finish` event.
-pub(crate) fn run_boxes_until<O: Observer>(
-    boxes: Vec<Aabb>,
-    keep: usize,
-    tag_id: impl Fn(u32) -> u32,
-    params: &ResolvedParams,
-    observer: O,
-    budget: &Budget<'_>,
-) -> Result<Partial, Stopped> {
-    assert!(
-        keep >= 1 && keep <= boxes.len(),
-        "keep must be in 1..=bodies"
-    );
-    let n = boxes.len();
-    let diameters = boxes.iter().map(Aabb::diameter).collect();
-    let mut c = Clusterer::new(boxes, params, AabbBodies, diameters, observer);
-    c.keep = keep;
-    for (i, t) in c.tag.iter_mut().enumerate() {
-        *t = tie_tag(params.seed, tag_id(i as u32));
-    }
-    let rounds = c.rounds(budget)?;
-    let roots = (0..c.parent.len() as u32)
-        .filter(|&x| c.parent[x as usize] == NONE && (x as usize) < n + c.children.len())
-        .collect();
-    Ok(Partial {
-        aabb: c.aabb.split_off(n),
-        diameter: c.diameter.split_off(n),
-        children: c.children,
-        roots,
-        rounds,
-        stats: c.stats,
-    })
 }
 
 /// The budget as the round-start scans see it: pairs left before `max_pairs` is exceeded,
@@ -134,30 +73,6 @@ impl ScanLimit<'_> {
         }
         false
     }
-}
-
-/// Surface area of a box with extents `e` (the size measure of `--cost area`).
-#[inline(always)]
-pub(super) fn box_area(e: &crate::geom::V3) -> f64 {
-    2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
-}
-
-/// Fill and Balance of a would-be parent of diameter `d` over children of diameters `dx`, `dy`.
-///
-/// Point-like children (diameter 0) get documented fallbacks: Fill = 1 when both children are
-/// points, and Balance uses the smaller diameter floored at 1e-12 × the larger (so it is at
-/// most 1e12) and is 1 when both are points.
-#[inline]
-pub(super) fn fill_balance(d: f64, dx: f64, dy: f64) -> (f64, f64) {
-    let sum = dx + dy;
-    let fill = if sum > 0.0 { d / sum } else { 1.0 };
-    let (lo, hi) = if dx < dy { (dx, dy) } else { (dy, dx) };
-    let balance = if hi > 0.0 {
-        hi / lo.max(hi * 1e-12)
-    } else {
-        1.0
-    };
-    (fill, balance)
 }
 
 /// The state of one grouping run.

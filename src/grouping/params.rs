@@ -1,0 +1,313 @@
+//! The parameters of a grouping run: the Cost [`Weights`] of eq. (2), the initial DLimit and
+//! GLimit (resolved from the scene by [`Params::resolve`]), the p-set wrapper and the [`Mode`]
+//! (schedule, pre-grouping, size measure).
+
+use crate::scene::Scene;
+
+/// The p-set wrapper bodies carry while grouping.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum PSet {
+    /// Axis-aligned boxes, diagonal as diameter, L∞ gaps (the paper's fast variant).
+    #[default]
+    Aabb,
+    /// Convex hulls (parry), largest vertex distance as diameter, L2 gaps (GJK).
+    Hull,
+}
+
+/// The Cost weights of eq. (2).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Weights {
+    /// Exponent A on the diameter.
+    pub a: f64,
+    /// Weight B on Fill.
+    pub b: f64,
+    /// Weight C on Balance.
+    pub c: f64,
+}
+
+impl Weights {
+    /// Cost = diameter^A × (B·Fill + C·Balance). When B = C = 0 the bracket would vanish for
+    /// every pair; it is then taken as 1, so the cost is diameter^A.
+    #[inline]
+    pub fn cost(&self, diameter: f64, fill: f64, balance: f64) -> f64 {
+        let scale = if self.a == 1.0 {
+            diameter
+        } else if self.a == 0.0 {
+            1.0
+        } else {
+            diameter.powf(self.a)
+        };
+        self.cost_scaled(scale, fill, balance)
+    }
+
+    /// Checks that A, B and C are finite and ≥ 0; the error names the weight (`a`, `b`, `c`).
+    pub fn check(&self) -> Result<(), String> {
+        for (name, v) in [("a", self.a), ("b", self.b), ("c", self.c)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("{name} must be a finite number ≥ 0, got {v}"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The cost given `scale` = diameter^A already computed.
+    #[inline(always)]
+    pub fn cost_scaled(&self, scale: f64, fill: f64, balance: f64) -> f64 {
+        if self.b == 0.0 && self.c == 0.0 {
+            scale
+        } else {
+            scale * (self.b * fill + self.c * balance)
+        }
+    }
+}
+
+/// How the grouping phase is scheduled over the scene.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Schedule {
+    /// The literal §2.2 run over all bodies at once (the default; what users debug step by step).
+    #[default]
+    Exact,
+    /// The same grouping step run inside the chunks of a top-down Morton split, bottom-up
+    /// (approximate agglomerative clustering), in parallel.
+    Partitioned,
+}
+
+/// Which components are grouped on their own before the top level (the paper's §1.3 speed-up).
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Pregroup {
+    /// No pre-grouping: the literal §2.2 run.
+    #[default]
+    None,
+    /// The file's own `o`/`g` objects are the components.
+    Objects,
+    /// Primitives joined by shared (welded) vertices are the components.
+    Connected,
+}
+
+/// The size measure in the Cost: the paper's diameter, or a surface-area alternative.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum CostMeasure {
+    /// Cost = diameter^A × (B·Fill + C·Balance), eq. (2) of the paper.
+    #[default]
+    Diameter,
+    /// The surface area of the merged box in place of the diameter (Walter et al. 2008).
+    Area,
+}
+
+/// How a grouping run is organised beyond its Cost weights and limits. The default is the
+/// literal §2.2 run; every other setting is recorded in recordings' metadata so that
+/// `replay --verify` re-runs the same mode.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct Mode {
+    /// Exact or partitioned schedule.
+    pub schedule: Schedule,
+    /// Components grouped first, if any.
+    pub pregroup: Pregroup,
+    /// Whether rigid copies of a component reuse its Subset Tree shape.
+    pub instancing: bool,
+    /// The size measure in the Cost.
+    pub cost: CostMeasure,
+}
+
+impl Mode {
+    /// Checks that the settings fit together with the p-set `pset`: instancing needs
+    /// pre-grouping (copies are found among components), and pre-grouping needs the AABB p-set.
+    /// The errors name the CLI flags.
+    pub fn check(&self, pset: PSet) -> Result<(), String> {
+        if self.instancing && self.pregroup == Pregroup::None {
+            return Err(
+                "--instancing needs --pregroup objects or --pregroup connected (copies are \
+                 found among components)"
+                    .to_string(),
+            );
+        }
+        if self.pregroup != Pregroup::None && pset != PSet::Aabb {
+            return Err("--pregroup needs --pset aabb (parts are grouped as boxes)".to_string());
+        }
+        Ok(())
+    }
+}
+
+/// User-facing parameters; `None` limits are derived from the scene by [`Params::resolve`].
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Params {
+    /// Cost weights.
+    pub weights: Weights,
+    /// Initial DLimit (default: median primitive diameter).
+    pub dlimit: Option<f64>,
+    /// Initial GLimit (default: DLimit / 4).
+    pub glimit: Option<f64>,
+    /// P-set wrapper kind.
+    pub pset: PSet,
+    /// Seed for randomised tie-breaking (`None`: ties break by id).
+    pub seed: Option<u64>,
+    /// Schedule, pre-grouping, instancing and Cost measure.
+    #[serde(default)]
+    pub mode: Mode,
+}
+
+impl Default for Params {
+    /// A = 1, B = 1, C = 0: cost = diameter × Fill. The calibration runs found Balance (C > 0)
+    /// worsened SAH on every scene and could produce degenerate trees with small GLimit.
+    fn default() -> Self {
+        Params {
+            weights: Weights {
+                a: 1.0,
+                b: 1.0,
+                c: 0.0,
+            },
+            dlimit: None,
+            glimit: None,
+            pset: PSet::Aabb,
+            seed: None,
+            mode: Mode::default(),
+        }
+    }
+}
+
+/// Parameters with every limit fixed, as recorded in recordings' metadata.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ResolvedParams {
+    /// Cost weights.
+    pub weights: Weights,
+    /// DLimit of the first round.
+    pub dlimit0: f64,
+    /// GLimit of the first round.
+    pub glimit0: f64,
+    /// P-set wrapper kind.
+    pub pset: PSet,
+    /// Seed for randomised ties, if any.
+    pub seed: Option<u64>,
+    /// Schedule, pre-grouping, instancing and Cost measure.
+    #[serde(default)]
+    pub mode: Mode,
+}
+
+impl ResolvedParams {
+    /// Checks what the round loop relies on: valid weights and finite, positive initial limits
+    /// (with GLimit0 = 0 a scene of several components would never finish). Parameters from
+    /// [`Params::resolve`] always pass; ones read from a file may not.
+    pub fn check(&self) -> Result<(), String> {
+        self.weights.check()?;
+        self.mode.check(self.pset)?;
+        for (name, v) in [("dlimit0", self.dlimit0), ("glimit0", self.glimit0)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("{name} must be a finite number > 0, got {v}"));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Params {
+    /// Checks values as a user gives them: valid weights, a given DLimit and GLimit finite and
+    /// > 0, and a mode the p-set supports. The error names the command-line flag (`--a`,
+    /// `--dlimit`, …).
+    pub fn check(&self) -> Result<(), String> {
+        self.weights.check().map_err(|e| format!("--{e}"))?;
+        for (name, v) in [("--dlimit", self.dlimit), ("--glimit", self.glimit)] {
+            if let Some(v) = v
+                && !(v.is_finite() && v > 0.0)
+            {
+                return Err(format!("{name} must be a finite number > 0, got {v}"));
+            }
+        }
+        self.mode.check(self.pset)
+    }
+
+    /// Fixes the initial limits: DLimit0 = the median primitive diameter (AABB diagonal) and
+    /// GLimit0 = DLimit0 / 4. When that median is 0 (point-like primitives) DLimit0 falls back
+    /// to 1e-6 × the scene diagonal, and to 1 for a scene that is a single point. A given
+    /// DLimit ≤ 0 (or not finite) becomes 1; a given GLimit ≤ 0 becomes 1e-9 × DLimit0, since
+    /// the paper's GLimit must be positive for scenes of several connected components.
+    pub fn resolve(&self, scene: &Scene) -> ResolvedParams {
+        let dlimit0 = match self.dlimit {
+            Some(d) => d,
+            None => {
+                let mut d: Vec<f64> = (0..scene.len())
+                    .map(|i| scene.prim_aabb(i).diameter())
+                    .collect();
+                let median = if d.is_empty() {
+                    0.0
+                } else {
+                    let mid = d.len() / 2;
+                    *d.select_nth_unstable_by(mid, f64::total_cmp).1
+                };
+                if median > 0.0 {
+                    median
+                } else {
+                    let diag = scene.aabb().diameter();
+                    if diag.is_finite() && diag > 0.0 {
+                        diag * 1e-6
+                    } else {
+                        1.0
+                    }
+                }
+            }
+        };
+        let dlimit0 = if dlimit0.is_finite() && dlimit0 > 0.0 {
+            dlimit0
+        } else {
+            1.0
+        };
+        // GLimit must be positive or disconnected scenes would never finish (doubling 0 stays 0).
+        let glimit0 = match self.glimit {
+            Some(g) if g.is_finite() && g > 0.0 => g,
+            Some(_) => dlimit0 * 1e-9,
+            None => dlimit0 / 4.0,
+        };
+        ResolvedParams {
+            weights: self.weights,
+            dlimit0,
+            glimit0,
+            pset: self.pset,
+            seed: self.seed,
+            mode: self.mode,
+        }
+    }
+}
