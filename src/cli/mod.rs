@@ -80,18 +80,9 @@ impl SceneArgs {
         };
         let mut loaded = wraptree::scene::load_path(&self.scene, &opts)?;
         if let Some(r) = self.split_aspect {
-            if r.is_nan() || r < wraptree::scene::split::MIN_ASPECT_LIMIT {
-                anyhow::bail!("--split-aspect must be a number ≥ 2, got {r}");
-            }
-            let n = loaded.scene.len();
-            let (split, st) = wraptree::scene::split::split_loaded(loaded, r)?;
+            let (split, line) = wraptree::scene::split::split_flag(loaded, r)?;
+            eprintln!("{line}");
             loaded = split;
-            eprintln!(
-                "split-aspect {r}: split {} of {n} primitives into {} pieces ({n} → {} primitives)",
-                st.split,
-                st.pieces,
-                loaded.scene.len()
-            );
         }
         for w in &loaded.warnings {
             eprintln!("warning: {w}");
@@ -148,51 +139,48 @@ impl GroupArgs {
     /// Builds the global rayon pool with `--threads` threads (once per process; later calls
     /// keep the first pool) and returns the number of threads it has.
     pub fn threads(&self) -> Result<usize> {
-        if self.threads == Some(0) {
-            anyhow::bail!("--threads must be at least 1, got 0");
-        }
-        let mut pool = rayon::ThreadPoolBuilder::new();
-        if let Some(n) = self.threads {
-            pool = pool.num_threads(n);
-        }
-        // Fails only when a pool exists already: that pool is then the one used.
-        let _ = pool.build_global();
-        Ok(rayon::current_num_threads())
+        build_pool(self.threads)
     }
 
     /// Checks the values (building the thread pool, see [`GroupArgs::threads`]) and turns them
     /// into [`Params`].
     pub fn params(&self) -> Result<Params> {
         self.threads()?;
-        let weights = Weights {
-            a: self.a,
-            b: self.b,
-            c: self.c,
-        };
-        weights.check().map_err(|e| anyhow::anyhow!("--{e}"))?;
-        for (name, v) in [("--dlimit", self.dlimit), ("--glimit", self.glimit)] {
-            if let Some(v) = v
-                && !(v.is_finite() && v > 0.0)
-            {
-                anyhow::bail!("{name} must be a finite number > 0, got {v}");
-            }
-        }
-        let mode = Mode {
-            schedule: self.schedule,
-            pregroup: self.pregroup,
-            instancing: self.instancing,
-            cost: self.cost,
-        };
-        mode.check(self.pset).map_err(anyhow::Error::msg)?;
-        Ok(Params {
-            weights,
+        let params = Params {
+            weights: Weights {
+                a: self.a,
+                b: self.b,
+                c: self.c,
+            },
             dlimit: self.dlimit,
             glimit: self.glimit,
             pset: self.pset,
             seed: self.seed,
-            mode,
-        })
+            mode: Mode {
+                schedule: self.schedule,
+                pregroup: self.pregroup,
+                instancing: self.instancing,
+                cost: self.cost,
+            },
+        };
+        params.check().map_err(anyhow::Error::msg)?;
+        Ok(params)
     }
+}
+
+/// Builds the global rayon pool with `threads` threads (`--threads`; once per process, later
+/// calls keep the first pool) and returns the number of threads it has.
+pub fn build_pool(threads: Option<usize>) -> Result<usize> {
+    if threads == Some(0) {
+        anyhow::bail!("--threads must be at least 1, got 0");
+    }
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        pool = pool.num_threads(n);
+    }
+    // Fails only when a pool exists already: that pool is then the one used.
+    let _ = pool.build_global();
+    Ok(rayon::current_num_threads())
 }
 
 /// Runs the parsed command.

@@ -154,6 +154,24 @@ pub fn split_loaded(loaded: Loaded, r: f64) -> Result<(Loaded, SplitStats), Load
     Ok((out, stats))
 }
 
+/// `--split-aspect R`: [`split_loaded`] after checking `r`, with what was split in one line
+/// (`split-aspect R: split S of N primitives into P pieces (N → M primitives)`). Err: `r` NaN
+/// or below [`MIN_ASPECT_LIMIT`] (named as the flag), or a split scene that does not load.
+pub fn split_flag(loaded: Loaded, r: f64) -> anyhow::Result<(Loaded, String)> {
+    if r.is_nan() || r < MIN_ASPECT_LIMIT {
+        anyhow::bail!("--split-aspect must be a number ≥ 2, got {r}");
+    }
+    let n = loaded.scene.len();
+    let (split, st) = split_loaded(loaded, r)?;
+    let line = format!(
+        "split-aspect {r}: split {} of {n} primitives into {} pieces ({n} → {} primitives)",
+        st.split,
+        st.pieces,
+        split.scene.len()
+    );
+    Ok((split, line))
+}
+
 /// Appends primitive `i` of `scene` to `out` (which shares `scene`'s points) unchanged.
 fn copy_primitive(scene: &Scene, i: usize, out: &mut Scene) {
     let kind = scene.kind.unwrap_or(PrimitiveKind::Polygon);
