@@ -6,14 +6,16 @@ use anyhow::{Result, anyhow};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use wraptree::metrics::bench::{record_cost, record_scenes, target_rows, target_scenes};
+use wraptree::metrics::bench::{record_costs, target_rows, target_scenes};
 use wraptree::metrics::compare::{Options, Wrapper, evaluate};
-use wraptree::metrics::report::{bench_table, write_bench};
+use wraptree::metrics::report::{
+    bench_table, record_cost_header, record_cost_line, record_cost_notes, refine_table,
+    speedup_table, target_line, targets_header, targets_notes, write_bench,
+};
 use wraptree::peers::Method;
-use wraptree::record::Detail;
 use wraptree::record::output::output_dir;
 use wraptree::scene::generate;
-use wraptree::scene::spec::{as_loaded, scene_spec};
+use wraptree::scene::spec::scene_spec;
 
 /// Arguments of `wraptree bench`.
 #[derive(Args, Debug)]
@@ -67,16 +69,8 @@ pub(super) fn load_spec(spec: &str) -> Result<wraptree::scene::Scene> {
 impl BenchCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
-        if self.threads == Some(0) {
-            anyhow::bail!("--threads must be at least 1, got 0");
-        }
-        let mut pool = rayon::ThreadPoolBuilder::new();
-        if let Some(n) = self.threads {
-            pool = pool.num_threads(n);
-        }
-        // Fails only when a pool exists already: that pool is then the one used.
-        let _ = pool.build_global();
-        eprintln!("threads: {} (rayon pool)", rayon::current_num_threads());
+        let threads = super::build_pool(self.threads)?;
+        eprintln!("threads: {threads} (rayon pool)");
         if self.record {
             return self.run_record();
         }
@@ -88,21 +82,17 @@ impl BenchCmd {
             .iter()
             .map(|s| load_spec(s))
             .collect::<Result<Vec<_>>>()?;
-        let opts = Options {
-            methods: if self.methods.is_empty() {
-                Method::ALL.to_vec()
-            } else {
-                self.methods.clone()
-            },
-            wrappers: if self.wrappers.is_empty() {
-                Wrapper::ALL.to_vec()
-            } else {
-                self.wrappers.clone()
-            },
+        let mut opts = Options {
             repeat: self.repeat,
             tightness_max_n: self.tightness_max_n,
             ..Options::default()
         };
+        if !self.methods.is_empty() {
+            opts.methods = self.methods.clone();
+        }
+        if !self.wrappers.is_empty() {
+            opts.wrappers = self.wrappers.clone();
+        }
         let output = output_dir(self.output.as_deref(), "recordings/bench")?;
         let mut rows = Vec::new();
         for scene in &scenes {
@@ -125,105 +115,18 @@ impl BenchCmd {
     /// The targets: grouping time against obvhs PLOC, SAH and query cost against parry Binned.
     fn run_targets(&self) -> Result<ExitCode> {
         let mut cases = target_scenes(self.max_soup)?;
-        println!(
-            "{:<18} {:>8} {:>9} {:>9} {:>7} {:>9} {:>7} {:>8} {:>8} {:>6} {:>8}",
-            "scene",
-            "N",
-            "group ms",
-            "PLOC ms",
-            "t/PLOC",
-            "binned ms",
-            "t/bin",
-            "SAH/bin",
-            "qry/bin",
-            "depth",
-            "peak MB"
-        );
+        print!("{}", targets_header());
         let mut refined = Vec::new();
         let mut sped_up = Vec::new();
         for scene in &cases {
             let (r, refine, speedups) = target_rows(scene, self.repeat)?;
-            let (t, tp, tb) = (r.group_seconds, r.ploc_seconds, r.binned_seconds);
             refined.push(refine);
             sped_up.extend(speedups);
-            println!(
-                "{:<18} {:>8} {:>9.2} {:>9.2} {:>7.2} {:>9.2} {:>7.2} {:>8.3} {:>8.3} {:>6} {:>8.0}",
-                r.scene,
-                r.n,
-                t * 1e3,
-                tp * 1e3,
-                t / tp,
-                tb * 1e3,
-                t / tb,
-                r.sah_ratio,
-                r.query_ratio,
-                r.depth,
-                r.peak_rss_bytes.unwrap_or(0) as f64 / 1e6
-            );
+            print!("{}", target_line(&r));
         }
-        println!("t/PLOC = grouping time / obvhs PLOC build time; t/bin = / parry3d Bvh Binned.");
-        println!("SAH/bin, qry/bin = SAH cost and node tests per query (AABB BVs, standard");
-        println!(
-            "workload) of the grouping tree / parry Binned's. Goal: t/PLOC <= 1 and qry/bin <= 1."
-        );
-        println!("peak MB = process peak RSS after the case (cases run in increasing size).");
-        println!();
-        println!(
-            "{:<18} {:>10} {:>9} {:>9}",
-            "scene", "ref/PLOC", "SAH/best", "qry/best"
-        );
-        for r in &refined {
-            println!(
-                "{:<18} {:>10.2} {:>9.3} {:>9.3}",
-                r.scene, r.refine_per_ploc, r.sah_per_best, r.query_per_best
-            );
-        }
-        println!("grouping+refine: ref/PLOC = refinement time alone / obvhs PLOC build time;");
-        println!(
-            "SAH/best, qry/best = its SAH and node tests per query / the best of parry Binned"
-        );
-        println!("and obvhs PLOC + reinsertion. Goal: all three <= 1.");
-        println!();
-        println!(
-            "{:<18} {:<19} {:>3} {:>9} {:>7} {:>7} {:>8} {:>8} {:>6} {:>8} {:>8}",
-            "scene",
-            "method",
-            "thr",
-            "ms",
-            "t/PLOC",
-            "t/grp",
-            "SAH/grp",
-            "qry/grp",
-            "depth",
-            "box8/grp",
-            "hull8/grp"
-        );
-        for r in &sped_up {
-            println!(
-                "{:<18} {:<19} {:>3} {:>9.2} {:>7.2} {:>7.2} {:>8.3} {:>8.3} {:>6} {:>8.3} {:>8.3}",
-                r.scene,
-                r.method.name(),
-                r.threads,
-                r.seconds * 1e3,
-                r.per_ploc,
-                r.per_grouping,
-                r.sah_ratio,
-                r.query_ratio,
-                r.depth,
-                r.box8_ratio,
-                r.hull8_ratio
-            );
-        }
-        println!("The paper's §1.3 speed-ups (pregroup: connected components grouped first;");
-        println!("instanced: and rigid copies copy-moved; objects: the scene's objects as");
-        println!("components, copies copy-moved) on thr threads, against obvhs PLOC and the plain");
-        println!("grouping above: t/grp time, SAH, node tests per query, and the volume of the");
-        println!("depth-3 cut (Figure 3's 8-node level) as AABBs and convex hulls (N <= 50,000).");
-        println!();
-        println!(
-            "group ms on {} threads (the exact run's round-start scans are parallel).",
-            rayon::current_num_threads()
-        );
+        print!("{}", targets_notes());
+        print!("{}", refine_table(&refined));
+        print!("{}", speedup_table(&sped_up, rayon::current_num_threads()));
         if self.max_soup >= 10_000_000 {
             cases.push(generate::soup(10_000_000, 1));
         }
@@ -231,63 +134,11 @@ impl BenchCmd {
         Ok(ExitCode::SUCCESS)
     }
 
+    /// `--record`: what recording costs, a line per scene and detail as it is measured.
     fn run_record(&self) -> Result<ExitCode> {
-        let details = [Detail::Levels, Detail::Merges, Detail::Full];
-        let dir = tempfile::tempdir()?;
-        // The fixed cost of a recording: two triangles, one merge.
-        let tiny = as_loaded(&generate::soup(2, 1))?;
-        let mut fixed = [0.0; 3];
-        for (f, &detail) in fixed.iter_mut().zip(&details) {
-            let prefix = dir.path().join(format!("fixed-{detail:?}"));
-            *f = record_cost(&tiny, detail, &prefix, self.repeat)?.record_seconds;
-        }
-        println!(
-            "{:<16} {:>7} {:>8} {:>9} {:>10} {:>7} {:>7} {:>8} {:>8} {:>8}",
-            "scene",
-            "N",
-            "detail",
-            "group ms",
-            "record ms",
-            "ratio",
-            "median",
-            "no-fixed",
-            "rrd MB",
-            "mcap MB"
-        );
-        for scene in &record_scenes() {
-            let loaded = as_loaded(scene)?;
-            for (&detail, &fixed) in details.iter().zip(&fixed) {
-                let prefix = dir.path().join(format!("{}-{detail:?}", scene.name));
-                let c = record_cost(&loaded, detail, &prefix, self.repeat)?;
-                let (t_group, t_rec) = (c.group_seconds, c.record_seconds);
-                println!(
-                    "{:<16} {:>7} {:>8} {:>9.1} {:>10.1} {:>7.2} {:>7.2} {:>8.2} {:>8.2} {:>8.2}",
-                    scene.name,
-                    scene.len(),
-                    format!("{detail:?}").to_lowercase(),
-                    t_group * 1e3,
-                    t_rec * 1e3,
-                    t_rec / t_group,
-                    c.median_ratio,
-                    (t_rec - fixed).max(0.0) / t_group,
-                    c.rrd_bytes as f64 / 1e6,
-                    c.mcap_bytes as f64 / 1e6
-                );
-            }
-        }
-        let ms = fixed.map(|f| format!("{:.1}", f * 1e3));
-        println!(
-            "record ms = grouping with both recorders listening + sphere tree + writing both files."
-        );
-        println!(
-            "ratio = best record ms / best group ms; median = median over the runs of record / group"
-        );
-        println!("in the same pair (recording overhead is ratio - 1). Goal: merges <= 3.");
-        println!(
-            "no-fixed = (record ms - fixed cost) / group ms, the fixed cost being a 2-triangle \
-             recording: {} ms (levels / merges / full).",
-            ms.join(" / ")
-        );
+        print!("{}", record_cost_header());
+        let fixed = record_costs(self.repeat, |r| print!("{}", record_cost_line(r)))?;
+        print!("{}", record_cost_notes(&fixed));
         Ok(ExitCode::SUCCESS)
     }
 }

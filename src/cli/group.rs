@@ -6,6 +6,7 @@ use clap::Args;
 use std::process::ExitCode;
 use std::time::Instant;
 use wraptree::grouping::{self, Event, Limits, Observer, StopReason};
+use wraptree::metrics::report::{group_json, group_text};
 
 /// Exit code of a run stopped by `--max-seconds` or `--max-pairs`.
 pub const EXIT_BUDGET: u8 = 3;
@@ -99,101 +100,22 @@ impl GroupCmd {
         let limits = self.limits.limits()?;
         let scene = &loaded.scene;
         let start = Instant::now();
-        let g = if limits.is_none() {
-            match Progress::for_merges(scene.len() as u64) {
-                Some(p) => grouping::group(scene, &params, p),
-                None => grouping::group(scene, &params, ()),
-            }
-        } else {
-            let resolved = params.resolve(scene);
-            let budget = limits.budget(None);
-            let run = match Progress::for_merges(scene.len() as u64) {
-                Some(p) => grouping::group_within(scene, &resolved, p, &budget),
-                None => grouping::group_within(scene, &resolved, (), &budget),
-            };
-            match run {
-                Ok(g) => g,
-                Err(s) => {
-                    let file = self.scene.scene.display();
-                    eprintln!("error: {file}: {}", limits.message(&s, scene.len()));
-                    return Ok(BudgetArgs::exit_code(s.reason));
-                }
+        let resolved = params.resolve(scene);
+        let progress = Progress::for_merges(scene.len() as u64);
+        let g = match grouping::group_within(scene, &resolved, progress, &limits.budget(None)) {
+            Ok(g) => g,
+            Err(s) => {
+                let file = self.scene.scene.display();
+                eprintln!("error: {file}: {}", limits.message(&s, scene.len()));
+                return Ok(BudgetArgs::exit_code(s.reason));
             }
         };
         let seconds = start.elapsed().as_secs_f64();
-        let t = &g.tree;
         if self.json {
-            let out = serde_json::json!({
-                "scene": scene.name,
-                "primitives": scene.len(),
-                "rounds": g.rounds,
-                "depth_max": t.depth_max(),
-                "depth_mean": t.depth_mean(),
-                "seconds": seconds,
-                "threads": threads,
-                "params": g.params,
-                "stats": g.stats,
-                "pregrouping": g.pregrouping,
-                "peak_rss_bytes": wraptree::metrics::peak_rss_bytes(),
-                "parent": t.parent_i64(),
-            });
-            println!("{out}");
+            println!("{}", group_json(scene, &g, threads, seconds));
         } else {
-            println!("scene       {} ({} primitives)", scene.name, scene.len());
-            println!(
-                "params      A={} B={} C={} DLimit0={:.6e} GLimit0={:.6e} pset={:?}",
-                g.params.weights.a,
-                g.params.weights.b,
-                g.params.weights.c,
-                g.params.dlimit0,
-                g.params.glimit0,
-                g.params.pset
-            );
-            println!(
-                "schedule    {:?} on {threads} thread{}",
-                g.params.mode.schedule,
-                if threads == 1 { "" } else { "s" }
-            );
-            if let Some(p) = &g.pregrouping {
-                println!("{}", pregrouping_lines(p));
-            }
-            println!("rounds      {}", g.rounds);
-            println!(
-                "depth       max {} ({} levels), mean {:.2}, 2·log2 N = {:.1}",
-                t.depth_max(),
-                t.depth_max() + 1,
-                t.depth_mean(),
-                2.0 * (scene.len() as f64).log2()
-            );
-            println!("time        {:.3} ms", seconds * 1e3);
+            print!("{}", group_text(scene, &g, threads, seconds));
         }
         Ok(ExitCode::SUCCESS)
     }
-}
-
-/// What pre-grouping found, as the lines `wraptree group` prints.
-fn pregrouping_lines(p: &grouping::Pregrouping) -> String {
-    let kind = match p.pregroup {
-        grouping::Pregroup::None => "none",
-        grouping::Pregroup::Objects => "objects",
-        grouping::Pregroup::Connected => "connected",
-    };
-    let mut out = format!(
-        "pregroup    {kind}: {} components, {} grouped on their own (>= {} primitives), {} \
-         primitives of smaller ones and {} part roots at the top level ({} bodies), {} threads",
-        p.components,
-        p.parts - p.copies,
-        grouping::pregroup::MIN_PART,
-        p.loose,
-        p.parts,
-        p.top_bodies,
-        p.threads
-    );
-    if p.instancing {
-        out.push_str(&format!(
-            "\ninstancing  {} classes with copies, {} copies, {} primitives not grouped",
-            p.classes, p.copies, p.primitives_saved
-        ));
-    }
-    out
 }

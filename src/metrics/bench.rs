@@ -7,6 +7,7 @@ use crate::peers::{self, Method};
 use crate::query::{self, Bv, Workload};
 use crate::record::{Detail, RecordOptions, Written, record};
 use crate::scene::obj::{LoadOptions, Loaded, load_path};
+use crate::scene::spec::as_loaded;
 use crate::scene::{Scene, generate};
 use anyhow::{Result, anyhow};
 use std::path::{Path, PathBuf};
@@ -217,6 +218,52 @@ pub fn record_scenes() -> [Scene; 3] {
         generate::replicate(&generate::robot_base(), 44, 1),
         generate::soup(100_000, 1),
     ]
+}
+
+/// The details `bench --record` measures, in its table's order.
+pub const RECORD_DETAILS: [Detail; 3] = [Detail::Levels, Detail::Merges, Detail::Full];
+
+/// One line of `bench --record`: what recording one scene at one detail costs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecordCostRow {
+    /// Scene name.
+    pub scene: String,
+    /// Primitives.
+    pub n: usize,
+    /// What was recorded.
+    pub detail: Detail,
+    /// The measured cost.
+    pub cost: RecordCost,
+    /// The fixed cost (s) of a 2-triangle recording at this detail.
+    pub fixed_seconds: f64,
+}
+
+/// `bench --record`: [`record_cost`] of each of [`record_scenes`] at each of
+/// [`RECORD_DETAILS`] (into a temporary directory), `repeat` pairs each; `on_row` sees each row
+/// as it is measured. Returns the fixed costs (s) of a 2-triangle recording per detail.
+pub fn record_costs(repeat: u32, mut on_row: impl FnMut(&RecordCostRow)) -> Result<[f64; 3]> {
+    let dir = tempfile::tempdir()?;
+    // The fixed cost of a recording: two triangles, one merge.
+    let tiny = as_loaded(&generate::soup(2, 1))?;
+    let mut fixed = [0.0; 3];
+    for (f, &detail) in fixed.iter_mut().zip(&RECORD_DETAILS) {
+        let prefix = dir.path().join(format!("fixed-{detail:?}"));
+        *f = record_cost(&tiny, detail, &prefix, repeat)?.record_seconds;
+    }
+    for scene in &record_scenes() {
+        let loaded = as_loaded(scene)?;
+        for (&detail, &fixed_seconds) in RECORD_DETAILS.iter().zip(&fixed) {
+            let prefix = dir.path().join(format!("{}-{detail:?}", scene.name));
+            on_row(&RecordCostRow {
+                scene: scene.name.clone(),
+                n: scene.len(),
+                detail,
+                cost: record_cost(&loaded, detail, &prefix, repeat)?,
+                fixed_seconds,
+            });
+        }
+    }
+    Ok(fixed)
 }
 
 /// `repeat` pairs of (grouping alone, grouping recorded) wall times for `loaded`, each

@@ -1,16 +1,26 @@
-//! Results of `bench`, `sweep` and `stress` as files: CSV tables, charts (SVG + PNG) and `.rrd` series.
+//! Results of `group`, `bench`, `sweep` and `stress`: text tables, CSV tables, charts (SVG +
+//! PNG) and `.rrd` series.
 //!
+//! - `group`: the run's summary as text or JSON;
 //! - `bench`: `results.csv`, the two charts per scene and `bench.rrd`;
 //! - `sweep`: `sweep.csv`, the heat maps and `sweep.rrd`;
-//! - `stress`: `stress.csv` and the spaghetti sweep charts.
+//! - `stress`: `stress.csv` and the spaghetti sweep charts;
+//! - the targets tables and `bench --record`'s table as text ([`targets_header`] …).
 
 mod bench;
+mod group;
 mod stress;
 mod sweep;
+mod targets;
 
 pub use bench::{bench_charts, bench_csv, bench_table, write_bench};
+pub use group::{group_json, group_text, pregrouping_lines};
 pub use stress::{StressRow, stress_csv, stress_sweep_chart, stress_table};
 pub use sweep::{SweepRrd, setting_name, sweep_csv, sweep_heat_maps, sweep_table, write_sweep};
+pub use targets::{
+    record_cost_header, record_cost_line, record_cost_notes, refine_table, speedup_table,
+    target_line, targets_header, targets_notes,
+};
 
 use crate::query::QueryCost;
 use crate::record::output::write_atomic;
