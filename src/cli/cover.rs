@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use wraptree::record::output::{output_prefix, with_ext, write_atomic};
 use wraptree::wrap::WrapperKind;
 use wraptree::wrap::cover::export;
-use wraptree::wrap::cover::solve::{CoverLimit, CoverSummary, Tolerance, cover_scene};
+use wraptree::wrap::cover::solve::{CoverLimit, Tolerance, cover_scene};
 
 /// Arguments of `wraptree cover`.
 #[derive(Args, Debug)]
@@ -64,10 +64,8 @@ impl CoverCmd {
                 );
             }
         }
-        let limit = match (self.tolerance, self.budget) {
-            (Some(t), _) => CoverLimit::Tolerance(t),
-            (None, Some(k)) => CoverLimit::Budget(k),
-            (None, None) => bail!("give --tolerance or --budget"),
+        let Some(limit) = CoverLimit::from_flags(self.tolerance, self.budget) else {
+            bail!("give --tolerance or --budget");
         };
         let out = cover_scene(scene, &params, limit, &self.kinds)?;
         let json = serde_json::to_vec_pretty(&out).context("cover: cannot serialise")?;
@@ -75,57 +73,11 @@ impl CoverCmd {
         let obj = export::to_obj(&out.wrappers, &scene.name);
         write_atomic(&obj_path, obj.as_bytes(), self.force)?;
         if self.json {
-            let mut v = serde_json::to_value(&out).context("cover: cannot serialise")?;
-            if let Some(m) = v.as_object_mut() {
-                m.remove("wrappers");
-                m.insert("json".into(), json_path.display().to_string().into());
-                m.insert("obj".into(), obj_path.display().to_string().into());
-            }
-            println!("{v}");
+            println!("{}", out.to_json(&json_path, &obj_path)?);
         } else {
-            print_text(&out);
+            print!("{}", out.text());
             println!("wrote {} and {}", json_path.display(), obj_path.display());
         }
         Ok(ExitCode::SUCCESS)
-    }
-}
-
-fn print_text(o: &CoverSummary) {
-    let mut count = std::collections::BTreeMap::new();
-    for w in &o.wrappers {
-        *count.entry(w.node.choice.kind.name()).or_insert(0usize) += 1;
-    }
-    let kinds: Vec<String> = count.iter().map(|(k, n)| format!("{n} {k}")).collect();
-    println!(
-        "{}: {} primitives, diagonal {:.4e}; kinds {}",
-        o.scene,
-        o.primitives,
-        o.diagonal,
-        o.kinds.join(",")
-    );
-    match o.budget {
-        Some(k) => println!(
-            "budget {k}: smallest achievable max error {:.4e}",
-            o.tolerance
-        ),
-        None => println!("tolerance {:.4e}", o.tolerance),
-    }
-    println!(
-        "cover       {} wrappers ({}), max error {:.4e}, query cost {:.1}",
-        o.size,
-        kinds.join(", "),
-        o.max_error,
-        o.total_cost
-    );
-    println!("depth  level nodes  level max error  cover nodes  ratio");
-    for r in &o.levels {
-        println!(
-            "{:>5}  {:>11}  {:>15.4e}  {:>11}  {:>5.1}",
-            r.depth,
-            r.level_nodes,
-            r.level_max_error,
-            r.cover_nodes,
-            r.level_nodes as f64 / r.cover_nodes.max(1) as f64
-        );
     }
 }

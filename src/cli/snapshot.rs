@@ -8,30 +8,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use wraptree::grouping::{Merge, Params, ResolvedParams};
 use wraptree::render::View;
-use wraptree::render::snapshot::{SnapshotOptions, draw, from_recording, regroup};
+use wraptree::render::snapshot::{
+    SnapshotOptions, draw, from_recording, parse_angle, parse_size, regroup,
+};
 use wraptree::scene::Scene;
 use wraptree::wrap::WrapperKind;
-
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let bad = || format!("invalid size '{s}' (want WxH with each 64..=8192, e.g. 800x600)");
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
-    let (w, h): (u32, u32) = (
-        w.trim().parse().map_err(|_| bad())?,
-        h.trim().parse().map_err(|_| bad())?,
-    );
-    if !(64..=8192).contains(&w) || !(64..=8192).contains(&h) {
-        return Err(bad());
-    }
-    Ok((w, h))
-}
-
-fn parse_angle(s: &str, lo: f64, hi: f64) -> Result<f64, String> {
-    s.trim()
-        .parse::<f64>()
-        .ok()
-        .filter(|v| (lo..=hi).contains(v))
-        .ok_or_else(|| format!("want degrees in {lo}..={hi}, got '{s}'"))
-}
 
 /// Arguments of `wraptree snapshot`.
 #[derive(Args, Debug)]
@@ -113,18 +94,8 @@ impl SnapshotCmd {
             size: self.size,
             force: self.force,
         };
-        let tree = &g.tree;
-        let s = draw(&scene, tree, &opts, &self.output)?;
-        for (p, s) in &s.written {
-            println!("  {} + {}", p.display(), s.display());
-        }
-        println!(
-            "{}: {} primitives, depth {}; frames: {}",
-            scene.name,
-            scene.len(),
-            tree.depth_max(),
-            s.captions.join(" | ")
-        );
+        let s = draw(&scene, &g.tree, &opts, &self.output)?;
+        print!("{}", s.text(&scene, &g.tree));
         Ok(ExitCode::SUCCESS)
     }
 }

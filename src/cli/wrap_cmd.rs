@@ -4,11 +4,11 @@
 
 use super::{GroupArgs, SceneArgs};
 use anyhow::Result;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use std::process::ExitCode;
 use std::time::Instant;
 use wraptree::grouping;
-use wraptree::wrap::report::{KindReport, report};
+use wraptree::wrap::report::{report, report_json, report_text};
 use wraptree::wrap::{DEFAULT_SAMPLES, SphereMethod, WrapperKind};
 
 /// Arguments of `wraptree wrap`.
@@ -32,43 +32,6 @@ pub struct WrapCmd {
     json: bool,
 }
 
-/// The command-line name of `m`, e.g. `aabb-center`.
-fn method_name(m: SphereMethod) -> String {
-    m.to_possible_value()
-        .map_or_else(|| format!("{m:?}"), |v| v.get_name().to_string())
-}
-
-/// Prints one kind's report as text.
-fn print_kind(r: &KindReport, method: SphereMethod) {
-    let name = match r.kind {
-        WrapperKind::Sphere => format!("sphere ({})", method_name(method)),
-        k => k.name().to_string(),
-    };
-    let c = &r.containment;
-    println!(
-        "\n{name}: built in {:.3} s; containment {}: max excess {:.3e} (worst node {:.3e} vs tolerance {:.3e}, {})",
-        r.build_seconds,
-        if c.holds { "holds" } else { "FAILS" },
-        c.max_excess,
-        c.excess_at_worst,
-        c.tolerance_at_worst,
-        c.tolerance_rule
-    );
-    println!(
-        "{:>5} {:>7} {:>8} {:>12} {:>8} {:>11} {:>11}",
-        "depth", "nodes", "interior", "volume", "ratio", "error max", "error mean"
-    );
-    for l in &r.levels {
-        let ratio = l
-            .volume_ratio
-            .map_or_else(|| "-".to_string(), |v| format!("{v:.3}"));
-        println!(
-            "{:>5} {:>7} {:>8} {:>12.4e} {:>8} {:>11.4e} {:>11.4e}",
-            l.depth, l.nodes, l.interior, l.volume, ratio, l.error_max, l.error_mean
-        );
-    }
-}
-
 impl WrapCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
@@ -81,28 +44,11 @@ impl WrapCmd {
         let tree = &g.tree;
         let samples = self.samples as usize;
         let reports = report(tree, scene, &self.wrapper, self.sphere_method, samples);
+        let (m, t) = (self.sphere_method, group_seconds);
         if self.json {
-            let out = serde_json::json!({
-                "scene": scene.name,
-                "primitives": scene.len(),
-                "depth_max": tree.depth_max(),
-                "grouping_seconds": group_seconds,
-                "sphere_method": method_name(self.sphere_method),
-                "samples": samples,
-                "wrappers": reports,
-            });
-            println!("{out}");
+            println!("{}", report_json(scene, tree, t, m, samples, &reports));
         } else {
-            println!(
-                "{}: {} primitives, depth {}, grouped in {:.3} s; error from {samples} surface samples per wrapper",
-                scene.name,
-                scene.len(),
-                tree.depth_max(),
-                group_seconds
-            );
-            for r in &reports {
-                print_kind(r, self.sphere_method);
-            }
+            print!("{}", report_text(scene, tree, t, m, samples, &reports));
         }
         let failed: Vec<&str> = reports
             .iter()

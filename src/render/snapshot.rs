@@ -159,6 +159,48 @@ pub struct Snapshot {
     pub captions: Vec<String>,
 }
 
+impl Snapshot {
+    /// What `wraptree snapshot` prints: each frame's files, a line each, then `scene` and
+    /// `tree` in one line with the frames' captions.
+    pub fn text(&self, scene: &Scene, tree: &SubsetTree) -> String {
+        let mut s = String::new();
+        for (p, v) in &self.written {
+            s.push_str(&format!("  {} + {}\n", p.display(), v.display()));
+        }
+        s.push_str(&format!(
+            "{}: {} primitives, depth {}; frames: {}\n",
+            scene.name,
+            scene.len(),
+            tree.depth_max(),
+            self.captions.join(" | ")
+        ));
+        s
+    }
+}
+
+/// Parses a frame size `WxH` (`--size`), each side in 64..=8192.
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let bad = || format!("invalid size '{s}' (want WxH with each 64..=8192, e.g. 800x600)");
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let (w, h): (u32, u32) = (
+        w.trim().parse().map_err(|_| bad())?,
+        h.trim().parse().map_err(|_| bad())?,
+    );
+    if !(64..=8192).contains(&w) || !(64..=8192).contains(&h) {
+        return Err(bad());
+    }
+    Ok((w, h))
+}
+
+/// Parses an angle in degrees within `lo..=hi` (`--azimuth`, `--elevation`).
+pub fn parse_angle(s: &str, lo: f64, hi: f64) -> Result<f64, String> {
+    s.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| (lo..=hi).contains(v))
+        .ok_or_else(|| format!("want degrees in {lo}..={hi}, got '{s}'"))
+}
+
 /// Draws the input and the chosen levels of `tree` over `scene` into `dir` (created with its
 /// parents if missing): `frame-NN-….{png,svg}` per frame and `figure.{png,svg}`, the sheet of
 /// them all.

@@ -1,5 +1,6 @@
 //! The report of `wraptree wrap`: each Wrapper Tree's build time, containment check (every
-//! vertex below a node inside its wrapper, within a tolerance) and per-level tightness.
+//! vertex below a node inside its wrapper, within a tolerance) and per-level tightness, and
+//! the same as text ([`report_text`]) or JSON ([`report_json`]).
 //!
 //! ```no_run
 //! use wraptree::wrap::{DEFAULT_SAMPLES, SphereMethod, WrapperKind, report::report};
@@ -17,6 +18,7 @@ use super::{
 use crate::geom::Aabb;
 use crate::grouping::SubsetTree;
 use crate::scene::Scene;
+use std::fmt::Write as _;
 use std::time::Instant;
 
 /// Containment tolerance of spheres, boxes and oriented boxes, relative to the scene diagonal.
@@ -173,4 +175,89 @@ pub fn report(
             levels: level_tightness(tree, scene, w, hulls, samples),
         })
         .collect()
+}
+
+/// The command-line name of `m`, e.g. `aabb-center`.
+pub fn method_name(m: SphereMethod) -> String {
+    use clap::ValueEnum;
+    m.to_possible_value()
+        .map_or_else(|| format!("{m:?}"), |v| v.get_name().to_string())
+}
+
+/// What `wraptree wrap` prints for `reports` of `scene`'s tree (grouped in `group_seconds`,
+/// spheres by `method`, errors from `samples` surface samples per wrapper).
+pub fn report_text(
+    scene: &Scene,
+    tree: &SubsetTree,
+    group_seconds: f64,
+    method: SphereMethod,
+    samples: usize,
+    reports: &[KindReport],
+) -> String {
+    let mut s = format!(
+        "{}: {} primitives, depth {}, grouped in {:.3} s; error from {samples} surface samples per wrapper\n",
+        scene.name,
+        scene.len(),
+        tree.depth_max(),
+        group_seconds
+    );
+    for r in reports {
+        s.push_str(&kind_text(r, method));
+    }
+    s
+}
+
+/// One kind's report as text: a blank line, the build time and containment, and the level
+/// table.
+fn kind_text(r: &KindReport, method: SphereMethod) -> String {
+    let name = match r.kind {
+        WrapperKind::Sphere => format!("sphere ({})", method_name(method)),
+        k => k.name().to_string(),
+    };
+    let c = &r.containment;
+    let mut s = format!(
+        "\n{name}: built in {:.3} s; containment {}: max excess {:.3e} (worst node {:.3e} vs tolerance {:.3e}, {})\n",
+        r.build_seconds,
+        if c.holds { "holds" } else { "FAILS" },
+        c.max_excess,
+        c.excess_at_worst,
+        c.tolerance_at_worst,
+        c.tolerance_rule
+    );
+    let _ = writeln!(
+        s,
+        "{:>5} {:>7} {:>8} {:>12} {:>8} {:>11} {:>11}",
+        "depth", "nodes", "interior", "volume", "ratio", "error max", "error mean"
+    );
+    for l in &r.levels {
+        let ratio = l
+            .volume_ratio
+            .map_or_else(|| "-".to_string(), |v| format!("{v:.3}"));
+        let _ = writeln!(
+            s,
+            "{:>5} {:>7} {:>8} {:>12.4e} {:>8} {:>11.4e} {:>11.4e}",
+            l.depth, l.nodes, l.interior, l.volume, ratio, l.error_max, l.error_mean
+        );
+    }
+    s
+}
+
+/// The same as one JSON object (`wrap --json`).
+pub fn report_json(
+    scene: &Scene,
+    tree: &SubsetTree,
+    group_seconds: f64,
+    method: SphereMethod,
+    samples: usize,
+    reports: &[KindReport],
+) -> serde_json::Value {
+    serde_json::json!({
+        "scene": scene.name,
+        "primitives": scene.len(),
+        "depth_max": tree.depth_max(),
+        "grouping_seconds": group_seconds,
+        "sphere_method": method_name(method),
+        "samples": samples,
+        "wrappers": reports,
+    })
 }

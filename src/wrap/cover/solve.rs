@@ -1,13 +1,16 @@
 //! Computing a cover end to end, as `wraptree cover` and `record --cover-*` do: build the
 //! Wrapper Trees the kinds need, measure every node's [`Fits`], cut the tree within a
-//! [`CoverLimit`], and (for [`cover_scene`]) the summary `wraptree cover` writes as JSON.
+//! [`CoverLimit`], and (for [`cover_scene`]) the summary `wraptree cover` writes as JSON and
+//! prints ([`CoverSummary::text`]).
 
 use super::export::{self, WrapperRecord};
 use super::{Cover, Fits, LevelRow, compare_levels};
 use crate::grouping::{self, Params, SubsetTree};
 use crate::scene::Scene;
 use crate::wrap::{DEFAULT_SAMPLES, SphereMethod, WrapperKind, Wrappers};
-use anyhow::Result;
+use anyhow::{Context, Result};
+use std::fmt::Write as _;
+use std::path::Path;
 use std::time::Instant;
 
 /// A tolerance: a length in scene units, or a fraction of the scene diagonal.
@@ -180,4 +183,75 @@ pub fn cover_scene(
         levels,
         wrappers: s.records,
     })
+}
+
+impl CoverLimit {
+    /// The limit of a `--tolerance`/`--budget` flag pair (a tolerance wins), `None` for neither.
+    pub fn from_flags(tolerance: Option<Tolerance>, budget: Option<usize>) -> Option<CoverLimit> {
+        match (tolerance, budget) {
+            (Some(t), _) => Some(CoverLimit::Tolerance(t)),
+            (None, Some(k)) => Some(CoverLimit::Budget(k)),
+            (None, None) => None,
+        }
+    }
+}
+
+impl CoverSummary {
+    /// The summary as one JSON object without the wrappers, naming the files written instead
+    /// (`cover --json`).
+    pub fn to_json(&self, json: &Path, obj: &Path) -> Result<serde_json::Value> {
+        let mut v = serde_json::to_value(self).context("cover: cannot serialise")?;
+        if let Some(m) = v.as_object_mut() {
+            m.remove("wrappers");
+            m.insert("json".into(), json.display().to_string().into());
+            m.insert("obj".into(), obj.display().to_string().into());
+        }
+        Ok(v)
+    }
+
+    /// The summary as the lines `wraptree cover` prints: the scene, the bound, the cover and a
+    /// table of each level against the cover of the same error.
+    pub fn text(&self) -> String {
+        let mut count = std::collections::BTreeMap::new();
+        for w in &self.wrappers {
+            *count.entry(w.node.choice.kind.name()).or_insert(0usize) += 1;
+        }
+        let kinds: Vec<String> = count.iter().map(|(k, n)| format!("{n} {k}")).collect();
+        let mut s = format!(
+            "{}: {} primitives, diagonal {:.4e}; kinds {}\n",
+            self.scene,
+            self.primitives,
+            self.diagonal,
+            self.kinds.join(",")
+        );
+        let _ = match self.budget {
+            Some(k) => writeln!(
+                s,
+                "budget {k}: smallest achievable max error {:.4e}",
+                self.tolerance
+            ),
+            None => writeln!(s, "tolerance {:.4e}", self.tolerance),
+        };
+        let _ = writeln!(
+            s,
+            "cover       {} wrappers ({}), max error {:.4e}, query cost {:.1}",
+            self.size,
+            kinds.join(", "),
+            self.max_error,
+            self.total_cost
+        );
+        s.push_str("depth  level nodes  level max error  cover nodes  ratio\n");
+        for r in &self.levels {
+            let _ = writeln!(
+                s,
+                "{:>5}  {:>11}  {:>15.4e}  {:>11}  {:>5.1}",
+                r.depth,
+                r.level_nodes,
+                r.level_max_error,
+                r.cover_nodes,
+                r.level_nodes as f64 / r.cover_nodes.max(1) as f64
+            );
+        }
+        s
+    }
 }
