@@ -3,9 +3,9 @@
 
 use super::group::{BudgetArgs, EXIT_INTERRUPTED, Progress};
 use super::{GroupArgs, SceneArgs};
-use anyhow::{Result, bail};
+use anyhow::Result;
 use clap::Args;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -89,36 +89,13 @@ pub fn stop_flag() -> Arc<AtomicBool> {
     .clone()
 }
 
-/// Prints what was written.
-pub fn report(w: &Written, scene: &Scene) {
-    let size = |p: &Path| {
-        std::fs::metadata(p)
-            .map(|m| m.len() as f64 / 1e6)
-            .unwrap_or(0.0)
-    };
-    match &w.grouping {
-        Some(g) => println!(
-            "{}: {} primitives, {} rounds, depth {} (mean {:.2}); recorded in {:.3} s",
-            scene.name,
-            scene.len(),
-            g.rounds,
-            g.tree.depth_max(),
-            g.tree.depth_mean(),
-            w.seconds
-        ),
-        None => {
-            let why = match &w.stopped {
-                Some(s) => w.limits.message(s, scene.len()),
-                None => "grouping stopped".to_string(),
-            };
-            eprintln!(
-                "incomplete: {}: {why}; wrote what was recorded, marked incomplete",
-                scene.name
-            );
-        }
+/// Prints what was written: the run (or why it stopped, on stderr) and the files.
+pub fn print_written(w: &Written, scene: &Scene) {
+    match w.summary(scene) {
+        Ok(line) => println!("{line}"),
+        Err(why) => eprintln!("{why}"),
     }
-    println!("  {} ({:.2} MB)", w.rrd.display(), size(&w.rrd));
-    println!("  {} ({:.2} MB)", w.mcap.display(), size(&w.mcap));
+    print!("{}", w.files());
 }
 
 impl RecordCmd {
@@ -127,28 +104,7 @@ impl RecordCmd {
         // Installed before loading so an early Ctrl-C still ends in readable, incomplete files.
         let stop = stop_flag();
         let limits = self.limits.limits()?;
-        if self.cover_budget == Some(0) {
-            bail!("--cover-budget must be ≥ 1 (a cover needs at least one wrapper)");
-        }
-        let limit = match (self.cover_tolerance, self.cover_budget) {
-            (Some(t), _) => Some(CoverLimit::Tolerance(t)),
-            (None, Some(k)) => Some(CoverLimit::Budget(k)),
-            (None, None) => None,
-        };
-        if limit.is_some() && !self.detail.levels() {
-            bail!(
-                "--cover-tolerance/--cover-budget need --detail levels or full (the cover is a level)"
-            );
-        }
-        if !(self.refine_batch > 0.0 && self.refine_batch <= 1.0) {
-            bail!(
-                "--refine-batch must be in (0, 1], got {}",
-                self.refine_batch
-            );
-        }
-        let loaded = self.scene.load()?;
-        let params = self.group.params()?.resolve(&loaded.scene);
-        let prefix = output_prefix(self.output.as_deref(), &loaded.source.file_name, "")?;
+        let limit = CoverLimit::from_flags(self.cover_tolerance, self.cover_budget);
         let opts = RecordOptions {
             detail: self.detail,
             force: self.force,
@@ -163,9 +119,13 @@ impl RecordCmd {
                 batch: self.refine_batch,
             }),
         };
+        opts.check()?;
+        let loaded = self.scene.load()?;
+        let params = self.group.params()?.resolve(&loaded.scene);
+        let prefix = output_prefix(self.output.as_deref(), &loaded.source.file_name, "")?;
         let progress = Progress::for_merges(loaded.scene.len() as u64);
         let w = record(&loaded, &params, &prefix, &opts, progress)?;
-        report(&w, &loaded.scene);
+        print_written(&w, &loaded.scene);
         Ok(exit_code(&w))
     }
 }

@@ -2,13 +2,15 @@
 //! ([`mcap`]). Both recorders are [`Observer`](crate::grouping::Observer)s fed the same events
 //! and share nothing else; [`output`] makes their files appear atomically, and [`background`]
 //! lets a recorder consume the events on another thread while the grouping runs; [`record()`]
-//! runs a grouping with both recorders listening.
+//! runs a grouping with both recorders listening, and [`Written`] says what it wrote.
 
 pub mod background;
 pub mod mcap;
+mod options;
 pub mod output;
 pub mod rrd;
 mod run;
+mod summary;
 
 pub use run::{RecordOptions, Written, record};
 

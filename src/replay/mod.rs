@@ -1,7 +1,8 @@
 //! Replaying a run from its `.mcap` recording: [`open`] reads it and loads the embedded scene,
 //! [`Replay::tree`] rebuilds the Subset Tree from the recorded merges alone, [`verify`] re-runs
 //! the grouping and compares it merge by merge, [`reweight`] re-runs it with other Cost weights
-//! and records the new run (`wraptree replay`).
+//! and records the new run (`wraptree replay`); [`report`] words what they find as
+//! `wraptree replay` prints it.
 //!
 //! ```no_run
 //! use wraptree::grouping::Limits;
@@ -12,6 +13,8 @@
 //! }
 //! # Ok::<(), anyhow::Error>(())
 //! ```
+
+pub mod report;
 
 use crate::grouping::{
     self, Event, EventLog, Limits, Merge, Observer, Part, ResolvedParams, StopReason, Stopped,
