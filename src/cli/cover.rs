@@ -6,7 +6,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use wraptree::record::output::{output_prefix, with_ext, write_atomic};
+use wraptree::record::output::{check_new, output_prefix, with_ext, write_atomic};
 use wraptree::wrap::WrapperKind;
 use wraptree::wrap::cover::export;
 use wraptree::wrap::cover::solve::{CoverLimit, Tolerance, cover_scene};
@@ -50,20 +50,8 @@ impl CoverCmd {
         let scene = &loaded.scene;
         let params = self.group.params()?;
         let prefix = output_prefix(self.output.as_deref(), &loaded.source.file_name, "-cover")?;
-        let json_path = with_ext(&prefix, ".json");
-        let obj_path = with_ext(&prefix, ".obj");
-        let input = std::fs::canonicalize(&self.scene.scene).ok();
-        for p in [&json_path, &obj_path] {
-            if input.is_some() && std::fs::canonicalize(p).ok() == input {
-                bail!("{}: is the input scene; choose another -o", p.display());
-            }
-            if p.exists() && !self.force {
-                bail!(
-                    "{}: already exists (use --force to replace it)",
-                    p.display()
-                );
-            }
-        }
+        let (json_path, obj_path) = (with_ext(&prefix, ".json"), with_ext(&prefix, ".obj"));
+        check_new(&[&json_path, &obj_path], &self.scene.scene, self.force)?;
         let Some(limit) = CoverLimit::from_flags(self.tolerance, self.budget) else {
             bail!("give --tolerance or --budget");
         };

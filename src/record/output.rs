@@ -161,3 +161,22 @@ pub fn output_dir(given: Option<&Path>, default: &str) -> Result<PathBuf> {
     }
     Ok(d)
 }
+
+/// Checks, before the work that produces them, that the files `paths` may be written: none is
+/// the input file `input` (a path that cannot be resolved is none), and none exists unless
+/// `force`.
+pub fn check_new(paths: &[&Path], input: &Path, force: bool) -> Result<()> {
+    let input = std::fs::canonicalize(input).ok();
+    for p in paths {
+        if input.is_some() && std::fs::canonicalize(p).ok() == input {
+            anyhow::bail!("{}: is the input scene; choose another -o", p.display());
+        }
+        if p.exists() && !force {
+            anyhow::bail!(
+                "{}: already exists (use --force to replace it)",
+                p.display()
+            );
+        }
+    }
+    Ok(())
+}
