@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use wraptree::record::output::output_prefix;
 use wraptree::record::{Detail, RecordOptions};
-use wraptree::replay::{self, RefineVerified, Replay, Verified, report};
+use wraptree::replay::{self, Replay, report};
 
 /// Arguments of `wraptree replay`.
 #[derive(Args, Debug)]
@@ -53,32 +53,20 @@ impl ReplayCmd {
         print!("{}", report::header(rec, &name));
         print!("{}", report::state(&replay, &name)?);
         if self.verify {
-            match replay::verify(&replay, &limits) {
+            let v = match report::verification(&replay, &limits)? {
+                Ok(v) => v,
                 Err(s) => {
                     let msg = limits.message(&s, loaded.scene.len());
                     eprintln!("error: {name}: --verify re-run: {msg}");
                     return Ok(BudgetArgs::exit_code(s.reason));
                 }
-                Ok(v) => {
-                    let text = report::verified_text(&v, rec);
-                    match v {
-                        Verified::PartDiffers { .. } => {
-                            eprintln!("error: {name}: --verify: {text}");
-                            return Ok(ExitCode::FAILURE);
-                        }
-                        Verified::Diverged { .. } => {
-                            print!("{text}");
-                            return Ok(ExitCode::FAILURE);
-                        }
-                        _ => print!("{text}"),
-                    }
-                }
+            };
+            print!("{}", v.text);
+            if let Some(e) = &v.error {
+                eprintln!("error: {name}: --verify: {e}");
             }
-            if let Some(v) = replay::verify_refinement(&replay)? {
-                print!("{}", report::refine_verified_text(&v));
-                if matches!(v, RefineVerified::Diverged { .. }) {
-                    return Ok(ExitCode::FAILURE);
-                }
+            if !v.passed {
+                return Ok(ExitCode::FAILURE);
             }
         }
         if self.a.is_some() || self.b.is_some() || self.c.is_some() {

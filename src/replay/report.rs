@@ -2,8 +2,10 @@
 //! and [`verify_refinement`](super::verify_refinement), and a re-weighted run beside the
 //! recorded one.
 
-use super::{RefineVerified, Replay, Verified, balance_stats, final_tree};
-use crate::grouping::{Grouping, Merge, Part, SubsetTree};
+use super::{
+    RefineVerified, Replay, Verified, balance_stats, final_tree, verify, verify_refinement,
+};
+use crate::grouping::{Grouping, Limits, Merge, Part, Stopped, SubsetTree};
 use crate::record::mcap::{Recorded, metadata};
 use anyhow::{Context, Result};
 use std::fmt::Write as _;
@@ -156,6 +158,50 @@ pub fn refine_verified_text(v: &RefineVerified) -> String {
             "first refinement divergence at step {step}:\n  recorded: {recorded:?}\n  re-run:   {rerun:?}\n"
         ),
     }
+}
+
+/// What `replay --verify` found, worded as it prints it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Verification {
+    /// Lines for standard output.
+    pub text: String,
+    /// The one line, without its end, saying which part differs, when that failed the
+    /// verification (for standard error).
+    pub error: Option<String>,
+    /// Whether the merges and, for a refined recording, the refinement's moves match.
+    pub passed: bool,
+}
+
+/// Runs [`verify`] within `limits` and, when the merges match, [`verify_refinement`], and
+/// words what they found ([`verified_text`], [`refine_verified_text`]). Inner Err: the stop,
+/// when a limit ended the re-run first.
+pub fn verification(replay: &Replay, limits: &Limits) -> Result<Result<Verification, Stopped>> {
+    let v = match verify(replay, limits) {
+        Ok(v) => v,
+        Err(s) => return Ok(Err(s)),
+    };
+    let text = verified_text(&v, &replay.rec);
+    let out = match v {
+        Verified::PartDiffers { .. } => Verification {
+            text: String::new(),
+            error: Some(text),
+            passed: false,
+        },
+        Verified::Diverged { .. } => Verification {
+            text,
+            error: None,
+            passed: false,
+        },
+        _ => {
+            let refined = verify_refinement(replay)?;
+            Verification {
+                text: text + &refined.as_ref().map_or(String::new(), refine_verified_text),
+                error: None,
+                passed: !matches!(refined, Some(RefineVerified::Diverged { .. })),
+            }
+        }
+    };
+    Ok(Ok(out))
 }
 
 /// Whether a re-weighted run's merges pair the same bodies in the same order as the recorded
