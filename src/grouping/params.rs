@@ -246,7 +246,7 @@ impl ResolvedParams {
 
 impl Params {
     /// Checks values as a user gives them: valid weights, a given DLimit and GLimit finite and
-    /// > 0, and a mode the p-set supports. The error names the command-line flag (`--a`,
+    /// positive, and a mode the p-set supports. The error names the command-line flag (`--a`,
     /// `--dlimit`, …).
     pub fn check(&self) -> Result<(), String> {
         self.weights.check().map_err(|e| format!("--{e}"))?;
