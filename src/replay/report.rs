@@ -1,5 +1,5 @@
-//! What `wraptree replay` prints: the recording's run, the outcome of [`verify`](super::verify)
-//! and [`verify_refinement`](super::verify_refinement), and a re-weighted run beside the
+//! What `wraptree replay` prints: the recording's run, the outcome of [`verify`]
+//! and [`verify_refinement`], and a re-weighted run beside the
 //! recorded one.
 
 use super::{
@@ -103,7 +103,7 @@ pub fn divergence_table(
     s
 }
 
-/// What [`verify`](super::verify) found, as `replay --verify` reports it: for
+/// What [`verify`] found, as `replay --verify` reports it: for
 /// [`Verified::PartDiffers`] one line without its end (an error message), for
 /// [`Verified::Diverged`] the [`divergence_table`] against the recording `rec`, else the
 /// lines printed on success.
@@ -144,7 +144,7 @@ pub fn verified_text(v: &Verified, rec: &Recorded) -> String {
     }
 }
 
-/// What [`verify_refinement`](super::verify_refinement) found, as `replay --verify` prints it.
+/// What [`verify_refinement`] found, as `replay --verify` prints it.
 pub fn refine_verified_text(v: &RefineVerified) -> String {
     match v {
         RefineVerified::Identical { moves } => {
