@@ -5,20 +5,21 @@
 //! Data flows [`scene`] → [`grouping`] (Subset Tree, §2.2) → [`wrap`] (Wrapper Trees, §2.4) →
 //! [`record`] (`.rrd`, `.mcap`), [`replay`], [`render`], [`metrics`] and [`query`]; [`peers`]
 //! wraps the hierarchies it is compared with, and [`geom`] is the small geometry every stage
-//! shares. Each `wraptree` command is a thin layer over one entry point here:
+//! shares. Each `wraptree` command is a thin layer over one entry point here, and what it prints
+//! is built here too:
 //!
-//! | command | entry point |
-//! |---|---|
-//! | `group` | [`grouping::group`], [`grouping::group_within`] with [`grouping::Limits`] |
-//! | `record` | [`record::record`] with [`record::RecordOptions`] |
-//! | `replay` | [`replay::open`], [`replay::verify`], [`replay::reweight`] |
-//! | `wrap` | [`wrap::report::report`] |
-//! | `cover` | [`wrap::cover::solve::cover_scene`], [`wrap::cover::solve::solve`] |
-//! | `snapshot` | [`render::snapshot::draw`] |
-//! | `bench` | [`metrics::compare::evaluate`], [`metrics::bench`] |
-//! | `sweep` | [`metrics::sweep::sweep`] |
-//! | `stress` | [`metrics::stress::run`] |
-//! | `scene` | [`scene::generate::by_name`] |
+//! | command | entry point | what it prints |
+//! |---|---|---|
+//! | `group` | [`grouping::group`], [`grouping::group_within`] with [`grouping::Limits`] | [`metrics::report::group_text`], [`metrics::report::group_json`] |
+//! | `record` | [`record::record`] with [`record::RecordOptions`] | [`record::Written::summary`] |
+//! | `replay` | [`replay::open`], [`replay::verify`], [`replay::reweight`] | [`replay::report`] |
+//! | `wrap` | [`wrap::report::report`] | [`wrap::report::report_text`] |
+//! | `cover` | [`wrap::cover::solve::cover_scene`], [`wrap::cover::solve::solve`] | [`wrap::cover::solve::CoverSummary::text`] |
+//! | `snapshot` | [`render::snapshot::draw`] | [`render::snapshot::Snapshot::text`] |
+//! | `bench` | [`metrics::compare::evaluate`], [`metrics::bench`] | [`metrics::report::bench_table`], [`metrics::report::target_line`], … |
+//! | `sweep` | [`metrics::sweep::sweep`] | [`metrics::report::sweep_table`] |
+//! | `stress` | [`metrics::stress::run`] | [`metrics::report::stress_table`] |
+//! | `scene` | [`scene::generate::by_name`] | |
 //!
 //! Group a scene and ask the tree for the distance from a point (as `examples/query_tree.rs`):
 //!
