@@ -10,7 +10,10 @@ use std::path::Path;
 
 use serde_json::Value;
 
-const LAYOUT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/recordings/foxglove-layout.json");
+const LAYOUT: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/recordings/foxglove-layout.json"
+);
 
 /// For each `[topic, field path]` of `argv[2]` (a JSON list; an empty path names the topic
 /// alone), checks that the recording `argv[1]` has a message on the topic and that the path
@@ -122,7 +125,10 @@ fn layout_panels_are_laid_out_once_each() {
         .collect();
     let laid_out: BTreeSet<String> = ids.iter().cloned().collect();
     assert_eq!(laid_out.len(), ids.len(), "a panel appears twice: {ids:?}");
-    assert_eq!(laid_out, configured, "laid-out panels against configured ones");
+    assert_eq!(
+        laid_out, configured,
+        "laid-out panels against configured ones"
+    );
     let kinds: BTreeSet<&str> = ids.iter().filter_map(|id| id.split('!').next()).collect();
     for kind in ["3D", "Plot", "Table"] {
         assert!(kinds.contains(kind), "no {kind} panel");

@@ -69,13 +69,24 @@ fn boxes_are_left_out_above_the_caps_and_drawn_below() {
     let dir = tempfile::tempdir().unwrap();
     let n = 3 * ACTIVE_CAP;
     let count = n.to_string();
-    let out = common::wraptree(&["scene", "soup", "-n", &count, "-o", "soup.obj"], dir.path());
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = common::wraptree(
+        &["scene", "soup", "-n", &count, "-o", "soup.obj"],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let out = common::wraptree(
         &["record", "soup.obj", "-o", "soup", "--detail", "merges"],
         dir.path(),
     );
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let rrd = dir.path().join("soup.rrd");
     common::assert_rrd_verifies(&rrd);
     let read = common::python()
@@ -103,11 +114,20 @@ fn boxes_are_left_out_above_the_caps_and_drawn_below() {
         let boxes = rows[round];
         if active > ACTIVE_CAP {
             capped += 1;
-            assert_eq!(boxes, 0, "round {round}: {active} active, {boxes} boxes drawn");
-            assert!(noted, "round {round}: the log line does not say the boxes are left out");
+            assert_eq!(
+                boxes, 0,
+                "round {round}: {active} active, {boxes} boxes drawn"
+            );
+            assert!(
+                noted,
+                "round {round}: the log line does not say the boxes are left out"
+            );
         } else {
             assert_eq!(boxes, active, "round {round}: every active body's box");
-            assert!(!noted, "round {round}: under the cap, yet noted as left out");
+            assert!(
+                !noted,
+                "round {round}: under the cap, yet noted as left out"
+            );
         }
     }
     assert!(capped > 0, "no round start above the cap: {starts:?}");

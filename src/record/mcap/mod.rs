@@ -32,8 +32,8 @@
 //! merges, dormant bodies, doublings, the finish, then the refinement's start and steps) at k ms; the level snapshots after the last event at consecutive milliseconds,
 //! `/levels/<d>` at (events + 1 + d) ms, then `/cover` at (events + 2 + depth max) ms. Sequence numbers count up from 0 on each channel.
 
-pub mod messages;
 mod levels;
+pub mod messages;
 pub mod metadata;
 mod read;
 pub mod scene_msgs;
