@@ -263,7 +263,7 @@ def check_detail_topics(run, merges, bodies, active):
         if bodies:
             fail(f"/grouping/bodies written with detail {detail}")
         return
-    # Only the last BODIES_CAP merges of the run (src/record/mcap/mod.rs).
+    # Only the last BODIES_CAP merges of the run (src/record/mod.rs).
     last = int(run["primitives"]) - 1
     capped = [m for m in merges if m.step + 4096 >= last]
     if len(bodies) != len(capped):

@@ -51,8 +51,8 @@ pub struct RecordCmd {
     /// Wrapper kinds the cover chooses from, comma-separated: sphere, box (or aabb), obb, hull.
     #[arg(long, default_value = "sphere,box,hull", value_delimiter = ',', value_parser = WrapperKind::parse)]
     cover_kinds: Vec<WrapperKind>,
-    /// Write every level to the .mcap (default: from the root down to the first level whose cut
-    /// is half leaves or more; the .rrd always has every level).
+    /// Write every level to the .mcap (default: from the root down to the last level whose cut
+    /// is less than half leaves; the .rrd always has every level).
     #[arg(long)]
     all_levels: bool,
     /// Refine the finished tree (reinsertion, see the README) and record each move on the

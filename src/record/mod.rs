@@ -20,6 +20,23 @@ use crate::wrap::cover::Cover;
 use crate::wrap::cover::export::WrapperRecord;
 use crate::wrap::{Sphere, Wrappers};
 
+/// A round start with more active bodies than this draws none of their boxes, in both files
+/// (`grouping/active` in the `.rrd`, `/grouping/active` in the `.mcap`; the count is in the
+/// round's log line and on `/grouping/round`): tens of thousands of boxes overload a 3D view
+/// and the file, and at that scale they only paint the scene over.
+pub const ACTIVE_CAP: usize = 8192;
+
+/// The per-merge boxes (the merged pair and the new body: `grouping/merge` in the `.rrd`,
+/// `/grouping/bodies` in the `.mcap`) are written for the last this many merges of a run: the
+/// merges of the top of the tree, large enough to be told apart at the scene's scale. Every
+/// merge is still in the series, the log and `/grouping/merge` of the `.mcap`.
+pub const BODIES_CAP: u32 = 4096;
+
+/// Whether merge `step` of a run over `n` primitives is among the last [`BODIES_CAP`].
+pub fn boxes_drawn(step: u32, n: usize) -> bool {
+    step + BODIES_CAP >= n.saturating_sub(1) as u32
+}
+
 /// What a recording holds (`--detail`).
 #[derive(
     Clone,

@@ -47,7 +47,8 @@ pub struct RecordOptions {
     /// A cover logged as one more level, within this limit, from these kinds (needs `detail`
     /// with levels).
     pub cover: Option<(CoverLimit, Vec<WrapperKind>)>,
-    /// Write every level to the `.mcap`, not only down to the first cut of half leaves.
+    /// Write every level to the `.mcap`, not only down to the last cut of less than half
+    /// leaves.
     pub all_levels: bool,
     /// Refine the finished tree with these parameters ([`crate::refine`]), recording each
     /// move; the levels are then the refined tree's.
@@ -138,7 +139,8 @@ pub fn record<O: Observer>(
         let rrd_thread = std::thread::Builder::new()
             .name("rrd-recorder".into())
             .spawn_scoped(s, move || {
-                let mut rrd = RrdRecorder::with_name(rrd_tmp, rrd_name, info)?;
+                let refined = opts.refine.is_some();
+                let mut rrd = RrdRecorder::with_refine(rrd_tmp, rrd_name, info, refined)?;
                 rrd_worker.run(&mut rrd);
                 Ok::<_, anyhow::Error>(rrd)
             })

@@ -15,10 +15,10 @@
 //! | `/grouping/part` | `partevent.PartEvent` | each part of the run (partitioned schedule's chunks and top, pre-grouping's components and copies): id, kind (0 chunk, 1 component, 2 copy, 3 top), bodies, first step, chunk level and keep, component index (or the copied one), copy rotation and translation; the merges up to the next part belong to it | runs with parts, from the first part on |
 //! | `/grouping/finish` | `finishevent.FinishEvent` | root, rounds, merges | always, once |
 //! | `/refine/step` | `refinestepevent.RefineStepEvent` | every kept move of the refinement: step, pass, moved node, its parent slot, old and new sibling, the moved subtree's and new parent's boxes, SAH before and after | `record --refine` |
-//! | `/grouping/active` | `foxglove.SceneUpdate` | entity `active`: one translucent green box per active body at each round start | `--detail merges` or `full` |
-//! | `/grouping/bodies` | `foxglove.SceneUpdate` | entity `merge`: the merged pair (red) and the new body (yellow) as boxes, per merge | `--detail full` (it repeats boxes the merge events already carry, and is the largest per-merge topic) |
+//! | `/grouping/active` | `foxglove.SceneUpdate` | entity `active`: one translucent green box per active body at each round start (none above [`ACTIVE_CAP`] active bodies) | `--detail merges` or `full` |
+//! | `/grouping/bodies` | `foxglove.SceneUpdate` | entity `merge`: the merged pair (red) and the new body (yellow) as boxes, per merge of the last [`BODIES_CAP`] | `--detail full` (it repeats boxes the merge events already carry, and is the largest per-merge topic) |
 //! | `/grouping/dormant` | `dormantevent.DormantEvent` | round, body, diameter of each body going dormant | `--detail merges` or `full` |
-//! | `/levels/<d>` | `foxglove.SceneUpdate` | one snapshot of the cut at depth d of the finished tree (the refined one with `record --refine`) (d = 0 down to the first cut of half leaves, `LEVEL_LEAF_SHARE`; every depth with `set_all_levels`), one entity per wrapper kind chosen with `--wrapper` for the cut's interior nodes: `spheres` (`SpherePrimitive`s, size = diameter), `hulls` (one indexed `TriangleListPrimitive` per hull; a segment hull is one degenerate triangle `[a, b, b]`, a point hull `[a, a, a]`), `boxes` (axis-aligned `CubePrimitive`s), `obbs` (`CubePrimitive`s with orientation); and entity `leaves` (the cut's leaves as one orange `TriangleListPrimitive`) | `--detail levels` or `full`, finished runs |
+//! | `/levels/<d>` | `foxglove.SceneUpdate` | one snapshot of the cut at depth d of the finished tree (the refined one with `record --refine`) (d = 0 down to the last cut of less than half leaves, `LEVEL_LEAF_SHARE`; every depth with `set_all_levels`), one entity per wrapper kind chosen with `--wrapper` for the cut's interior nodes: `spheres` (`SpherePrimitive`s, size = diameter), `hulls` (one indexed `TriangleListPrimitive` per hull; a segment hull is one degenerate triangle `[a, b, b]`, a point hull `[a, a, a]`), `boxes` (axis-aligned `CubePrimitive`s), `obbs` (`CubePrimitive`s with orientation); and entity `leaves` (the cut's leaves as one orange `TriangleListPrimitive`) | `--detail levels` or `full`, finished runs |
 //! | `/cover` | `foxglove.SceneUpdate` | the cover (`--cover-tolerance` or `--cover-budget`) as one more level: entities `spheres`, `boxes` (oriented ones with orientation), `hulls` (one indexed `TriangleListPrimitive` per hull) and `leaves` (one `TriangleListPrimitive` per leaf drawn as itself), only those used | with a cover, `--detail levels` or `full`, finished runs |
 //!
 //! The input scene file is attached (name = its file name, media type `model/obj`, log time 0),
@@ -32,6 +32,7 @@
 //! merges, dormant bodies, doublings, the finish, then the refinement's start and steps) at k ms; the level snapshots after the last event at consecutive milliseconds,
 //! `/levels/<d>` at (events + 1 + d) ms, then `/cover` at (events + 2 + depth max) ms. Sequence numbers count up from 0 on each channel.
 
+mod levels;
 pub mod messages;
 pub mod metadata;
 mod read;
@@ -42,7 +43,7 @@ pub use read::{Recorded, read_recording};
 use crate::geom::Aabb;
 use crate::grouping::{Event, Observer};
 use crate::record::{Detail, Outcome, RunInfo};
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, anyhow};
 use foxglove::Encode;
 use foxglove::messages::SceneUpdate;
 use messages::{DormantEvent, FinishEvent, MergeEvent, PartEvent, RefineStepEvent, RoundEvent};
@@ -61,17 +62,12 @@ pub const PROFILE: &str = "";
 /// The MCAP header's library string.
 pub const LIBRARY: &str = concat!("wraptree ", env!("CARGO_PKG_VERSION"), " (mcap-rs 0.26)");
 const MS: u64 = 1_000_000;
-/// Without [`McapRecorder::set_all_levels`], levels are written from the root down to the first
-/// whose cut is at least this share leaves; deeper cuts are mostly the scene itself, and each
-/// repeats its leaves' geometry.
+/// Without [`McapRecorder::set_all_levels`], levels are written from the root down to the
+/// last whose cut is less than this share leaves (level 0 always): the first cut that is half
+/// leaves or more, and every deeper one, is mostly the scene itself, and each level repeats its
+/// leaves' geometry.
 pub const LEVEL_LEAF_SHARE: f64 = 0.5;
-/// A round start with more active bodies than this writes `/grouping/active` without boxes (the
-/// count is on `/grouping/round`): tens of thousands of boxes overload a 3D panel and the file.
-pub const ACTIVE_CAP: usize = 8192;
-/// `/grouping/bodies` is written for the last this many merges of the run: the merges of the
-/// top of the tree, large enough to be told apart at the scene's scale (the earlier ones are
-/// on `/grouping/merge`).
-pub const BODIES_CAP: u32 = 4096;
+pub use crate::record::{ACTIVE_CAP, BODIES_CAP};
 
 /// A channel and its next sequence number.
 #[derive(Clone, Copy, Debug)]
@@ -264,8 +260,8 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
         self.reproducible = on;
     }
 
-    /// Writes every level down to the deepest (`record --all-levels`) instead of stopping at
-    /// the first whose cut is [`LEVEL_LEAF_SHARE`] leaves.
+    /// Writes every level down to the deepest (`record --all-levels`) instead of stopping
+    /// before the first whose cut is [`LEVEL_LEAF_SHARE`] leaves.
     pub fn set_all_levels(&mut self, on: bool) {
         self.all_levels = on;
     }
@@ -319,8 +315,8 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
                     self.bodies.resize(new + 1, Aabb::EMPTY);
                 }
                 self.bodies[new] = m.aabb;
-                let last = self.info.scene.len().saturating_sub(1) as u32;
-                if let Some(bodies_topic) = bodies_topic.filter(|_| m.step + BODIES_CAP >= last) {
+                let drawn = crate::record::boxes_drawn(m.step, self.info.scene.len());
+                if let Some(bodies_topic) = bodies_topic.filter(|_| drawn) {
                     let mut e = scene_msgs::entity("merge", t);
                     let get =
                         |id: u32| self.bodies.get(id as usize).copied().unwrap_or(Aabb::EMPTY);
@@ -410,104 +406,6 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             }
         }
         Ok(())
-    }
-
-    /// Writes one `/levels/<d>` snapshot per depth of the finished tree, from the root down to
-    /// the first cut of [`LEVEL_LEAF_SHARE`] leaves (to the deepest with `all_levels`); returns
-    /// the number of levels written.
-    fn write_levels(&mut self, outcome: &Outcome<'_>) -> Result<u32> {
-        let (Some(grouping), Some(spheres)) = (outcome.grouping, outcome.spheres) else {
-            return Ok(0);
-        };
-        let tree = &grouping.tree;
-        if !spheres.is_empty() && spheres.len() != tree.len() {
-            bail!("{} spheres for {} tree nodes", spheres.len(), tree.len());
-        }
-        let none = crate::wrap::Wrappers::default();
-        let extra = outcome.wrappers.unwrap_or(&none);
-        for (what, len) in [
-            ("hulls", extra.hulls.as_ref().map(Vec::len)),
-            ("boxes", extra.boxes.as_ref().map(Vec::len)),
-            ("oriented boxes", extra.obbs.as_ref().map(Vec::len)),
-        ] {
-            if let Some(len) = len.filter(|&l| l != tree.len()) {
-                bail!("{len} {what} for {} tree nodes", tree.len());
-            }
-        }
-        let scene = self.info.scene;
-        // The cut at depth d holds the leaves of depth <= d: each level adds one depth's leaves.
-        let mut leaves_by_depth = vec![Vec::new(); tree.depth_max() as usize + 1];
-        for x in 0..tree.leaves() {
-            leaves_by_depth[tree.depth[x] as usize].push(x);
-        }
-        let mut leaf_mesh = SceneMesh::new(scene);
-        let mut written = 0;
-        for d in 0..=tree.depth_max() {
-            written = d + 1;
-            let t = (self.events + 1 + u64::from(d)) * MS;
-            let mut topic =
-                add_topic(&mut self.writer, self.scene_update, &format!("/levels/{d}"))?;
-            let cut = tree.level(d);
-            let interior: Vec<usize> = cut
-                .iter()
-                .filter(|&&x| !tree.is_leaf(x))
-                .map(|&x| x as usize)
-                .collect();
-            let mut entities = Vec::with_capacity(5);
-            if !spheres.is_empty() {
-                let mut e = scene_msgs::entity("spheres", t);
-                e.spheres = interior
-                    .iter()
-                    .map(|&x| scene_msgs::sphere(&spheres[x], scene_msgs::SPHERE_COLOR))
-                    .collect();
-                entities.push(e);
-            }
-            if let Some(h) = &extra.hulls {
-                let mut e = scene_msgs::entity("hulls", t);
-                e.triangles = interior
-                    .iter()
-                    .map(|&x| scene_msgs::hull_triangles(&h[x], scene_msgs::HULL_COLOR))
-                    .collect();
-                entities.push(e);
-            }
-            if let Some(b) = &extra.boxes {
-                let mut e = scene_msgs::entity("boxes", t);
-                e.cubes = interior
-                    .iter()
-                    .map(|&x| scene_msgs::cube(&b[x], scene_msgs::BOX_COLOR))
-                    .collect();
-                entities.push(e);
-            }
-            if let Some(b) = &extra.obbs {
-                let mut e = scene_msgs::entity("obbs", t);
-                e.cubes = interior
-                    .iter()
-                    .map(|&x| scene_msgs::obb_cube(&b[x], scene_msgs::OBB_COLOR))
-                    .collect();
-                entities.push(e);
-            }
-            let mut leaves = scene_msgs::entity("leaves", t);
-            leaf_mesh.add(leaves_by_depth[d as usize].iter().copied());
-            leaves
-                .triangles
-                .push(leaf_mesh.primitive(scene_msgs::LEAF_COLOR));
-            entities.push(leaves);
-            let msg = scene_msgs::update(entities);
-            emit(&mut self.writer, &mut self.buf, &mut topic, t, &msg)
-                .with_context(|| format!("writing level {d}"))?;
-            let leaves = cut.len() - interior.len();
-            if !self.all_levels && leaves as f64 >= LEVEL_LEAF_SHARE * cut.len() as f64 {
-                break;
-            }
-        }
-        if let Some(cover) = &outcome.cover {
-            let t = (self.events + 2 + u64::from(tree.depth_max())) * MS;
-            let mut topic = add_topic(&mut self.writer, self.scene_update, "/cover")?;
-            let msg = scene_msgs::cover_update(cover.wrappers, t);
-            emit(&mut self.writer, &mut self.buf, &mut topic, t, &msg)
-                .context("writing the cover")?;
-        }
-        Ok(written)
     }
 
     /// Levels, metadata records and the summary section.

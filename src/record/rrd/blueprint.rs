@@ -3,9 +3,9 @@
 //! Top, side by side (wide views, so the scene is framed whole at 1280×720): a 3D view of the
 //! scene and the grouping boxes (scrub the `merge` or `round` timeline) and, when levels are
 //! written, a 3D view of the tree levels and the cover, if any (scrub `level`).
-//! Bottom: the plots of the merge series (and the refinement's SAH, `record --refine`, on the
-//! `refine` timeline) in a grid of two columns beside the text log of rounds, doublings and
-//! refinement.
+//! Bottom: the plots of the merge series (and, for a refined run, `record --refine`, the
+//! refinement's SAH on the `refine` timeline) in a grid of two columns beside the text log of
+//! rounds, doublings and refinement.
 //!
 //! Every view shows something when the file is opened: the time panel opens collapsed (the play
 //! bar alone) on the `merge` timeline, following, so the cursor stands at the last merge; there
@@ -21,8 +21,9 @@ use rerun::blueprint::{
 
 use crate::record::Detail;
 
-/// The blueprint for a recording written at `detail`.
-pub(super) fn layout(detail: Detail) -> Blueprint {
+/// The blueprint for a recording written at `detail`, with the SAH plot when the tree is
+/// `refined` (without a refinement that plot would stay empty).
+pub(super) fn layout(detail: Detail, refined: bool) -> Blueprint {
     let mut views: Vec<ContainerLike> = vec![
         Spatial3DView::new("Grouping (timelines merge, round)")
             .with_origin("/")
@@ -43,14 +44,16 @@ pub(super) fn layout(detail: Detail) -> Blueprint {
             .with_contents(series.iter().map(|s| format!("+ /series/{s}")))
             .into()
     };
-    let plots = Grid::new([
+    let mut plots = vec![
         plot("Cost", &["cost"]),
         plot("diameter, DLimit, GLimit", &["limits"]),
         plot("Fill, Balance", &["fill_balance"]),
         plot("MPairs length", &["queue_len"]),
-        plot("SAH (timeline refine)", &["refine_sah"]),
-    ])
-    .with_grid_columns(2);
+    ];
+    if refined {
+        plots.push(plot("SAH (timeline refine)", &["refine_sah"]));
+    }
+    let plots = Grid::new(plots).with_grid_columns(2);
     let bottom = Horizontal::new([
         plots.into(),
         TextLogView::new("Rounds, doublings, refinement")

@@ -59,7 +59,9 @@ pub(super) struct Columns {
     round: Vec<i64>,
     /// Per [`SERIES`] entity, its rows' scalars one after the other.
     series: [Vec<f64>; 4],
-    /// Per merge, the pair's two boxes then the new body's.
+    /// (merge, round) ticks of the merges drawn as boxes (`record::BODIES_CAP`).
+    box_ticks: Vec<(i64, i64)>,
+    /// Per merge drawn, the pair's two boxes then the new body's.
     box_centers: Vec<[f32; 3]>,
     box_halves: Vec<[f32; 3]>,
     /// `log/doublings` rows: (merge, round) ticks, lines and levels.
@@ -73,8 +75,8 @@ pub(super) struct Columns {
 }
 
 impl Columns {
-    /// Buffers one merge; `boxes` are the pair's and the new body's boxes when per-merge
-    /// geometry is written.
+    /// Buffers one merge; `boxes` are the pair's and the new body's boxes when this merge is
+    /// drawn.
     pub(super) fn push(
         &mut self,
         m: &Merge,
@@ -94,6 +96,7 @@ impl Columns {
             column.extend_from_slice(v);
         }
         if let Some(([a, b], new)) = boxes {
+            self.box_ticks.push((m.step as i64, m.round as i64));
             self.box_centers.extend([a.center, b.center, new.center]);
             self.box_halves.extend([a.half, b.half, new.half]);
         }
@@ -131,6 +134,7 @@ impl Columns {
         self.step.clear();
         self.round.clear();
         self.series.iter_mut().for_each(Vec::clear);
+        self.box_ticks.clear();
         self.box_centers.clear();
         self.box_halves.clear();
         self.text_ticks.clear();
@@ -184,18 +188,22 @@ impl Columns {
             return Ok(());
         }
         let merge = || TimeColumn::new_sequence("merge", self.step.iter().copied());
-        let round = || TimeColumn::new_sequence("round", self.round.iter().copied());
         for ((path, names), values) in SERIES.iter().zip(&self.series) {
             let scalars = rerun::Scalars::new(values.iter().copied())
                 .columns(std::iter::repeat_n(names.len(), k))?;
             rec.send_columns(*path, [merge()], scalars)?;
         }
-        if !self.box_centers.is_empty() {
+        if !self.box_ticks.is_empty() {
             let boxes = rerun::Boxes3D::update_fields()
                 .with_centers(self.box_centers.iter().copied())
                 .with_half_sizes(self.box_halves.iter().copied())
-                .columns(std::iter::repeat_n(3, k))?;
-            rec.send_columns("grouping/merge", [merge(), round()], boxes)?;
+                .columns(std::iter::repeat_n(3, self.box_ticks.len()))?;
+            let (merge, round): (Vec<i64>, Vec<i64>) = self.box_ticks.iter().copied().unzip();
+            let ticks = [
+                TimeColumn::new_sequence("merge", merge),
+                TimeColumn::new_sequence("round", round),
+            ];
+            rec.send_columns("grouping/merge", ticks, boxes)?;
         }
         Ok(())
     }

@@ -2,8 +2,8 @@
 //!
 //! [`RrdRecorder`] is an [`Observer`]; it saves with the SDK's file sink
 //! (`RecordingStreamBuilder::save`, no viewer is spawned), checks at the end that the file is
-//! complete (`sink.rs`), and embeds a blueprint (`blueprint.rs`) so the file opens on a useful
-//! layout.
+//! complete (`sink.rs`), writes what precedes the events in `header.rs`, and embeds a
+//! blueprint (`blueprint.rs`) so the file opens on a useful layout.
 //!
 //! # Timelines
 //!
@@ -31,8 +31,8 @@
 //! | `/` | `ViewCoordinates` | static | all | right-handed, Z up (the generated scenes' convention) |
 //! | `scene`, `grouping`, `levels` | `Transform3D` | static | all | translation by the scene origin |
 //! | `scene/primitives` | `Mesh3D` | static | all | every input primitive in one shaded mesh, light grey (with `--pregroup`: one colour per component) |
-//! | `grouping/merge` | `Boxes3D` (3 boxes) | `merge`, `round` | merges, full | the AABBs of the two merged bodies (orange), then of the new body (green) |
-//! | `grouping/active` | `Boxes3D` | `round`, `merge` | merges, full | at each round start, the AABBs of all active bodies (blue) |
+//! | `grouping/merge` | `Boxes3D` (3 boxes) | `merge`, `round` | merges, full | the AABBs of the two merged bodies (orange), then of the new body (green), for the last [`BODIES_CAP`](crate::record::BODIES_CAP) merges |
+//! | `grouping/active` | `Boxes3D` | `round`, `merge` | merges, full | at each round start, the AABBs of all active bodies (blue); none (an empty row) above [`ACTIVE_CAP`] active bodies |
 //! | `series/cost` | `Scalars` (1) | `merge` | all | Cost of each merge |
 //! | `series/limits` | `Scalars` (3: diameter, DLimit, GLimit) | `merge` | all | each merge's diameter, and DLimit and GLimit in force at it |
 //! | `series/fill_balance` | `Scalars` (2: Fill, Balance) | `merge` | all | Fill and Balance of each merge |
@@ -75,6 +75,7 @@
 
 mod blueprint;
 mod columns;
+mod header;
 mod levels;
 mod mesh;
 mod refine;
@@ -88,13 +89,10 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail};
 use rerun::external::arrow::array::Array as _;
 use rerun::{AsComponents, RecordingStream, SerializedComponentColumn, TimeColumn};
-use sha2::{Digest, Sha256};
 
 use crate::geom::{Aabb, P3};
-use crate::grouping::Pregroup;
 use crate::grouping::{Event, Observer};
-use crate::record::{Detail, Outcome, RunInfo};
-use crate::scene::components;
+use crate::record::{ACTIVE_CAP, Detail, Outcome, RunInfo, boxes_drawn};
 use columns::Columns;
 use mesh::PrimMesh;
 
@@ -111,6 +109,8 @@ pub struct RrdRecorder {
     /// The path named in errors.
     name: PathBuf,
     detail: Detail,
+    /// Primitives in the scene (N).
+    primitives: usize,
     origin: P3,
     /// Box of every body so far, relative to `origin` (only when per-merge geometry is written).
     boxes: Vec<BoxF32>,
@@ -150,31 +150,6 @@ impl BoxF32 {
 fn rel(p: &P3, origin: &P3) -> [f32; 3] {
     let d = p - origin;
     [d.x as f32, d.y as f32, d.z as f32]
-}
-
-/// The recording id: a UUID-shaped hex digest of the scene hash and the resolved parameters.
-fn recording_id(info: &RunInfo<'_>) -> String {
-    let mut h = Sha256::new();
-    h.update(b"wraptree rrd\0");
-    h.update(info.source.sha256.as_bytes());
-    h.update(b"\0");
-    h.update(
-        serde_json::to_string(info.params)
-            .unwrap_or_default()
-            .as_bytes(),
-    );
-    let hex: String = h.finalize()[..16]
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    format!(
-        "{}-{}-{}-{}-{}",
-        &hex[..8],
-        &hex[8..12],
-        &hex[12..16],
-        &hex[16..20],
-        &hex[20..]
-    )
 }
 
 /// Sends one row of `arch` as static data. Unlike `log_static`, whose rows wait in the SDK's
@@ -219,14 +194,25 @@ impl RrdRecorder {
     /// As [`RrdRecorder::new`], but errors name `name` instead of `path`: the destination that
     /// a temporary `path` will be renamed to.
     pub fn with_name(path: &Path, name: &Path, info: &RunInfo<'_>) -> anyhow::Result<Self> {
+        Self::with_refine(path, name, info, false)
+    }
+
+    /// As [`RrdRecorder::with_name`], for a run whose tree is then `refined` (`record
+    /// --refine`): the layout then has the refinement's SAH plot.
+    pub fn with_refine(
+        path: &Path,
+        name: &Path,
+        info: &RunInfo<'_>,
+        refined: bool,
+    ) -> anyhow::Result<Self> {
         let scene = info.scene;
         let builder =
-            rerun::RecordingStreamBuilder::new("wraptree").recording_id(recording_id(info));
+            rerun::RecordingStreamBuilder::new("wraptree").recording_id(header::recording_id(info));
         let rec = sink::save(builder, path)
             .map_err(|e| file_error(name, "cannot create the Rerun recording", e))?;
         // The SDK builds a blueprint through a stream of its own (two threads, one chunk per
         // view); a thread of ours does it while this one writes the header and the events.
-        let (layout, bp_rec) = (blueprint::layout(info.detail), rec.clone());
+        let (layout, bp_rec) = (blueprint::layout(info.detail, refined), rec.clone());
         let activation = rerun::blueprint::BlueprintActivation {
             make_active: true,
             make_default: true,
@@ -255,6 +241,7 @@ impl RrdRecorder {
             path: path.to_path_buf(),
             name: name.to_path_buf(),
             detail: info.detail,
+            primitives: scene.len(),
             origin,
             boxes,
             columns: Columns::default(),
@@ -281,86 +268,6 @@ impl RrdRecorder {
         self.rec.as_ref().ok_or_else(closed)
     }
 
-    /// Metadata, transforms, the scene mesh and static styling.
-    fn write_header(&self, info: &RunInfo<'_>, mesh: &PrimMesh) -> anyhow::Result<()> {
-        let rec = self.rec()?;
-        let scene = info.scene;
-        rec.send_recording_name(format!(
-            "{} ({} primitives)",
-            info.source.file_name,
-            scene.len()
-        ))?;
-        let text = |s: String| [rerun::components::Text::from(s)];
-        rec.send_property(
-            "wraptree",
-            &rerun::AnyValues::default()
-                .with_component::<rerun::components::Text>(
-                    "version",
-                    text(env!("CARGO_PKG_VERSION").into()),
-                )
-                .with_component::<rerun::components::Text>(
-                    "scene",
-                    text(info.source.file_name.clone()),
-                )
-                .with_component::<rerun::components::Text>(
-                    "sha256",
-                    text(info.source.sha256.clone()),
-                )
-                .with_component::<rerun::components::Text>(
-                    "primitives",
-                    text(scene.len().to_string()),
-                )
-                .with_component::<rerun::components::Text>(
-                    "params",
-                    text(serde_json::to_string(info.params)?),
-                )
-                .with_component::<rerun::components::Text>(
-                    "detail",
-                    text(format!("{:?}", info.detail).to_lowercase()),
-                ),
-        )?;
-        let o = self.origin;
-        for root in ["scene", "grouping", "levels", "refine"] {
-            send_static(
-                rec,
-                root,
-                &rerun::Transform3D::from_translation([o.x as f32, o.y as f32, o.z as f32]),
-            )?;
-        }
-        send_static(rec, "/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
-        let primitives = rerun::Mesh3D::new(mesh.positions.iter().copied())
-            .with_vertex_normals(mesh.normals.iter().copied())
-            .with_triangle_indices(mesh.all_tris().iter().copied());
-        // With pre-grouping, each component in its own colour.
-        let primitives = match info.params.mode.pregroup {
-            Pregroup::None => primitives.with_albedo_factor(SCENE_GREY),
-            Pregroup::Objects => {
-                primitives.with_vertex_colors(mesh.component_colors(&components::objects(scene).of))
-            }
-            Pregroup::Connected => primitives
-                .with_vertex_colors(mesh.component_colors(&components::connected(scene).of)),
-        };
-        send_static(rec, "scene/primitives", &primitives)?;
-        for ((path, names), colors) in columns::SERIES.iter().zip(columns::SERIES_COLORS) {
-            let lines = rerun::SeriesLines::new()
-                .with_names(names.iter().copied())
-                .with_colors(colors.iter().copied());
-            send_static(rec, path, &lines)?;
-        }
-        if self.detail.merges() {
-            columns::log_styles(rec)?;
-            send_static(
-                rec,
-                "grouping/active",
-                &rerun::Boxes3D::update_fields()
-                    .with_colors([ACTIVE_BLUE])
-                    .with_radii([rerun::components::Radius::new_ui_points(0.5)])
-                    .with_fill_mode(rerun::components::FillMode::MajorWireframe),
-            )?;
-        }
-        Ok(())
-    }
-
     fn text(&mut self, round: u32, line: String) {
         let info = rerun::components::TextLogLevel::from(rerun::TextLogLevel::INFO);
         self.columns.push_text(self.merges, round, line, info);
@@ -382,9 +289,17 @@ impl RrdRecorder {
                 let n = active.len();
                 let limits = format!("DLimit {dlimit:.6e}, GLimit {glimit:.6e}");
                 let sets = format!("{n} active, {dormant} dormant, {pairs} pairs");
-                self.text(round, format!("round {round}: {limits}, {sets}"));
+                let capped = self.detail.merges() && n > ACTIVE_CAP;
+                let note = if capped {
+                    format!(" (active boxes not drawn above {ACTIVE_CAP})")
+                } else {
+                    String::new()
+                };
+                self.text(round, format!("round {round}: {limits}, {sets}{note}"));
                 if self.detail.merges() {
-                    let boxes = active
+                    // Above the cap the row is empty: it still clears the previous round's boxes.
+                    let drawn = if capped { &active[..0] } else { active };
+                    let boxes = drawn
                         .iter()
                         .map(|&b| self.body(b))
                         .collect::<anyhow::Result<Vec<_>>>()?;
@@ -404,7 +319,7 @@ impl RrdRecorder {
                     }
                     let pair = [self.body(m.a)?, self.body(m.b)?];
                     self.boxes.push(new);
-                    Some((pair, new))
+                    boxes_drawn(m.step, self.primitives).then_some((pair, new))
                 } else {
                     None
                 };
@@ -502,34 +417,6 @@ impl RrdRecorder {
                 levels::log_cover(rec, tree, cover, &self.origin)?;
             }
         }
-        Ok(())
-    }
-}
-
-impl RrdRecorder {
-    /// Marks a run stopped before the root: a warning line in `log/doublings` at the last
-    /// merge, and the recording property `wraptree_outcome` with `complete` = `false`,
-    /// `stop_reason` (`interrupted`, `max-seconds`, `max-pairs` or `unknown`) and `merges`.
-    fn mark_incomplete(&mut self, outcome: &Outcome<'_>) -> anyhow::Result<()> {
-        let reason = outcome.stopped.map_or("unknown", |s| s.reason.name());
-        let line = format!(
-            "incomplete: stopped ({reason}) after {} merges; no tree levels",
-            outcome.merges
-        );
-        let warn = rerun::components::TextLogLevel::from(rerun::TextLogLevel::WARN);
-        self.columns.push_text(self.merges, self.round, line, warn);
-        let rec = self.rec()?;
-        let text = |s: String| [rerun::components::Text::from(s)];
-        rec.send_property(
-            "wraptree_outcome",
-            &rerun::AnyValues::default()
-                .with_component::<rerun::components::Text>("complete", text("false".into()))
-                .with_component::<rerun::components::Text>("stop_reason", text(reason.into()))
-                .with_component::<rerun::components::Text>(
-                    "merges",
-                    text(outcome.merges.to_string()),
-                ),
-        )?;
         Ok(())
     }
 }

@@ -1,0 +1,163 @@
+//! Conversions between the grouping's and refinement's events and their messages.
+
+use super::{MergeEvent, PartEvent, RefineStepEvent};
+use crate::geom::{Aabb, P3};
+use crate::grouping::{Merge, Part, PartKind};
+
+impl From<&crate::refine::Step> for RefineStepEvent {
+    fn from(s: &crate::refine::Step) -> Self {
+        let (a, p) = (&s.aabb, &s.parent_aabb);
+        RefineStepEvent {
+            step: s.step,
+            pass: s.pass,
+            node: s.node,
+            parent: s.parent,
+            sibling: s.sibling,
+            target: s.target,
+            min_x: a.min.x,
+            min_y: a.min.y,
+            min_z: a.min.z,
+            max_x: a.max.x,
+            max_y: a.max.y,
+            max_z: a.max.z,
+            parent_min_x: p.min.x,
+            parent_min_y: p.min.y,
+            parent_min_z: p.min.z,
+            parent_max_x: p.max.x,
+            parent_max_y: p.max.y,
+            parent_max_z: p.max.z,
+            sah_before: s.sah_before,
+            sah: s.sah,
+        }
+    }
+}
+
+impl From<&RefineStepEvent> for crate::refine::Step {
+    fn from(e: &RefineStepEvent) -> Self {
+        let b = |lo: [f64; 3], hi: [f64; 3]| Aabb {
+            min: P3::new(lo[0], lo[1], lo[2]),
+            max: P3::new(hi[0], hi[1], hi[2]),
+        };
+        crate::refine::Step {
+            step: e.step,
+            pass: e.pass,
+            node: e.node,
+            parent: e.parent,
+            sibling: e.sibling,
+            target: e.target,
+            aabb: b([e.min_x, e.min_y, e.min_z], [e.max_x, e.max_y, e.max_z]),
+            parent_aabb: b(
+                [e.parent_min_x, e.parent_min_y, e.parent_min_z],
+                [e.parent_max_x, e.parent_max_y, e.parent_max_z],
+            ),
+            sah_before: e.sah_before,
+            sah: e.sah,
+        }
+    }
+}
+
+impl From<&Part> for PartEvent {
+    fn from(p: &Part) -> Self {
+        let mut e = PartEvent {
+            id: p.id,
+            bodies: p.bodies,
+            first_step: p.first_step,
+            ..PartEvent::default()
+        };
+        match p.kind {
+            PartKind::Chunk { level, keep } => {
+                e.kind = 0;
+                e.level = level;
+                e.keep = keep;
+            }
+            PartKind::Component { index } => {
+                e.kind = 1;
+                e.index = index;
+            }
+            PartKind::Copy {
+                of,
+                rotation: r,
+                translation: t,
+            } => {
+                e.kind = 2;
+                e.index = of;
+                [e.r0, e.r1, e.r2, e.r3, e.r4, e.r5, e.r6, e.r7, e.r8] = r;
+                [e.tx, e.ty, e.tz] = t;
+            }
+            PartKind::Top => e.kind = 3,
+        }
+        e
+    }
+}
+
+impl TryFrom<&PartEvent> for Part {
+    type Error = String;
+    fn try_from(e: &PartEvent) -> Result<Self, String> {
+        let kind = match e.kind {
+            0 => PartKind::Chunk {
+                level: e.level,
+                keep: e.keep,
+            },
+            1 => PartKind::Component { index: e.index },
+            2 => PartKind::Copy {
+                of: e.index,
+                rotation: [e.r0, e.r1, e.r2, e.r3, e.r4, e.r5, e.r6, e.r7, e.r8],
+                translation: [e.tx, e.ty, e.tz],
+            },
+            3 => PartKind::Top,
+            k => return Err(format!("unknown part kind {k}")),
+        };
+        Ok(Part {
+            id: e.id,
+            kind,
+            bodies: e.bodies,
+            first_step: e.first_step,
+        })
+    }
+}
+
+impl From<&Merge> for MergeEvent {
+    fn from(m: &Merge) -> Self {
+        MergeEvent {
+            step: m.step,
+            round: m.round,
+            a: m.a,
+            b: m.b,
+            new: m.new,
+            min_x: m.aabb.min.x,
+            min_y: m.aabb.min.y,
+            min_z: m.aabb.min.z,
+            max_x: m.aabb.max.x,
+            max_y: m.aabb.max.y,
+            max_z: m.aabb.max.z,
+            diameter: m.diameter,
+            fill: m.fill,
+            balance: m.balance,
+            cost: m.cost,
+            queue_len: m.queue_len,
+            active: m.active,
+        }
+    }
+}
+
+impl From<&MergeEvent> for Merge {
+    fn from(e: &MergeEvent) -> Self {
+        Merge {
+            step: e.step,
+            round: e.round,
+            a: e.a,
+            b: e.b,
+            new: e.new,
+            aabb: Aabb {
+                min: P3::new(e.min_x, e.min_y, e.min_z),
+                max: P3::new(e.max_x, e.max_y, e.max_z),
+            },
+            diameter: e.diameter,
+            fill: e.fill,
+            balance: e.balance,
+            cost: e.cost,
+            queue_len: e.queue_len,
+            active: e.active,
+        }
+    }
+}
