@@ -53,6 +53,10 @@ pub struct BenchCmd {
     /// 12,144-polygon scenes and a 10^5-triangle soup.
     #[arg(long)]
     record: bool,
+    /// Instead: only the targets' partitioned-schedule table (exact and partitioned grouping
+    /// and obvhs PLOC on 1 and 2 threads, quality, peak memory) on the targets scenes.
+    #[arg(long, conflicts_with = "record")]
+    partitioned: bool,
 }
 
 /// Loads a KIND[:COUNT] or OBJ scene spec, printing loader warnings to stderr.
@@ -79,6 +83,9 @@ impl BenchCmd {
         eprintln!("threads: {} (rayon pool)", rayon::current_num_threads());
         if self.record {
             return self.run_record();
+        }
+        if self.partitioned {
+            return self.run_partitioned();
         }
         if self.scenes.is_empty() {
             return self.run_targets();
@@ -224,6 +231,16 @@ impl BenchCmd {
             "group ms on {} threads (the exact run's round-start scans are parallel).",
             rayon::current_num_threads()
         );
+        if self.max_soup >= 10_000_000 {
+            cases.push(generate::soup(10_000_000, 1));
+        }
+        super::bench_partitioned::print_table(&cases, self.repeat)?;
+        Ok(ExitCode::SUCCESS)
+    }
+
+    /// The partitioned schedule's table alone.
+    fn run_partitioned(&self) -> Result<ExitCode> {
+        let mut cases = target_scenes(self.max_soup)?;
         if self.max_soup >= 10_000_000 {
             cases.push(generate::soup(10_000_000, 1));
         }
