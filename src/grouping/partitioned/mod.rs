@@ -67,6 +67,9 @@ pub struct Chunking {
     pub delta: u32,
     /// f(n) = ⌈c·n^(1/2 − ε)⌉ with c = δ^(1/2 + ε)/2.
     pub epsilon: f64,
+    /// A node of n of the N primitives keeps at least ⌈top·n/N⌉ bodies, so the root's
+    /// subproblem (the exact schedule's step) starts from about `top` bodies; 0 = AAC's f alone.
+    pub top: u32,
 }
 
 impl Chunking {
@@ -76,6 +79,7 @@ impl Chunking {
     pub const DEFAULT: Chunking = Chunking {
         delta: 4,
         epsilon: 0.2,
+        top: 0,
     };
 
     /// The bodies a node of `n` primitives leaves for the level above: f(n), at least 1.
@@ -101,6 +105,15 @@ pub(super) struct Body {
     id: u32,
     aabb: Aabb,
     d: f64,
+}
+
+/// What a subproblem leaves: its bodies and, when a brute-force subproblem made them for a
+/// brute-force parent, the Cost (as `order_bits`) and first eligible round of each pair of
+/// them (`p < q`, row by row), so that the parent does not evaluate them again.
+#[derive(Debug, Default)]
+pub(super) struct Left {
+    bodies: Vec<Body>,
+    pairs: Vec<(u64, u32)>,
 }
 
 /// What a merge event needs beyond the tree.
@@ -297,7 +310,7 @@ pub fn group_with<O: Observer>(
         info: listens.then_some(&mut info[..]),
         stats: SubStats::default(),
     };
-    let (result, sub) = exec.node(nodes.len() as u32 - 1, (leaf_aabb, leaf_d), out);
+    let (result, sub) = exec.node(nodes.len() as u32 - 1, (leaf_aabb, leaf_d), out, false);
     // Events, in post-order, up to the first unfinished subproblem.
     let mut emitted = 0u32;
     let mut part = 0u32;
@@ -396,15 +409,17 @@ struct Exec<'a> {
 
 impl Exec<'_> {
     /// Groups node `k`'s subtree into `out` (its merges, in post-order); returns the bodies it
-    /// leaves (`None` when the budget stopped it) and its counters.
+    /// leaves (`None` when the budget stopped it), with their pairs when `export`, and its
+    /// counters.
     fn node(
         &self,
         k: u32,
         leaves: (&[Aabb], &[f64]),
         out: Out<'_>,
-    ) -> (Option<Vec<Body>>, SubStats) {
+        export: bool,
+    ) -> (Option<Left>, SubStats) {
         let node = self.nodes[k as usize];
-        let (bodies, mut own, mut stats) = match node.kids {
+        let (parts, mut own, mut stats) = match node.kids {
             None => {
                 let bodies: Vec<Body> = self.codes[node.lo as usize..node.hi as usize]
                     .iter()
@@ -414,7 +429,11 @@ impl Exec<'_> {
                         d: leaves.1[id as usize],
                     })
                     .collect();
-                (bodies, out, SubStats::default())
+                let part = Left {
+                    bodies,
+                    pairs: Vec::new(),
+                };
+                ([part, Left::default()], out, SubStats::default())
             }
             Some((l, r)) => {
                 let (ln, rn) = (self.nodes[l as usize], self.nodes[r as usize]);
@@ -422,28 +441,42 @@ impl Exec<'_> {
                 let rm = (rn.hi - rn.lo - rn.keep) as usize;
                 let (lout, rest) = out.split(lm);
                 let (rout, own) = rest.split(rm);
+                // The children's pairs serve this node's brute-force step.
+                let want = node.inputs as usize <= small::SMALL && node.inputs > node.keep;
                 let ((lb, ls), (rb, rs)) = if node.hi - node.lo >= GRAIN {
-                    rayon::join(|| self.node(l, leaves, lout), || self.node(r, leaves, rout))
+                    rayon::join(
+                        || self.node(l, leaves, lout, want),
+                        || self.node(r, leaves, rout, want),
+                    )
                 } else {
-                    (self.node(l, leaves, lout), self.node(r, leaves, rout))
+                    (
+                        self.node(l, leaves, lout, want),
+                        self.node(r, leaves, rout, want),
+                    )
                 };
                 let mut stats = ls;
                 stats.add(&rs);
-                let (Some(mut lb), Some(rb)) = (lb, rb) else {
+                let (Some(lb), Some(rb)) = (lb, rb) else {
                     return (None, stats);
                 };
-                lb.extend(rb);
-                (lb, own, stats)
+                ([lb, rb], own, stats)
             }
         };
         if self.ctx.exceeded() {
             return (None, stats);
         }
         let keep = node.keep as usize;
-        let left = if bodies.len() <= small::SMALL {
-            Some(small::combine(self.ctx, bodies, keep, &mut own))
+        let m = parts[0].bodies.len() + parts[1].bodies.len();
+        let left = if m <= small::SMALL {
+            Some(small::combine(self.ctx, parts, keep, &mut own, export))
         } else {
-            big::combine(self.ctx, bodies, keep, &mut own)
+            let [a, b] = parts;
+            let mut bodies = a.bodies;
+            bodies.extend_from_slice(&b.bodies);
+            big::combine(self.ctx, bodies, keep, &mut own).map(|bodies| Left {
+                bodies,
+                pairs: Vec::new(),
+            })
         };
         self.ctx
             .pairs

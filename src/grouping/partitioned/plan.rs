@@ -23,11 +23,46 @@ pub(super) struct Node {
     pub(super) own_step: u32,
 }
 
+/// Below this many primitives f(n) comes from a table (most nodes are small).
+const TABLED: usize = 4096;
+
+/// What a node may keep: AAC's reduction function f (from a table for small arguments), and at
+/// least ⌈top·n/N⌉ for a node of n primitives.
+struct Keep {
+    chunking: Chunking,
+    small: Vec<u32>,
+    n: u64,
+}
+
+impl Keep {
+    fn new(chunking: &Chunking, n: usize) -> Keep {
+        let small = (0..TABLED.min(n + 1))
+            .map(|k| chunking.keep(k as u32))
+            .collect();
+        Keep {
+            chunking: *chunking,
+            small,
+            n: n as u64,
+        }
+    }
+
+    /// max(f(`f_of`), ⌈top·`size`/N⌉).
+    #[inline]
+    fn at(&self, f_of: u32, size: u32) -> u32 {
+        let f = match self.small.get(f_of as usize) {
+            Some(&f) => f,
+            None => self.chunking.keep(f_of),
+        };
+        let share = (u64::from(self.chunking.top) * u64::from(size)).div_ceil(self.n.max(1));
+        f.max(share.min(u64::from(u32::MAX)) as u32)
+    }
+}
+
 /// The split of `codes` (sorted) into chunks, nodes in post-order.
 pub(super) fn plan(codes: &[(u64, u32)], chunking: &Chunking) -> Vec<Node> {
     fn build(
         codes: &[(u64, u32)],
-        ch: &Chunking,
+        keep: &Keep,
         lo: u32,
         hi: u32,
         level: u32,
@@ -36,6 +71,7 @@ pub(super) fn plan(codes: &[(u64, u32)], chunking: &Chunking) -> Vec<Node> {
     ) -> u32 {
         let size = hi - lo;
         let top = level == 0;
+        let ch = &keep.chunking;
         let node = if size < ch.delta.max(2) {
             Node {
                 lo,
@@ -43,7 +79,11 @@ pub(super) fn plan(codes: &[(u64, u32)], chunking: &Chunking) -> Vec<Node> {
                 kids: None,
                 level,
                 inputs: size,
-                keep: if top { 1 } else { size.min(ch.keep(ch.delta)) },
+                keep: if top {
+                    1
+                } else {
+                    size.min(keep.at(ch.delta, size))
+                },
                 own_step: first_step,
             }
         } else {
@@ -55,10 +95,10 @@ pub(super) fn plan(codes: &[(u64, u32)], chunking: &Chunking) -> Vec<Node> {
                 let part = &codes[lo as usize..hi as usize];
                 lo + part.partition_point(|c| c.0 >> bit & 1 == 0) as u32
             };
-            let l = build(codes, ch, lo, mid, level + 1, first_step, nodes);
+            let l = build(codes, keep, lo, mid, level + 1, first_step, nodes);
             let kl = nodes[l as usize].keep;
             let r_first = first_step + (mid - lo - kl);
-            let r = build(codes, ch, mid, hi, level + 1, r_first, nodes);
+            let r = build(codes, keep, mid, hi, level + 1, r_first, nodes);
             let kr = nodes[r as usize].keep;
             let inputs = kl + kr;
             Node {
@@ -67,15 +107,20 @@ pub(super) fn plan(codes: &[(u64, u32)], chunking: &Chunking) -> Vec<Node> {
                 kids: Some((l, r)),
                 level,
                 inputs,
-                keep: if top { 1 } else { inputs.min(ch.keep(size)) },
+                keep: if top {
+                    1
+                } else {
+                    inputs.min(keep.at(size, size))
+                },
                 own_step: r_first + (hi - mid - kr),
             }
         };
         nodes.push(node);
         nodes.len() as u32 - 1
     }
-    let mut nodes = Vec::new();
-    build(codes, chunking, 0, codes.len() as u32, 0, 0, &mut nodes);
+    let mut nodes = Vec::with_capacity(codes.len() / 2 + 1);
+    let keep = Keep::new(chunking, codes.len());
+    build(codes, &keep, 0, codes.len() as u32, 0, 0, &mut nodes);
     nodes
 }
 
