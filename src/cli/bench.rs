@@ -54,7 +54,8 @@ pub struct BenchCmd {
     #[arg(long)]
     record: bool,
     /// Instead: only the targets' partitioned-schedule table (exact and partitioned grouping
-    /// and obvhs PLOC on 1 and 2 threads, quality, peak memory) on the targets scenes.
+    /// and obvhs PLOC on 1 and 2 threads, quality, peak memory) on the SCENEs, or without
+    /// scenes on the targets scenes (and a 10^7 soup with --max-soup 10000000).
     #[arg(long, conflicts_with = "record")]
     partitioned: bool,
 }
@@ -238,8 +239,17 @@ impl BenchCmd {
         Ok(ExitCode::SUCCESS)
     }
 
-    /// The partitioned schedule's table alone.
+    /// The partitioned schedule's table alone, on the given scenes or the targets scenes.
     fn run_partitioned(&self) -> Result<ExitCode> {
+        if !self.scenes.is_empty() {
+            let cases = self
+                .scenes
+                .iter()
+                .map(|s| load_spec(s))
+                .collect::<Result<Vec<_>>>()?;
+            super::bench_partitioned::print_table(&cases, self.repeat)?;
+            return Ok(ExitCode::SUCCESS);
+        }
         let mut cases = target_scenes(self.max_soup)?;
         if self.max_soup >= 10_000_000 {
             cases.push(generate::soup(10_000_000, 1));

@@ -38,7 +38,7 @@ pub struct Row {
     pub n: usize,
     /// The exact schedule (none above [`EXACT_MAX_N`]); quality on 1 thread only.
     pub exact: [Option<Case>; 2],
-    /// The partitioned schedule; quality on 1 thread only.
+    /// The partitioned schedule; quality on 1 thread only, up to [`EXACT_MAX_N`].
     pub partitioned: [Case; 2],
     /// obvhs PLOC (its `parallel` build); no quality.
     pub ploc: [Case; 2],
@@ -135,7 +135,8 @@ pub fn row(scene: &Scene, repeat: u32) -> Result<Row> {
         scene: scene.name.clone(),
         n,
         exact,
-        partitioned: each(Method::GroupingPartitioned, true)?,
+        // Quality only where the exact tree is there to compare with.
+        partitioned: each(Method::GroupingPartitioned, n <= EXACT_MAX_N)?,
         ploc: each(Method::ObvhsPloc, false)?,
     })
 }
