@@ -234,7 +234,7 @@ fn run(
     // Each part's own pairs (copied when it brings them), then the pairs across the parts.
     for (lo, hi, pairs) in [(0, ka, &a.pairs), (ka, m, &b.pairs)] {
         let k = hi - lo;
-        let mut given = (pairs.len() == k * (k.max(1) - 1) / 2).then(|| pairs.iter());
+        let mut given = (pairs.len() == k * (k.max(1) - 1) / 2).then_some(pairs.iter());
         for i in lo..hi {
             for j in i + 1..hi {
                 let (c, r) = match &mut given {
