@@ -57,48 +57,12 @@ use super::subset_tree::SubsetTree;
 use super::{Budget, Grouping, PSet, ResolvedParams, Stats, StopReason, Stopped};
 use crate::geom::Aabb;
 use crate::scene::Scene;
+pub use plan::Chunking;
 use plan::{Node, morton_order, plan};
 use rayon::prelude::*;
 use small::Limits;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-
-/// The split's parameters: chunk size δ and the reduction function's ε (AAC §3).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Chunking {
-    /// Ranges of fewer primitives than this are chunks.
-    pub delta: u32,
-    /// f(n) = ⌈c·n^(1/2 − ε)⌉ with c = δ^(1/2 + ε)/2.
-    pub epsilon: f64,
-    /// A node of n of the N primitives keeps at least ⌈top·n/N⌉ bodies, so the root's
-    /// subproblem (the exact schedule's step) starts from about `top` bodies; 0 = AAC's f alone.
-    pub top: u32,
-}
-
-impl Chunking {
-    /// AAC's fast setting, δ = 4, ε = 0.2, with a root step of about 4,096 bodies: on the
-    /// bench scenes (README) the root share brought the trees' SAH and node tests per query
-    /// to within 1 % of the exact schedule's on average (worst 6 %, against 4 % and 13 %
-    /// without it); scenes of at most 4,096 primitives get the exact schedule's tree.
-    pub const DEFAULT: Chunking = Chunking {
-        delta: 4,
-        epsilon: 0.2,
-        top: 4096,
-    };
-
-    /// The bodies a node of `n` primitives leaves for the level above: f(n), at least 1.
-    pub fn keep(&self, n: u32) -> u32 {
-        let d = self.delta as f64;
-        let c = d.powf(0.5 + self.epsilon) / 2.0;
-        ((c * (n as f64).powf(0.5 - self.epsilon)).ceil() as u32).max(1)
-    }
-}
-
-impl Default for Chunking {
-    fn default() -> Self {
-        Chunking::DEFAULT
-    }
-}
 
 /// Halves of at least this many primitives are grouped in parallel.
 const GRAIN: u32 = 2048;

@@ -8,7 +8,9 @@
 //! partner was one of the children search their row again. When no pair is eligible, the run
 //! moves to the first round in which one is (the rounds in between would merge nothing). Pairs
 //! are ordered by (Cost, smaller tie tag, larger tie tag) as in MPairs, so the merges are those
-//! of the exact schedule run on the same bodies with the same limits.
+//! of the exact schedule run on the same bodies with the same limits. A half of the split that
+//! was solved here passes its bodies' pairs up with them (`Left`), so its parent evaluates only
+//! the pairs across the two halves (a pair's Cost and round depend on its two bodies alone).
 
 use super::{Body, Ctx, Info, Left, Out, SubStats};
 use crate::grouping::cluster::{fill_balance, tie_tag};
