@@ -55,6 +55,11 @@ pub struct BenchCmd {
     /// 12,144-polygon scenes and a 10^5-triangle soup.
     #[arg(long)]
     record: bool,
+    /// Instead: only the targets' partitioned-schedule table (exact and partitioned grouping
+    /// and obvhs PLOC on 1 and 2 threads, quality, peak memory) on the SCENEs, or without
+    /// scenes on the targets scenes (and a 10^7 soup with --max-soup 10000000).
+    #[arg(long, conflicts_with = "record")]
+    partitioned: bool,
 }
 
 /// Loads a KIND[:COUNT] or OBJ scene spec, printing loader warnings to stderr.
@@ -73,6 +78,9 @@ impl BenchCmd {
         eprintln!("threads: {threads} (rayon pool)");
         if self.record {
             return self.run_record();
+        }
+        if self.partitioned {
+            return self.run_partitioned();
         }
         if self.scenes.is_empty() {
             return self.run_targets();
@@ -130,6 +138,24 @@ impl BenchCmd {
         if self.max_soup >= 10_000_000 {
             cases.push(generate::soup(10_000_000, 1));
         }
+        super::bench_partitioned::print_table(&cases, self.repeat)?;
+        Ok(ExitCode::SUCCESS)
+    }
+
+    /// The partitioned schedule's table alone, on the given scenes or the targets scenes.
+    fn run_partitioned(&self) -> Result<ExitCode> {
+        let cases = if self.scenes.is_empty() {
+            let mut cases = target_scenes(self.max_soup)?;
+            if self.max_soup >= 10_000_000 {
+                cases.push(generate::soup(10_000_000, 1));
+            }
+            cases
+        } else {
+            self.scenes
+                .iter()
+                .map(|s| load_spec(s))
+                .collect::<Result<Vec<_>>>()?
+        };
         super::bench_partitioned::print_table(&cases, self.repeat)?;
         Ok(ExitCode::SUCCESS)
     }

@@ -1,6 +1,9 @@
 //! The measurements of `wraptree bench` besides the builder × wrapper comparison
 //! ([`compare`](super::compare)): the targets table against obvhs PLOC and parry Binned
-//! ([`target_row`]) and what recording costs ([`record_cost`]).
+//! ([`target_row`]), the partitioned schedule's table ([`partitioned`]) and what recording
+//! costs ([`record_cost`]).
+
+pub mod partitioned;
 
 use crate::grouping::{self, Params};
 use crate::peers::{self, Method};

@@ -11,7 +11,9 @@
 //! 3. Bottom-up, each chunk groups its primitives until at most f(δ) bodies remain, and each
 //!    inner node of the split groups the bodies its two halves left until at most f(n) remain,
 //!    n its number of primitives, with AAC's reduction function f(n) = ⌈c·n^(1/2 − ε)⌉,
-//!    c = δ^(1/2 + ε)/2 (so f(δ) = δ/2). The root groups what is left into one body.
+//!    c = δ^(1/2 + ε)/2 (so f(δ) = δ/2) — but never fewer than ⌈top·n/N⌉ bodies
+//!    ([`Chunking::top`]), so that the root, which groups what is left into one body, starts
+//!    from about `top` bodies (nodes above that size pass their halves' bodies up unmerged).
 //! 4. Each of those subproblems is the paper's step: Cost = diameter^A × (B·Fill + C·Balance),
 //!    the AABB p-set, DLimit/GLimit eligibility from DLimit0/GLimit0 with doubling, the
 //!    cheapest eligible pair first, ties by the pair's tie tags of the run's (global) ids. Up to
@@ -22,7 +24,7 @@
 //! subproblem's result depends only on its bodies, and merge steps are numbered in the split's
 //! post-order (left half, right half, then the node's own merges), fixed before any grouping
 //! starts, so the tree is identical for any number of threads. A scene of fewer than δ
-//! primitives is one subproblem: the exact schedule's tree.
+//! primitives, or of at most `top`, is one subproblem: the exact schedule's tree.
 //!
 //! Events: after the grouping, each subproblem that merges anything is announced, in that
 //! post-order, by [`Event::Part`] (`Chunk { level, keep }`, the root `Top`), followed by its
@@ -55,42 +57,12 @@ use super::subset_tree::SubsetTree;
 use super::{Budget, Grouping, PSet, ResolvedParams, Stats, StopReason, Stopped};
 use crate::geom::Aabb;
 use crate::scene::Scene;
+pub use plan::Chunking;
 use plan::{Node, morton_order, plan};
+use rayon::prelude::*;
 use small::Limits;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-
-/// The split's parameters: chunk size δ and the reduction function's ε (AAC §3).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Chunking {
-    /// Ranges of fewer primitives than this are chunks.
-    pub delta: u32,
-    /// f(n) = ⌈c·n^(1/2 − ε)⌉ with c = δ^(1/2 + ε)/2.
-    pub epsilon: f64,
-}
-
-impl Chunking {
-    /// AAC's fast setting, δ = 4, ε = 0.2: on random soups (10^4–10^5) its trees had lower SAH
-    /// and fewer node tests per query than both the exact schedule's and AAC's high-quality
-    /// setting (δ = 20, ε = 0.1), with 3.7× fewer instructions than the latter (README).
-    pub const DEFAULT: Chunking = Chunking {
-        delta: 4,
-        epsilon: 0.2,
-    };
-
-    /// The bodies a node of `n` primitives leaves for the level above: f(n), at least 1.
-    pub fn keep(&self, n: u32) -> u32 {
-        let d = self.delta as f64;
-        let c = d.powf(0.5 + self.epsilon) / 2.0;
-        ((c * (n as f64).powf(0.5 - self.epsilon)).ceil() as u32).max(1)
-    }
-}
-
-impl Default for Chunking {
-    fn default() -> Self {
-        Chunking::DEFAULT
-    }
-}
 
 /// Halves of at least this many primitives are grouped in parallel.
 const GRAIN: u32 = 2048;
@@ -101,6 +73,15 @@ pub(super) struct Body {
     id: u32,
     aabb: Aabb,
     d: f64,
+}
+
+/// What a subproblem leaves: its bodies and, when a brute-force subproblem made them for a
+/// brute-force parent, the Cost (as `order_bits`) and first eligible round of each pair of
+/// them (`p < q`, row by row), so that the parent does not evaluate them again.
+#[derive(Debug, Default)]
+pub(super) struct Left {
+    bodies: Vec<Body>,
+    pairs: Vec<(u64, u32)>,
 }
 
 /// What a merge event needs beyond the tree.
@@ -257,8 +238,8 @@ pub fn group_with<O: Observer>(
         return cluster::run(scene, params, observer, budget);
     }
     let n = scene.len();
-    let mut aabb: Vec<Aabb> = (0..n).map(|i| scene.prim_aabb(i)).collect();
-    let mut diameter: Vec<f64> = aabb.iter().map(Aabb::diameter).collect();
+    let mut aabb: Vec<Aabb> = (0..n).into_par_iter().map(|i| scene.prim_aabb(i)).collect();
+    let mut diameter: Vec<f64> = aabb.par_iter().map(Aabb::diameter).collect();
     let codes = morton_order(&aabb);
     let nodes = plan(&codes, chunking);
     let ctx = Ctx {
@@ -297,7 +278,7 @@ pub fn group_with<O: Observer>(
         info: listens.then_some(&mut info[..]),
         stats: SubStats::default(),
     };
-    let (result, sub) = exec.node(nodes.len() as u32 - 1, (leaf_aabb, leaf_d), out);
+    let (result, sub) = exec.node(nodes.len() as u32 - 1, (leaf_aabb, leaf_d), out, false);
     // Events, in post-order, up to the first unfinished subproblem.
     let mut emitted = 0u32;
     let mut part = 0u32;
@@ -396,15 +377,17 @@ struct Exec<'a> {
 
 impl Exec<'_> {
     /// Groups node `k`'s subtree into `out` (its merges, in post-order); returns the bodies it
-    /// leaves (`None` when the budget stopped it) and its counters.
+    /// leaves (`None` when the budget stopped it), with their pairs when `export`, and its
+    /// counters.
     fn node(
         &self,
         k: u32,
         leaves: (&[Aabb], &[f64]),
         out: Out<'_>,
-    ) -> (Option<Vec<Body>>, SubStats) {
+        export: bool,
+    ) -> (Option<Left>, SubStats) {
         let node = self.nodes[k as usize];
-        let (bodies, mut own, mut stats) = match node.kids {
+        let (parts, mut own, mut stats) = match node.kids {
             None => {
                 let bodies: Vec<Body> = self.codes[node.lo as usize..node.hi as usize]
                     .iter()
@@ -414,7 +397,11 @@ impl Exec<'_> {
                         d: leaves.1[id as usize],
                     })
                     .collect();
-                (bodies, out, SubStats::default())
+                let part = Left {
+                    bodies,
+                    pairs: Vec::new(),
+                };
+                ([part, Left::default()], out, SubStats::default())
             }
             Some((l, r)) => {
                 let (ln, rn) = (self.nodes[l as usize], self.nodes[r as usize]);
@@ -422,32 +409,49 @@ impl Exec<'_> {
                 let rm = (rn.hi - rn.lo - rn.keep) as usize;
                 let (lout, rest) = out.split(lm);
                 let (rout, own) = rest.split(rm);
+                // The children's pairs serve this node's brute-force step.
+                let want = node.inputs as usize <= small::SMALL && node.inputs > node.keep;
                 let ((lb, ls), (rb, rs)) = if node.hi - node.lo >= GRAIN {
-                    rayon::join(|| self.node(l, leaves, lout), || self.node(r, leaves, rout))
+                    rayon::join(
+                        || self.node(l, leaves, lout, want),
+                        || self.node(r, leaves, rout, want),
+                    )
                 } else {
-                    (self.node(l, leaves, lout), self.node(r, leaves, rout))
+                    (
+                        self.node(l, leaves, lout, want),
+                        self.node(r, leaves, rout, want),
+                    )
                 };
                 let mut stats = ls;
                 stats.add(&rs);
-                let (Some(mut lb), Some(rb)) = (lb, rb) else {
+                let (Some(lb), Some(rb)) = (lb, rb) else {
                     return (None, stats);
                 };
-                lb.extend(rb);
-                (lb, own, stats)
+                ([lb, rb], own, stats)
             }
         };
         if self.ctx.exceeded() {
             return (None, stats);
         }
         let keep = node.keep as usize;
-        let left = if bodies.len() <= small::SMALL {
-            Some(small::combine(self.ctx, bodies, keep, &mut own))
+        let m = parts[0].bodies.len() + parts[1].bodies.len();
+        let left = if m <= small::SMALL {
+            Some(small::combine(self.ctx, parts, keep, &mut own, export))
         } else {
-            big::combine(self.ctx, bodies, keep, &mut own)
+            let [a, b] = parts;
+            let mut bodies = a.bodies;
+            bodies.extend_from_slice(&b.bodies);
+            big::combine(self.ctx, bodies, keep, &mut own).map(|bodies| Left {
+                bodies,
+                pairs: Vec::new(),
+            })
         };
-        self.ctx
-            .pairs
-            .fetch_add(own.stats.eligible_pairs, Ordering::Relaxed);
+        // Only a budget reads the shared count (an atomic add per node costs on 2 threads).
+        if !self.ctx.budget.is_unlimited() {
+            self.ctx
+                .pairs
+                .fetch_add(own.stats.eligible_pairs, Ordering::Relaxed);
+        }
         stats.add(&own.stats);
         if left.is_some() {
             self.done[k as usize].store(true, Ordering::Relaxed);

@@ -8,9 +8,11 @@
 //! partner was one of the children search their row again. When no pair is eligible, the run
 //! moves to the first round in which one is (the rounds in between would merge nothing). Pairs
 //! are ordered by (Cost, smaller tie tag, larger tie tag) as in MPairs, so the merges are those
-//! of the exact schedule run on the same bodies with the same limits.
+//! of the exact schedule run on the same bodies with the same limits. A half of the split that
+//! was solved here passes its bodies' pairs up with them (`Left`), so its parent evaluates only
+//! the pairs across the two halves (a pair's Cost and round depend on its two bodies alone).
 
-use super::{Body, Ctx, Info, Out, SubStats};
+use super::{Body, Ctx, Info, Left, Out, SubStats};
 use crate::grouping::cluster::{fill_balance, tie_tag};
 use crate::grouping::mpairs::order_bits;
 use std::cell::RefCell;
@@ -164,25 +166,57 @@ thread_local! {
     }) };
 }
 
-/// Groups `bodies` (at most [`SMALL`], in any order) until `keep` remain, writing merge `i` to
-/// `out` at index `i` with new id `first_new + i`; returns the bodies left, in no particular
-/// order (the merges do not depend on the order of `bodies`: every choice is by Cost and tie
-/// tags).
-pub(super) fn combine(ctx: &Ctx, bodies: Vec<Body>, keep: usize, out: &mut Out<'_>) -> Vec<Body> {
-    if bodies.len() <= keep {
-        return bodies;
+/// The Cost (as [`order_bits`]) and first eligible round of the pair `a`, `b`, whose bodies
+/// obey DLimit from rounds `ra` and `rb` on.
+#[inline(always)]
+fn eval(ctx: &Ctx, a: &Body, b: &Body, ra: u32, rb: u32) -> (u64, u32) {
+    let d = a.aabb.merge(&b.aabb).diameter();
+    let (fill, balance) = fill_balance(d, a.d, b.d);
+    let round = ra.max(rb).max(ctx.gl.first(a.aabb.gap_linf(&b.aabb)));
+    (order_bits(ctx.params.weights.cost(d, fill, balance)), round)
+}
+
+/// Groups the bodies of `parts` (at most [`SMALL`] together) until `keep` remain, writing merge
+/// `i` to `out` at index `i` with new id `first_new + i`; returns the bodies left, with their
+/// pairs when `export` (the merges do not depend on the order of the bodies: every choice is
+/// by Cost and tie tags). A part's pairs, when given, are used instead of evaluating them again.
+pub(super) fn combine(
+    ctx: &Ctx,
+    parts: [Left; 2],
+    keep: usize,
+    out: &mut Out<'_>,
+    export: bool,
+) -> Left {
+    let [a, b] = parts;
+    if a.bodies.len() + b.bodies.len() <= keep {
+        let mut bodies = a.bodies;
+        bodies.extend_from_slice(&b.bodies);
+        return Left {
+            bodies,
+            pairs: Vec::new(),
+        };
     }
-    TABLE.with(|t| run(ctx, bodies, keep, out, &mut t.borrow_mut()))
+    TABLE.with(|t| run(ctx, [a, b], keep, out, export, &mut t.borrow_mut()))
 }
 
 /// [`combine`] with the thread's table.
-fn run(ctx: &Ctx, bodies: Vec<Body>, keep: usize, out: &mut Out<'_>, t: &mut Table) -> Vec<Body> {
-    let m = bodies.len();
+fn run(
+    ctx: &Ctx,
+    parts: [Left; 2],
+    keep: usize,
+    out: &mut Out<'_>,
+    export: bool,
+    t: &mut Table,
+) -> Left {
+    let [a, b] = parts;
+    let ka = a.bodies.len();
+    let mut body = a.bodies;
+    body.extend_from_slice(&b.bodies);
+    let m = body.len();
     debug_assert!(m <= SMALL && keep >= 1);
     let mut st = SubStats::default();
     let w = ctx.params.weights;
     let seed = ctx.params.seed;
-    let mut body = bodies;
     t.m = m;
     if t.cost.len() < m * m {
         t.cost.resize(m * m, 0);
@@ -199,20 +233,32 @@ fn run(ctx: &Ctx, bodies: Vec<Body>, keep: usize, out: &mut Out<'_>, t: &mut Tab
     // Not scanned yet: every row is scanned at the first round start.
     t.next.clear();
     t.next.resize(m, 0);
-    let eval = |a: &Body, b: &Body, ra: u32, rb: u32| -> (u64, u32) {
-        let d = a.aabb.merge(&b.aabb).diameter();
-        let (fill, balance) = fill_balance(d, a.d, b.d);
-        let round = ra.max(rb).max(ctx.gl.first(a.aabb.gap_linf(&b.aabb)));
-        (order_bits(w.cost(d, fill, balance)), round)
-    };
-    for i in 0..m {
-        for j in i + 1..m {
-            let (c, r) = eval(&body[i], &body[j], t.rd[i], t.rd[j]);
+    // Each part's own pairs (copied when it brings them), then the pairs across the parts.
+    for (lo, hi, pairs) in [(0, ka, &a.pairs), (ka, m, &b.pairs)] {
+        let k = hi - lo;
+        let mut given = (pairs.len() == k * (k.max(1) - 1) / 2).then_some(pairs.iter());
+        for i in lo..hi {
+            for j in i + 1..hi {
+                let (c, r) = match &mut given {
+                    Some(it) => *it.next().expect("k(k-1)/2 pairs"),
+                    None => {
+                        st.candidates += 1;
+                        eval(ctx, &body[i], &body[j], t.rd[i], t.rd[j])
+                    }
+                };
+                (t.cost[i * m + j], t.round[i * m + j]) = (c, r);
+                (t.cost[j * m + i], t.round[j * m + i]) = (c, r);
+            }
+        }
+    }
+    for i in 0..ka {
+        for j in ka..m {
+            let (c, r) = eval(ctx, &body[i], &body[j], t.rd[i], t.rd[j]);
             (t.cost[i * m + j], t.round[i * m + j]) = (c, r);
             (t.cost[j * m + i], t.round[j * m + i]) = (c, r);
         }
     }
-    st.candidates += (m * (m - 1) / 2) as u64;
+    st.candidates += (ka * (m - ka)) as u64;
     let mut round = 0u32;
     let mut made = 0usize;
     let mut fresh = true;
@@ -256,7 +302,7 @@ fn run(ctx: &Ctx, bodies: Vec<Body>, keep: usize, out: &mut Out<'_>, t: &mut Tab
         t.live.retain(|&k| k != j);
         for &k in &t.live {
             if k != i {
-                let (c, r) = eval(&body[i], &body[k], t.rd[i], t.rd[k]);
+                let (c, r) = eval(ctx, &body[i], &body[k], t.rd[i], t.rd[k]);
                 (t.cost[i * m + k], t.round[i * m + k]) = (c, r);
                 (t.cost[k * m + i], t.round[k * m + i]) = (c, r);
             }
@@ -305,14 +351,27 @@ fn run(ctx: &Ctx, bodies: Vec<Body>, keep: usize, out: &mut Out<'_>, t: &mut Tab
     }
     st.rounds = round + 1;
     out.stats.add(&st);
-    // Keep the live slots' bodies, in slot order.
-    let mut k = 0;
-    for i in 0..m {
-        if t.live.contains(&i) {
-            body[k] = body[i];
-            k += 1;
+    // Keep the live slots' bodies, in slot order (`live` is increasing), and their pairs.
+    let pairs = if export {
+        let l = &t.live;
+        let mut p = Vec::with_capacity(l.len() * (l.len() - 1) / 2);
+        for (x, &i) in l.iter().enumerate() {
+            p.extend(
+                l[x + 1..]
+                    .iter()
+                    .map(|&j| (t.cost[i * m + j], t.round[i * m + j])),
+            );
         }
+        p
+    } else {
+        Vec::new()
+    };
+    for (k, &i) in t.live.iter().enumerate() {
+        body[k] = body[i];
     }
-    body.truncate(k);
-    body
+    body.truncate(t.live.len());
+    Left {
+        bodies: body,
+        pairs,
+    }
 }

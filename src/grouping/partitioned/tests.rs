@@ -1,6 +1,6 @@
 //! The brute-force subproblem against the voxel-hash one on the same bodies.
 
-use super::{Body, Ctx, Info, Out, SubStats, big, small};
+use super::{Body, Ctx, Info, Left, Out, SubStats, big, small};
 use crate::geom::Aabb;
 use crate::grouping::{Budget, Params, Weights};
 use crate::scene::generate;
@@ -11,10 +11,37 @@ use std::sync::atomic::{AtomicBool, AtomicU64};
 /// Children, Cost bits and round of each merge, and the ids of the bodies left.
 type Solved = (Vec<([u32; 2], u64, u32)>, Vec<u32>);
 
+/// A part of bodies without pairs.
+fn part(bodies: &[Body]) -> Left {
+    Left {
+        bodies: bodies.to_vec(),
+        pairs: Vec::new(),
+    }
+}
+
 /// Runs `combine` on `bodies` (ids from 0, new ids from `n`) and returns the merges and the
 /// bodies left.
 fn solve(ctx: &Ctx, bodies: &[Body], keep: usize, n: u32, brute: bool) -> Solved {
-    let m = bodies.len() - keep;
+    solve_parts(
+        ctx,
+        [part(bodies), Left::default()],
+        keep,
+        n,
+        brute.then_some(false),
+    )
+    .0
+}
+
+/// Runs `combine` on `parts` (brute force with `export`, or the voxel hash for `None`); returns
+/// the merges and bodies left, and what the brute force left.
+fn solve_parts(
+    ctx: &Ctx,
+    parts: [Left; 2],
+    keep: usize,
+    n: u32,
+    export: Option<bool>,
+) -> (Solved, Left) {
+    let m = parts[0].bodies.len() + parts[1].bodies.len() - keep;
     let mut children = vec![[0u32; 2]; m];
     let mut aabb = vec![Aabb::EMPTY; m];
     let mut diameter = vec![0.0; m];
@@ -27,17 +54,20 @@ fn solve(ctx: &Ctx, bodies: &[Body], keep: usize, n: u32, brute: bool) -> Solved
         info: Some(&mut info),
         stats: SubStats::default(),
     };
-    let left = if brute {
-        small::combine(ctx, bodies.to_vec(), keep, &mut out)
-    } else {
-        big::combine(ctx, bodies.to_vec(), keep, &mut out).unwrap()
+    let left = match export {
+        Some(e) => small::combine(ctx, parts, keep, &mut out, e),
+        None => {
+            let [a, b] = parts;
+            let bodies = [a.bodies, b.bodies].concat();
+            part(&big::combine(ctx, bodies, keep, &mut out).unwrap())
+        }
     };
     let merges = (0..m)
         .map(|i| (children[i], info[i].cost.to_bits(), info[i].round))
         .collect();
-    let mut ids: Vec<u32> = left.iter().map(|b| b.id).collect();
+    let mut ids: Vec<u32> = left.bodies.iter().map(|b| b.id).collect();
     ids.sort_unstable();
-    (merges, ids)
+    ((merges, ids), left)
 }
 
 #[test]
@@ -88,6 +118,23 @@ fn brute_force_equals_the_voxel_hash_run() {
                 let a = solve(&ctx, &bodies, keep, next, true);
                 let b = solve(&ctx, &bodies, keep, next, false);
                 assert_eq!(a, b, "soup {n} seed {seed} keep {keep} {weights:?}");
+            }
+            // The pairs two halves pass up give the merges of pairs evaluated again.
+            if n >= 6 {
+                let h = n / 2;
+                let half = |r: &[Body], keep, first| {
+                    solve_parts(&ctx, [part(r), Left::default()], keep, first, Some(true)).1
+                };
+                let (l0, l1) = (
+                    half(&bodies[..h], h - 1, 1000),
+                    half(&bodies[h..], n - h - 1, 2000),
+                );
+                assert!(!l0.pairs.is_empty() && !l1.pairs.is_empty());
+                let bare = [part(&l0.bodies), part(&l1.bodies)];
+                let keep = (n - 2) / 2;
+                let with = solve_parts(&ctx, [l0, l1], keep, 3000, Some(false)).0;
+                let without = solve_parts(&ctx, bare, keep, 3000, Some(false)).0;
+                assert_eq!(with, without, "soup {n} seed {seed} {weights:?}");
             }
         }
     }

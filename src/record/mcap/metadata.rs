@@ -54,9 +54,10 @@ pub const KEYS: &[&str] = &[
 /// announced.
 pub const STOP_KEYS: &[&str] = &["stop_reason", "stop_eligible_pairs"];
 
-/// Keys the `wraptree` record adds for the partitioned schedule: its chunk size δ and the
-/// reduction function's ε ([`Chunking`]); informative, as a build has one fixed chunking.
-pub const PARTITIONED_KEYS: &[&str] = &["chunk_delta", "chunk_epsilon"];
+/// Keys the `wraptree` record adds for the partitioned schedule: its chunk size δ, the
+/// reduction function's ε and the root's share `top` ([`Chunking`]); informative, as a build
+/// has one fixed chunking.
+pub const PARTITIONED_KEYS: &[&str] = &["chunk_delta", "chunk_epsilon", "chunk_top"];
 
 /// Keys the `wraptree` record adds when a cover is logged (`cover_budget` only for a cover
 /// asked for by budget).
@@ -179,6 +180,7 @@ pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String,
         let ch = Chunking::DEFAULT;
         put("chunk_delta", ch.delta.to_string());
         put("chunk_epsilon", ch.epsilon.to_string());
+        put("chunk_top", ch.top.to_string());
     }
     put("detail", value_name(&info.detail));
     put("scene", info.scene.name.clone());

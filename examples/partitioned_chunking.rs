@@ -1,0 +1,84 @@
+//! The partitioned schedule's chunking against the exact schedule's tree, on the targets
+//! scenes: SAH and node tests per query (AABB BVs, standard workload) of each chunking's tree
+//! over the exact tree's, and its grouping time on one thread. How the defaults were chosen.
+//!
+//! `cargo run --release --example partitioned_chunking [MAX_SOUP] [DELTA:EPSILON[:TOP] ...]`
+//! — default 100000 and 4:0.2 (the default chunking) and 20:0.1 (AAC's high-quality setting).
+
+use std::time::Instant;
+use wraptree::grouping::partitioned::{Chunking, group_with};
+use wraptree::grouping::{Budget, Params, SubsetTree, group};
+use wraptree::metrics::bench::target_scenes;
+use wraptree::metrics::{compare::query_values, sah};
+use wraptree::query::{self, Bv, Workload};
+
+fn parse(s: &str) -> anyhow::Result<Chunking> {
+    let v: Vec<&str> = s.split(':').collect();
+    let mut ch = Chunking::DEFAULT;
+    ch.delta = v[0].parse()?;
+    ch.epsilon = v.get(1).map_or(Ok(ch.epsilon), |e| e.parse())?;
+    ch.top = v.get(2).map_or(Ok(ch.top), |e| e.parse())?;
+    Ok(ch)
+}
+
+fn main() -> anyhow::Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let max_soup = args.first().map_or(Ok(100_000), |a| a.parse())?;
+    let mut chunkings = args
+        .iter()
+        .skip(1)
+        .map(|a| parse(a))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    if chunkings.is_empty() {
+        chunkings = vec![Chunking::DEFAULT, parse("20:0.1")?];
+    }
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    let budget = Budget::default();
+    print!("{:<18} {:>8} {:>9}", "scene", "N", "exact ms");
+    for ch in &chunkings {
+        let name = format!("{}:{}:{}", ch.delta, ch.epsilon, ch.top);
+        print!(" | {name:>17} {:>6} {:>6}", "SAH", "qry");
+    }
+    println!();
+    let mut sums = vec![(0.0, 0.0, 0.0, 0.0); chunkings.len()];
+    let scenes = target_scenes(max_soup)?;
+    for scene in &scenes {
+        let workload = Workload::standard(scene, 1);
+        let quality = |tree: &SubsetTree| {
+            let q = query::measure(tree, scene, Bv::Aabb, &workload);
+            (sah(tree), query_values(&q)[6])
+        };
+        let t = Instant::now();
+        let exact = pool.install(|| group(scene, &Params::default(), ()));
+        let te = t.elapsed().as_secs_f64();
+        let (se, qe) = quality(&exact.tree);
+        print!("{:<18} {:>8} {:>9.2}", scene.name, scene.len(), te * 1e3);
+        let params = Params::default().resolve(scene);
+        for (ch, sum) in chunkings.iter().zip(&mut sums) {
+            let t = Instant::now();
+            let g = pool
+                .install(|| group_with(scene, &params, ch, (), &budget))
+                .map_err(|s| anyhow::anyhow!("stopped: {:?}", s.reason))?;
+            let tp = t.elapsed().as_secs_f64();
+            let (sp, qp) = quality(&g.tree);
+            print!(" | {:>14.2} ms {:>6.3} {:>6.3}", tp * 1e3, sp / se, qp / qe);
+            sum.0 += tp / te;
+            sum.1 += sp / se;
+            sum.2 += qp / qe;
+            sum.3 = f64::max(sum.3, (sp / se).max(qp / qe));
+        }
+        println!();
+    }
+    let k = scenes.len() as f64;
+    print!("{:<18} {:>8} {:>9}", "mean (time/exact)", "", "");
+    for s in &sums {
+        print!(" | {:>17.3} {:>6.3} {:>6.3}", s.0 / k, s.1 / k, s.2 / k);
+    }
+    println!();
+    print!("{:<18} {:>8} {:>9}", "worst ratio", "", "");
+    for s in &sums {
+        print!(" | {:>17} {:>13.3}", "", s.3);
+    }
+    println!();
+    Ok(())
+}
