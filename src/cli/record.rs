@@ -55,7 +55,8 @@ pub struct RecordCmd {
     /// is half leaves or more; the .rrd always has every level).
     #[arg(long)]
     all_levels: bool,
-    /// Refine the finished tree (reinsertion, see the README) and record each move on the
+    /// Refine the finished tree (treelet restructuring, then reinsertion, see the README) and
+    /// record each step on the
     /// `refine` timeline / `/refine/step` topic; the levels are then the refined tree's.
     #[arg(long)]
     refine: bool,
@@ -65,6 +66,12 @@ pub struct RecordCmd {
     /// Fraction of the nodes searched in the first refinement pass, in (0, 1] (with --refine).
     #[arg(long, default_value_t = RefineParams::default().batch, requires = "refine")]
     refine_batch: f64,
+    /// Most leaves of a restructured treelet, 3 to 7 (with --refine).
+    #[arg(long, default_value_t = RefineParams::default().treelet, requires = "refine")]
+    refine_treelet: u32,
+    /// Treelet restructuring passes before the reinsertion passes (with --refine; 0 = none).
+    #[arg(long, default_value_t = RefineParams::default().treelet_passes, requires = "refine")]
+    refine_treelet_passes: u32,
 }
 
 /// Success for a finished grouping, else the stop's exit code (3 for a limit, 130 for
@@ -146,6 +153,12 @@ impl RecordCmd {
                 self.refine_batch
             );
         }
+        if !(3..=7).contains(&self.refine_treelet) {
+            bail!(
+                "--refine-treelet must be 3 to 7 leaves, got {}",
+                self.refine_treelet
+            );
+        }
         let loaded = self.scene.load()?;
         let params = self.group.params()?.resolve(&loaded.scene);
         let prefix = output_prefix(self.output.as_deref(), &loaded.source.file_name, "")?;
@@ -161,6 +174,8 @@ impl RecordCmd {
             refine: self.refine.then_some(RefineParams {
                 passes: self.refine_passes,
                 batch: self.refine_batch,
+                treelet: self.refine_treelet,
+                treelet_passes: self.refine_treelet_passes,
             }),
         };
         let progress = Progress::for_merges(loaded.scene.len() as u64);

@@ -88,8 +88,14 @@ impl ReplayCmd {
                 .with_context(|| format!("{name}: the merge events do not form a tree"))?;
             if let Some(r) = &rec.refine {
                 println!(
-                    "refined ({} passes at most, first batch {}): {} moves, SAH {:.6} -> {:.6}",
-                    r.params.passes, r.params.batch, r.steps, r.sah_before, r.sah_after
+                    "refined ({} treelet passes of {} leaves, {} reinsertion passes at most, first batch {}): {} steps, SAH {:.6} -> {:.6}",
+                    r.params.treelet_passes,
+                    r.params.treelet,
+                    r.params.passes,
+                    r.params.batch,
+                    r.steps,
+                    r.sah_before,
+                    r.sah_after
                 );
             }
             println!(

@@ -230,13 +230,17 @@ flat_message! {
 }
 
 flat_message! {
-    /// One kept move of the refinement (`record --refine`), on `/refine/step`: every field of
-    /// [`crate::refine::Step`].
+    /// One kept step of the refinement (`record --refine`), on `/refine/step`: every field of
+    /// [`crate::refine::Step`], its kind flattened.
     RefineStepEvent {
         /// 0-based step index.
         step: u32,
         /// Pass.
         pass: u32,
+        /// 0 a move, 1 a rebuilt treelet.
+        kind: u32,
+        /// The treelet's leaves (0 for a move).
+        treelet_leaves: u32,
         /// The moved subtree.
         node: u32,
         /// Its parent slot, moved with it.
@@ -276,12 +280,20 @@ flat_message! {
     }
 }
 
+use crate::refine::StepKind;
+
 impl From<&crate::refine::Step> for RefineStepEvent {
     fn from(s: &crate::refine::Step) -> Self {
         let (a, p) = (&s.aabb, &s.parent_aabb);
+        let (kind, treelet_leaves) = match s.kind {
+            StepKind::Move => (0, 0),
+            StepKind::Treelet { leaves } => (1, leaves),
+        };
         RefineStepEvent {
             step: s.step,
             pass: s.pass,
+            kind,
+            treelet_leaves,
             node: s.node,
             parent: s.parent,
             sibling: s.sibling,
@@ -313,6 +325,12 @@ impl From<&RefineStepEvent> for crate::refine::Step {
         crate::refine::Step {
             step: e.step,
             pass: e.pass,
+            kind: match e.kind {
+                0 => StepKind::Move,
+                _ => StepKind::Treelet {
+                    leaves: e.treelet_leaves,
+                },
+            },
             node: e.node,
             parent: e.parent,
             sibling: e.sibling,

@@ -14,7 +14,7 @@
 //! | `/grouping/merge` | `mergeevent.MergeEvent` | every merge: step, round, a, b, new, AABB, diameter, Fill, Balance, Cost, queue length, active | always |
 //! | `/grouping/part` | `partevent.PartEvent` | each part of the run (partitioned schedule's chunks and top, pre-grouping's components and copies): id, kind (0 chunk, 1 component, 2 copy, 3 top), bodies, first step, chunk level and keep, component index (or the copied one), copy rotation and translation; the merges up to the next part belong to it | runs with parts, from the first part on |
 //! | `/grouping/finish` | `finishevent.FinishEvent` | root, rounds, merges | always, once |
-//! | `/refine/step` | `refinestepevent.RefineStepEvent` | every kept move of the refinement: step, pass, moved node, its parent slot, old and new sibling, the moved subtree's and new parent's boxes, SAH before and after | `record --refine` |
+//! | `/refine/step` | `refinestepevent.RefineStepEvent` | every kept step of the refinement: step, pass, kind (0 move, 1 treelet) and treelet leaves, moved node (treelet root), its parent slot, old and new sibling, the moved subtree's and new parent's boxes, SAH before and after | `record --refine` |
 //! | `/grouping/active` | `foxglove.SceneUpdate` | entity `active`: one translucent green box per active body at each round start | `--detail merges` or `full` |
 //! | `/grouping/bodies` | `foxglove.SceneUpdate` | entity `merge`: the merged pair (red) and the new body (yellow) as boxes, per merge | `--detail full` (it repeats boxes the merge events already carry, and is the largest per-merge topic) |
 //! | `/grouping/dormant` | `dormantevent.DormantEvent` | round, body, diameter of each body going dormant | `--detail merges` or `full` |
