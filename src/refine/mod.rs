@@ -1,16 +1,19 @@
-//! Refinement of a finished Subset Tree (the grouping's or any peer's): subtrees are moved to
-//! where they lower the SAH ([`crate::metrics::sah`]) most, by insertion-based optimisation
-//! (Bittner, Hapala and Havran 2013) in the parallel form of Meister and Bittner 2018
-//! ([`reinsert`]).
+//! Refinement of a finished Subset Tree (the grouping's or any peer's): first treelet
+//! restructuring (Karras and Aila 2013, [`treelet`]): every treelet of up to 7 leaves rebuilt in
+//! its SAH-optimal shape, bottom-up; then subtrees are moved to where they lower the SAH
+//! ([`crate::metrics::sah`]) most, by insertion-based optimisation (Bittner, Hapala and Havran
+//! 2013) in the parallel form of Meister and Bittner 2018 ([`reinsert`]).
 //!
-//! A run is a sequence of passes. Pass k (0-based) ranks the non-root nodes by how badly their
-//! parent fits them ([`reinsert::candidates`]) and searches the best reinsertion of the first
-//! ⌈batch × (2N − 2) / (2k + 1)⌉ of them, in
+//! A run is a sequence of passes: `treelet_passes` treelet passes (a pass that rebuilds
+//! nothing ends them), then up to `passes` reinsertion passes. Reinsertion pass k (0-based) ranks
+//! the non-root nodes by how badly their parent fits them ([`reinsert::candidates`]) and
+//! searches the best reinsertion of the first ⌈batch × (2N − 2) / (2k + 1)⌉ of them, in
 //! parallel on the tree as it stands; the moves found are then applied one at a time, best
 //! first, each re-checked against the current tree and kept only if it lowers the SAH by more
 //! than 10⁻¹² of the root's area (else undone). The shrinking batches (1, 1/3, 1/5, …, as obvhs
 //! does) spend the later passes on the large nodes near the top. A pass that keeps no move
-//! ends the run early.
+//! ends the run early. A treelet is rebuilt only when that lowers the SAH by more than the
+//! same 10⁻¹² of the root's area.
 //!
 //! What holds for every input ([`refine`]):
 //! - the result is a Subset Tree: leaves `0..N` in input order, interior nodes renumbered so
@@ -24,8 +27,8 @@
 //! - interior nodes whose leaf set changed take their box diagonal as diameter (the AABB
 //!   p-set's measure); the others keep the input's.
 //!
-//! Each kept move is a [`Step`] event (`Event::Refine`) for recorders: which subtree moved,
-//! from where to where, and the SAH after it. A tree whose root box has no area (all
+//! Each rebuilt treelet and each kept move is a [`Step`] event (`Event::Refine`) for recorders:
+//! which treelet was rebuilt or which subtree moved from where to where, and the SAH after it. A tree whose root box has no area (all
 //! primitives in one point, or on one line) has nothing to gain and is returned unchanged.
 
 pub mod reinsert;
@@ -53,9 +56,8 @@ pub struct RefineParams {
 }
 
 impl Default for RefineParams {
-    /// 6 passes, first batch = a tenth of the nodes: refinement within about one obvhs PLOC
-    /// build time on the bench scenes (see the README's refinement section for the
-    /// measurements behind it).
+    /// One treelet pass of 7 leaves, then 3 reinsertion passes, first batch = a tenth of the
+    /// nodes (see the README's refinement section for the measurements behind it).
     fn default() -> Self {
         RefineParams {
             passes: 3,
@@ -148,14 +150,14 @@ pub struct Refined {
     pub sah_before: f64,
     /// SAH of the result.
     pub sah_after: f64,
-    /// Moves kept.
+    /// Steps kept (rebuilt treelets and moves).
     pub steps: u32,
     /// Passes run.
     pub passes: u32,
 }
 
 /// Refines `tree` (see the module doc), reporting the start ([`Event::RefineStart`]) and each
-/// kept move ([`Event::Refine`]) to `observer`.
+/// kept step ([`Event::Refine`]) to `observer`.
 pub fn refine<O: Observer>(tree: &SubsetTree, params: &RefineParams, mut observer: O) -> Refined {
     let sah_before = metrics::sah(tree);
     observer.on_event(&Event::RefineStart {
