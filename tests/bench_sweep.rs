@@ -79,6 +79,15 @@ fn bench_writes_one_row_per_method_and_wrapper_with_charts_and_rrd() {
         assert_eq!(row.len(), header.len());
         let sah: f64 = row[col("sah")].parse().unwrap();
         assert!(sah > 1.0, "SAH {sah}");
+        // Refinement time: its own column, part of the (total) build time; 0 when unrefined.
+        let build: f64 = row[col("build_s")].parse().unwrap();
+        let refine: f64 = row[col("refine_s")].parse().unwrap();
+        assert!(refine <= build, "{row:?}");
+        assert_eq!(
+            refine > 0.0,
+            row[col("method")].ends_with("+refine"),
+            "{row:?}"
+        );
         let query = row[col("node_tests_per_query")];
         let is_query_bv = row[col("wrapper")] == "box" || row[col("wrapper")].starts_with("sphere");
         assert_eq!(!query.is_empty(), is_query_bv, "{row:?}");

@@ -10,7 +10,7 @@ use wraptree::geom::P3;
 use wraptree::grouping::{CostMeasure, EventLog, Params, SubsetTree, group};
 use wraptree::metrics::sah;
 use wraptree::peers::{self, Method};
-use wraptree::refine::{RefineParams, Refined, refine};
+use wraptree::refine::{RefineParams, Refined, StepKind, refine};
 use wraptree::scene::{LoadOptions, PrimitiveKind, Scene, generate, load_path};
 
 /// Every leaf once under the root, children before parents and inside them, boxes exact
@@ -51,14 +51,33 @@ fn check_valid(scene: &Scene, t: &SubsetTree) {
 }
 
 fn refined(tree: &SubsetTree) -> (Refined, EventLog) {
+    refined_with(tree, &RefineParams::default())
+}
+
+fn refined_with(tree: &SubsetTree, params: &RefineParams) -> (Refined, EventLog) {
     let mut log = EventLog::default();
-    let r = refine(tree, &RefineParams::default(), &mut log);
+    let r = refine(tree, params, &mut log);
     (r, log)
+}
+
+/// Treelet restructuring alone: `passes` treelet passes of `k` leaves, no reinsertion.
+fn treelets(k: u32, passes: u32) -> RefineParams {
+    RefineParams {
+        passes: 0,
+        treelet: k,
+        treelet_passes: passes,
+        ..RefineParams::default()
+    }
 }
 
 /// Checks a refinement of `tree` over `scene`: valid, SAH not above, events consistent.
 fn check_refinement(scene: &Scene, tree: &SubsetTree) -> Refined {
-    let (r, log) = refined(tree);
+    check_refinement_with(scene, tree, &RefineParams::default())
+}
+
+/// [`check_refinement`] with `params`.
+fn check_refinement_with(scene: &Scene, tree: &SubsetTree, params: &RefineParams) -> Refined {
+    let (r, log) = refined_with(tree, params);
     check_valid(scene, &r.tree);
     assert!(
         r.sah_after <= r.sah_before,
@@ -72,7 +91,18 @@ fn check_refinement(scene: &Scene, tree: &SubsetTree) -> Refined {
     assert_eq!(log.refine_start.map(|s| s.1), Some(r.sah_before));
     for (i, s) in log.refine.iter().enumerate() {
         assert_eq!(s.step as usize, i);
-        assert!(s.sah < s.sah_before, "every kept move lowers the SAH");
+        assert!(s.sah < s.sah_before, "every kept step lowers the SAH");
+        match s.kind {
+            StepKind::Move => assert!(s.pass >= params.treelet_passes),
+            StepKind::Treelet { leaves } => {
+                assert!(s.pass < params.treelet_passes);
+                assert!((3..=params.treelet).contains(&leaves), "{s:?}");
+                assert_eq!(
+                    s.aabb, s.parent_aabb,
+                    "a rebuilt treelet keeps its root box"
+                );
+            }
+        }
     }
     if let Some(last) = log.refine.last() {
         assert!((last.sah - r.sah_after).abs() <= 1e-9 * r.sah_after);
@@ -135,6 +165,65 @@ fn refinement_is_deterministic_and_thread_count_independent() {
     assert_eq!(log2, log3);
     assert_eq!(r1.tree, r2.tree);
     assert_eq!(r2.tree, r3.tree);
+}
+
+#[test]
+fn treelet_pass_is_no_worse_and_thread_count_independent() {
+    // Wide enough that the low heights are solved in parallel (`treelet::PARALLEL_MIN`).
+    let scene = generate::soup(20_000, 5);
+    let g = group(&scene, &Params::default(), ());
+    let params = treelets(7, 2);
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| refined_with(&g.tree, &params))
+    };
+    let (r1, log1) = run(1);
+    let (r2, log2) = run(2);
+    assert!(r1.steps > 1000, "{} treelets rebuilt", r1.steps);
+    assert!(r1.sah_after < r1.sah_before);
+    assert_eq!(log1, log2);
+    assert_eq!(r1.tree, r2.tree);
+    check_refinement_with(&scene, &g.tree, &params);
+    // A second pass finds less to do than the first.
+    let first = log1.refine.iter().filter(|s| s.pass == 0).count();
+    assert!(log1.refine.len() - first < first);
+}
+
+#[test]
+fn a_badly_paired_treelet_is_rebuilt_in_its_optimal_shape() {
+    // Four triangles in a row at 0, 1, 10, 11, paired (0, 10) and (1, 11): the optimal tree
+    // pairs the neighbours, which one rebuilt treelet of 4 leaves finds.
+    let s = tri_scene(&[
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [10.0, 0.0, 0.0],
+        [11.0, 0.0, 0.0],
+    ]);
+    let b: Vec<_> = (0..4).map(|i| s.prim_aabb(i)).collect();
+    let (a, c) = (b[0].merge(&b[2]), b[1].merge(&b[3]));
+    let mut aabb = b.clone();
+    aabb.extend([a, c, a.merge(&c)]);
+    let diameter = aabb.iter().map(|x| x.diameter()).collect();
+    let bad = SubsetTree::new(aabb, diameter, vec![[0, 2], [1, 3], [4, 5]]).unwrap();
+    let r = check_refinement_with(&s, &bad, &treelets(4, 1));
+    assert_eq!(r.steps, 1);
+    let mut pairs: Vec<Vec<u32>> = [4, 5]
+        .iter()
+        .map(|&x| {
+            let mut l = r.tree.leaves_under(x);
+            l.sort();
+            l
+        })
+        .collect();
+    pairs.sort();
+    assert_eq!(pairs, vec![vec![0, 1], vec![2, 3]]);
+    // Already optimal: a second run keeps every id.
+    let (again, log) = refined_with(&r.tree, &treelets(7, 3));
+    assert_eq!(again.tree, r.tree);
+    assert!(log.refine.is_empty());
 }
 
 fn tri_scene(corners: &[[f64; 3]]) -> Scene {
@@ -235,6 +324,13 @@ proptest! {
         check_valid(&scene, &b.tree);
         check_refinement(&scene, &b.tree);
     }
+
+    #[test]
+    fn treelet_restructuring_of_any_builder_is_valid(scene in arb_scene(), which in 0usize..3, k in 3u32..=7) {
+        let m = [Method::Grouping, Method::ParryBinned, Method::MedianSplit][which];
+        let b = peers::build(m, &scene, &Params::default()).unwrap();
+        check_refinement_with(&scene, &b.tree, &treelets(k, 2));
+    }
 }
 
 #[test]
@@ -304,6 +400,11 @@ fn replay_verifies_a_refined_recording() {
     assert_eq!(r.params, RefineParams::default());
     assert!(r.steps > 0 && r.sah_after < r.sah_before);
     assert_eq!(rec.refine_steps.len(), r.steps as usize);
+    // Both kinds of step are recorded: rebuilt treelets first, then moves.
+    let treelet = |s: &&wraptree::refine::Step| matches!(s.kind, StepKind::Treelet { .. });
+    let rebuilt = rec.refine_steps.iter().take_while(treelet).count();
+    assert!(rebuilt > 0 && rebuilt < rec.refine_steps.len());
+    assert!(!rec.refine_steps[rebuilt..].iter().any(|s| treelet(&s)));
     // The levels are the refined tree's: its depth is recorded.
     let loaded = wraptree::scene::load_bytes(
         &rec.scene_file_name,
@@ -335,5 +436,19 @@ fn bad_refine_batch_is_one_clear_error() {
         dir.path(),
     );
     common::assert_one_line_error(&out, "--refine-batch");
+    assert!(!dir.path().join("x.rrd").exists());
+    let out = common::wraptree(
+        &[
+            "record",
+            LAMP,
+            "--refine",
+            "--refine-treelet",
+            "8",
+            "-o",
+            "x",
+        ],
+        dir.path(),
+    );
+    common::assert_one_line_error(&out, "--refine-treelet");
     assert!(!dir.path().join("x.rrd").exists());
 }

@@ -55,7 +55,8 @@ pub struct RecordCmd {
     /// is less than half leaves; the .rrd always has every level).
     #[arg(long)]
     all_levels: bool,
-    /// Refine the finished tree (reinsertion, see the README) and record each move on the
+    /// Refine the finished tree (treelet restructuring, then reinsertion, see the README) and
+    /// record each step on the
     /// `refine` timeline / `/refine/step` topic; the levels are then the refined tree's.
     #[arg(long)]
     refine: bool,
@@ -65,6 +66,12 @@ pub struct RecordCmd {
     /// Fraction of the nodes searched in the first refinement pass, in (0, 1] (with --refine).
     #[arg(long, default_value_t = RefineParams::default().batch, requires = "refine")]
     refine_batch: f64,
+    /// Most leaves of a restructured treelet, 3 to 7 (with --refine).
+    #[arg(long, default_value_t = RefineParams::default().treelet, requires = "refine")]
+    refine_treelet: u32,
+    /// Treelet restructuring passes before the reinsertion passes (with --refine; 0 = none).
+    #[arg(long, default_value_t = RefineParams::default().treelet_passes, requires = "refine")]
+    refine_treelet_passes: u32,
 }
 
 /// Success for a finished grouping, else the stop's exit code (3 for a limit, 130 for
@@ -117,6 +124,8 @@ impl RecordCmd {
             refine: self.refine.then_some(RefineParams {
                 passes: self.refine_passes,
                 batch: self.refine_batch,
+                treelet: self.refine_treelet,
+                treelet_passes: self.refine_treelet_passes,
             }),
         };
         opts.check()?;

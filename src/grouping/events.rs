@@ -164,7 +164,8 @@ pub enum Event<'a> {
         /// SAH of the tree before refinement.
         sah: f64,
     },
-    /// The refinement kept one move; one per kept move, after `RefineStart`.
+    /// The refinement kept one step (a rebuilt treelet or a move, see
+    /// [`crate::refine::StepKind`]); one per kept step, after `RefineStart`.
     Refine(crate::refine::Step),
     /// The root exists; grouping is over.
     Finish {

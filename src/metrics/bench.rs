@@ -112,6 +112,10 @@ fn measure(m: Method, scene: &Scene, repeat: u32, workload: &Workload) -> Result
 pub struct RefineRow {
     /// Scene name.
     pub scene: String,
+    /// Refinement time alone (s).
+    pub refine_seconds: f64,
+    /// Grouping + refinement time (s).
+    pub total_seconds: f64,
     /// Refinement time alone / obvhs PLOC build time.
     pub refine_per_ploc: f64,
     /// SAH / the best of parry Binned and obvhs PLOC + reinsertion.
@@ -161,6 +165,8 @@ pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, 
     let (_, sah_o, qc_o, ..) = run(Method::ObvhsPlocReinsert)?;
     let refine = RefineRow {
         scene: scene.name.clone(),
+        refine_seconds: refined.refine_seconds,
+        total_seconds: refined.seconds,
         refine_per_ploc: refined.refine_seconds / tp,
         sah_per_best: sah_r / sah_b.min(sah_o),
         query_per_best: qc_r / qc_b.min(qc_o),

@@ -114,8 +114,11 @@ pub struct Row {
     pub method: &'static str,
     /// Wrapper.
     pub wrapper: &'static str,
-    /// Hierarchy build seconds (best of the repetitions).
+    /// Hierarchy build seconds (best of the repetitions); for a refined method the total,
+    /// base build + refinement.
     pub build_s: f64,
+    /// Seconds of `build_s` spent refining (0 for an unrefined method).
+    pub refine_s: f64,
     /// Wrapper build seconds on top of the hierarchy (best of the repetitions).
     pub wrapper_s: f64,
     /// The hierarchy's quality.
@@ -252,6 +255,7 @@ pub fn evaluate(
                 method: method.name(),
                 wrapper: wrapper.name(),
                 build_s,
+                refine_s: built.refine_seconds,
                 wrapper_s,
                 quality: q,
                 tightness: tight,

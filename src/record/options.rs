@@ -6,7 +6,7 @@ use anyhow::{Result, bail};
 
 impl RecordOptions {
     /// Checks what [`record`](super::record) would reject only after loading and grouping: a
-    /// cover budget of 0, a cover without levels, a refinement batch outside (0, 1]. The errors
+    /// cover budget of 0, a cover without levels, a refinement batch outside (0, 1], a treelet outside 3 to 7 leaves. The errors
     /// name the command-line flags.
     pub fn check(&self) -> Result<()> {
         if let Some((CoverLimit::Budget(0), _)) = self.cover {
@@ -21,6 +21,11 @@ impl RecordOptions {
             && !(r.batch > 0.0 && r.batch <= 1.0)
         {
             bail!("--refine-batch must be in (0, 1], got {}", r.batch);
+        }
+        if let Some(r) = &self.refine
+            && !(3..=7).contains(&r.treelet)
+        {
+            bail!("--refine-treelet must be 3 to 7 leaves, got {}", r.treelet);
         }
         Ok(())
     }

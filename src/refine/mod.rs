@@ -1,16 +1,19 @@
-//! Refinement of a finished Subset Tree (the grouping's or any peer's): subtrees are moved to
-//! where they lower the SAH ([`crate::metrics::sah`]) most, by insertion-based optimisation
-//! (Bittner, Hapala and Havran 2013) in the parallel form of Meister and Bittner 2018
-//! ([`reinsert`]).
+//! Refinement of a finished Subset Tree (the grouping's or any peer's): first treelet
+//! restructuring (Karras and Aila 2013, [`treelet`]): every treelet of up to 7 leaves rebuilt in
+//! its SAH-optimal shape, bottom-up; then subtrees are moved to where they lower the SAH
+//! ([`crate::metrics::sah`]) most, by insertion-based optimisation (Bittner, Hapala and Havran
+//! 2013) in the parallel form of Meister and Bittner 2018 ([`reinsert`]).
 //!
-//! A run is a sequence of passes. Pass k (0-based) ranks the non-root nodes by how badly their
-//! parent fits them ([`reinsert::candidates`]) and searches the best reinsertion of the first
-//! ⌈batch × (2N − 2) / (2k + 1)⌉ of them, in
+//! A run is a sequence of passes: `treelet_passes` treelet passes (a pass that rebuilds
+//! nothing ends them), then up to `passes` reinsertion passes. Reinsertion pass k (0-based) ranks
+//! the non-root nodes by how badly their parent fits them ([`reinsert::candidates`]) and
+//! searches the best reinsertion of the first ⌈batch × (2N − 2) / (2k + 1)⌉ of them, in
 //! parallel on the tree as it stands; the moves found are then applied one at a time, best
 //! first, each re-checked against the current tree and kept only if it lowers the SAH by more
 //! than 10⁻¹² of the root's area (else undone). The shrinking batches (1, 1/3, 1/5, …, as obvhs
 //! does) spend the later passes on the large nodes near the top. A pass that keeps no move
-//! ends the run early.
+//! ends the run early. A treelet is rebuilt only when that lowers the SAH by more than the
+//! same 10⁻¹² of the root's area.
 //!
 //! What holds for every input ([`refine`]):
 //! - the result is a Subset Tree: leaves `0..N` in input order, interior nodes renumbered so
@@ -24,12 +27,13 @@
 //! - interior nodes whose leaf set changed take their box diagonal as diameter (the AABB
 //!   p-set's measure); the others keep the input's.
 //!
-//! Each kept move is a [`Step`] event (`Event::Refine`) for recorders: which subtree moved,
-//! from where to where, and the SAH after it. A tree whose root box has no area (all
+//! Each rebuilt treelet and each kept move is a [`Step`] event (`Event::Refine`) for recorders:
+//! which treelet was rebuilt or which subtree moved from where to where, and the SAH after it. A tree whose root box has no area (all
 //! primitives in one point, or on one line) has nothing to gain and is returned unchanged.
 
 pub mod reinsert;
 pub mod renumber;
+pub mod treelet;
 pub mod work;
 
 use crate::geom::Aabb;
@@ -45,16 +49,21 @@ pub struct RefineParams {
     /// Fraction of the non-root nodes searched in the first pass (pass k searches
     /// batch / (2k + 1) of them); in (0, 1].
     pub batch: f64,
+    /// Most leaves of a restructured treelet, 3..=7 ([`treelet::MAX_LEAVES`]).
+    pub treelet: u32,
+    /// Treelet restructuring passes run before the reinsertion passes (0: none).
+    pub treelet_passes: u32,
 }
 
 impl Default for RefineParams {
-    /// 6 passes, first batch = a tenth of the nodes: refinement within about one obvhs PLOC
-    /// build time on the bench scenes (see the README's refinement section for the
-    /// measurements behind it).
+    /// One treelet pass of 7 leaves, then 3 reinsertion passes, first batch = a tenth of the
+    /// nodes (see the README's refinement section for the measurements behind it).
     fn default() -> Self {
         RefineParams {
-            passes: 6,
+            passes: 3,
             batch: 0.1,
+            treelet: 7,
+            treelet_passes: 1,
         }
     }
 }
@@ -68,22 +77,45 @@ impl RefineParams {
                 self.batch
             ));
         }
+        if !(3..=treelet::MAX_LEAVES as u32).contains(&self.treelet) {
+            return Err(format!(
+                "refine treelet must be 3 to {} leaves, got {}",
+                treelet::MAX_LEAVES,
+                self.treelet
+            ));
+        }
         Ok(())
     }
 }
 
-/// One kept move of a refinement run.
+/// What a refinement step did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum StepKind {
+    /// A subtree moved (reinsertion, [`reinsert`]).
+    Move,
+    /// A treelet of `leaves` leaves was rebuilt in its optimal shape ([`treelet`]).
+    Treelet {
+        /// Treelet leaves (3..=7).
+        leaves: u32,
+    },
+}
+
+/// One kept step of a refinement run: a move or a rebuilt treelet.
 ///
 /// Ids are the input tree's: leaves are primitives; an interior id names the input's node
-/// *slot*, which a move can hang elsewhere (the final renumbering to merge order happens after
-/// the last step, see [`renumber`]).
+/// *slot*, which a step can hang elsewhere (the final renumbering to merge order happens after
+/// the last step, see [`renumber`]). For a rebuilt treelet, `node` is its root, `parent`,
+/// `sibling` and `target` are [`crate::grouping::NONE`], and both boxes are the root's (which
+/// a rebuild keeps).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Step {
     /// 0-based index of the step in the run.
     pub step: u32,
-    /// Pass the step belongs to.
+    /// Pass the step belongs to (treelet passes first, then reinsertion passes).
     pub pass: u32,
-    /// The subtree that moved.
+    /// Move or treelet.
+    pub kind: StepKind,
+    /// The subtree that moved (a treelet's root).
     pub node: u32,
     /// Its parent slot, which moved with it: before, parent of `node` and `sibling`; after,
     /// parent of `node` and `target`.
@@ -118,14 +150,14 @@ pub struct Refined {
     pub sah_before: f64,
     /// SAH of the result.
     pub sah_after: f64,
-    /// Moves kept.
+    /// Steps kept (rebuilt treelets and moves).
     pub steps: u32,
     /// Passes run.
     pub passes: u32,
 }
 
 /// Refines `tree` (see the module doc), reporting the start ([`Event::RefineStart`]) and each
-/// kept move ([`Event::Refine`]) to `observer`.
+/// kept step ([`Event::Refine`]) to `observer`.
 pub fn refine<O: Observer>(tree: &SubsetTree, params: &RefineParams, mut observer: O) -> Refined {
     let sah_before = metrics::sah(tree);
     observer.on_event(&Event::RefineStart {
@@ -144,49 +176,31 @@ pub fn refine<O: Observer>(tree: &SubsetTree, params: &RefineParams, mut observe
         return unchanged(0);
     }
     let leaves: f64 = tree.aabb[..tree.leaves()].iter().map(area).sum();
-    let min_gain = root_area * 1e-12;
-    let mut w = WorkTree::of(tree);
-    let nodes = w.parent.len() - 1;
-    let (mut steps, mut passes) = (0u32, 0u32);
-    for pass in 0..params.passes {
+    let mut run = Run {
+        w: WorkTree::of(tree),
+        leaves,
+        root_area,
+        min_gain: root_area * 1e-12,
+        steps: 0,
+        observer: &mut observer,
+    };
+    let mut passes = 0u32;
+    for pass in 0..params.treelet_passes {
         passes += 1;
-        let count = ((nodes as f64 * params.batch) / (2 * pass + 1) as f64).ceil() as usize;
-        let candidates = reinsert::candidates(&w, count.max(1));
-        let mut moves = reinsert::find_all(&w, &candidates, min_gain);
-        reinsert::sort_best_first(&mut moves);
-        let mut kept = 0;
-        for m in &moves {
-            if !reinsert::still_valid(&w, m) {
-                continue;
-            }
-            let before = w.interior;
-            let sah_before = w.sah(leaves, root_area);
-            let moved = w.reinsert(m.node, m.target);
-            if before - w.interior <= min_gain {
-                w.reinsert(m.node, moved.sibling);
-                w.interior = before;
-                continue;
-            }
-            w.mark_changed(&moved);
-            observer.on_event(&Event::Refine(Step {
-                step: steps,
-                pass,
-                node: m.node,
-                parent: moved.parent,
-                sibling: moved.sibling,
-                target: m.target,
-                aabb: w.aabb[m.node as usize],
-                parent_aabb: w.aabb[moved.parent as usize],
-                sah_before,
-                sah: w.sah(leaves, root_area),
-            }));
-            steps += 1;
-            kept += 1;
+        if run.treelet_pass(pass, params.treelet as usize) == 0 {
+            break;
         }
+    }
+    let nodes = run.w.parent.len() - 1;
+    for k in 0..params.passes {
+        let count = ((nodes as f64 * params.batch) / (2 * k + 1) as f64).ceil() as usize;
+        let kept = run.reinsert_pass(passes, count.max(1));
+        passes += 1;
         if kept == 0 {
             break;
         }
     }
+    let (w, steps) = (run.w, run.steps);
     if steps == 0 {
         return unchanged(passes);
     }
@@ -201,5 +215,95 @@ pub fn refine<O: Observer>(tree: &SubsetTree, params: &RefineParams, mut observe
         sah_after,
         steps,
         passes,
+    }
+}
+
+/// The state of a refinement run between passes.
+struct Run<'a, O: Observer> {
+    w: WorkTree,
+    /// Σ leaf area (constant).
+    leaves: f64,
+    root_area: f64,
+    min_gain: f64,
+    steps: u32,
+    observer: &'a mut O,
+}
+
+impl<O: Observer> Run<'_, O> {
+    fn sah(&self) -> f64 {
+        self.w.sah(self.leaves, self.root_area)
+    }
+
+    /// One treelet pass ([`treelet`]): every height's treelets solved on the frozen tree, then
+    /// applied in root order. Returns the treelets rebuilt.
+    fn treelet_pass(&mut self, pass: u32, k: usize) -> u32 {
+        let mut kept = 0;
+        for roots in treelet::by_height(&self.w) {
+            for plan in treelet::solve_all(&self.w, &roots, k, self.min_gain) {
+                let sah_before = self.sah();
+                self.w.restructure(&plan);
+                let bx = self.w.aabb[plan.root as usize];
+                self.emit(Step {
+                    step: self.steps,
+                    pass,
+                    kind: StepKind::Treelet {
+                        leaves: plan.leaves,
+                    },
+                    node: plan.root,
+                    parent: crate::grouping::NONE,
+                    sibling: crate::grouping::NONE,
+                    target: crate::grouping::NONE,
+                    aabb: bx,
+                    parent_aabb: bx,
+                    sah_before,
+                    sah: self.sah(),
+                });
+                kept += 1;
+            }
+        }
+        kept
+    }
+
+    /// One reinsertion pass ([`reinsert`]) over the `count` best-ranked candidates. Returns
+    /// the moves kept.
+    fn reinsert_pass(&mut self, pass: u32, count: usize) -> u32 {
+        let candidates = reinsert::candidates(&self.w, count);
+        let mut moves = reinsert::find_all(&self.w, &candidates, self.min_gain);
+        reinsert::sort_best_first(&mut moves);
+        let mut kept = 0;
+        for m in &moves {
+            if !reinsert::still_valid(&self.w, m) {
+                continue;
+            }
+            let before = self.w.interior;
+            let sah_before = self.sah();
+            let moved = self.w.reinsert(m.node, m.target);
+            if before - self.w.interior <= self.min_gain {
+                self.w.reinsert(m.node, moved.sibling);
+                self.w.interior = before;
+                continue;
+            }
+            self.w.mark_changed(&moved);
+            self.emit(Step {
+                step: self.steps,
+                pass,
+                kind: StepKind::Move,
+                node: m.node,
+                parent: moved.parent,
+                sibling: moved.sibling,
+                target: m.target,
+                aabb: self.w.aabb[m.node as usize],
+                parent_aabb: self.w.aabb[moved.parent as usize],
+                sah_before,
+                sah: self.sah(),
+            });
+            kept += 1;
+        }
+        kept
+    }
+
+    fn emit(&mut self, step: Step) {
+        self.observer.on_event(&Event::Refine(step));
+        self.steps += 1;
     }
 }

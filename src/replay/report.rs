@@ -48,8 +48,14 @@ pub fn state(replay: &Replay, name: &str) -> Result<String> {
     if let Some(r) = &rec.refine {
         let _ = writeln!(
             s,
-            "refined ({} passes at most, first batch {}): {} moves, SAH {:.6} -> {:.6}",
-            r.params.passes, r.params.batch, r.steps, r.sah_before, r.sah_after
+            "refined ({} treelet passes of {} leaves, {} reinsertion passes at most, first batch {}): {} steps, SAH {:.6} -> {:.6}",
+            r.params.treelet_passes,
+            r.params.treelet,
+            r.params.passes,
+            r.params.batch,
+            r.steps,
+            r.sah_before,
+            r.sah_after
         );
     }
     let _ = writeln!(

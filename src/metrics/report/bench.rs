@@ -17,19 +17,20 @@ use std::path::{Path, PathBuf};
 /// The bench rows as CSV (one header line, one line per row).
 pub fn bench_csv(rows: &[Row]) -> String {
     let mut s = format!(
-        "scene,n,method,wrapper,build_s,wrapper_s,sah,depth_max,depth_mean,structural_balance,\
+        "scene,n,method,wrapper,build_s,refine_s,wrapper_s,sah,depth_max,depth_mean,structural_balance,\
 spatial_balance,tightness,tightness_per_level,{QUERY_COLUMNS}\n"
     );
     for r in rows {
         let q = &r.quality;
         let _ = writeln!(
             s,
-            "{},{},{},{},{:.6e},{:.6e},{:.6e},{},{:.4},{:.4},{:.4},{},{},{}",
+            "{},{},{},{},{:.6e},{:.6e},{:.6e},{:.6e},{},{:.4},{:.4},{:.4},{},{},{}",
             r.scene,
             r.n,
             r.method,
             r.wrapper,
             r.build_s,
+            r.refine_s,
             r.wrapper_s,
             q.sah,
             q.depth_max,

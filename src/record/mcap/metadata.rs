@@ -69,13 +69,16 @@ pub const COVER_KEYS: &[&str] = &[
 ];
 
 /// Keys the `wraptree` record adds when the tree was refined (`record --refine`): `refine` =
-/// `reinsert` (the method), its `refine_passes` and `refine_batch` (what `replay --verify`
-/// re-runs), the moves kept (`refine_steps`) and the SAH before and after. `depth_max` and
+/// `treelet+reinsert` (the method; `reinsert` in recordings without treelet passes), its
+/// `refine_passes`, `refine_batch`, `refine_treelet` and `refine_treelet_passes` (what
+/// `replay --verify` re-runs), the moves kept (`refine_steps`) and the SAH before and after. `depth_max` and
 /// `depth_mean` and the levels are then the refined tree's.
 pub const REFINE_KEYS: &[&str] = &[
     "refine",
     "refine_passes",
     "refine_batch",
+    "refine_treelet",
+    "refine_treelet_passes",
     "refine_steps",
     "refine_sah_before",
     "refine_sah_after",
@@ -97,9 +100,11 @@ pub struct RefineSummary {
 /// Adds the [`REFINE_KEYS`] of `r` to a `wraptree` record.
 pub fn put_refine(m: &mut BTreeMap<String, String>, r: &RefineSummary) {
     for (k, v) in [
-        ("refine", "reinsert".to_string()),
+        ("refine", "treelet+reinsert".to_string()),
         ("refine_passes", r.params.passes.to_string()),
         ("refine_batch", r.params.batch.to_string()),
+        ("refine_treelet", r.params.treelet.to_string()),
+        ("refine_treelet_passes", r.params.treelet_passes.to_string()),
         ("refine_steps", r.steps.to_string()),
         ("refine_sah_before", r.sah_before.to_string()),
         ("refine_sah_after", r.sah_after.to_string()),
@@ -113,10 +118,21 @@ pub fn put_refine(m: &mut BTreeMap<String, String>, r: &RefineSummary) {
 pub fn refine(m: &BTreeMap<String, String>) -> Result<Option<RefineSummary>> {
     match m.get("refine").map(String::as_str) {
         None => Ok(None),
-        Some("reinsert") => {
+        Some(method @ ("reinsert" | "treelet+reinsert")) => {
+            let treelets = method != "reinsert";
             let params = RefineParams {
                 passes: parse(m, "refine_passes")?,
                 batch: parse(m, "refine_batch")?,
+                treelet: if treelets {
+                    parse(m, "refine_treelet")?
+                } else {
+                    RefineParams::default().treelet
+                },
+                treelet_passes: if treelets {
+                    parse(m, "refine_treelet_passes")?
+                } else {
+                    0
+                },
             };
             params
                 .check()

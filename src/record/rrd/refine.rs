@@ -1,10 +1,11 @@
 //! The refinement's rows (`record --refine`), on their own `refine` timeline: tick 0 is the
-//! grouping's tree (its SAH), tick k the tree after the k-th kept move.
+//! grouping's tree (its SAH), tick k the tree after the k-th kept step (a rebuilt treelet or a
+//! move).
 //!
 //! | entity | archetype | content |
 //! |---|---|---|
 //! | `series/refine_sah` | `Scalars` (1) | SAH of the tree at each tick |
-//! | `refine/move` | `Boxes3D` (2) | with per-merge geometry (`--detail merges`, `full`): the moved subtree's box (orange), then its new parent's (green) |
+//! | `refine/move` | `Boxes3D` (2) | with per-merge geometry (`--detail merges`, `full`): the moved subtree's box (orange), then its new parent's (green); for a rebuilt treelet its root's box twice |
 //! | `log/refine` | `TextLog` | the start (parameters, SAH) and the end (moves, SAH) |
 //!
 //! Rows are buffered and sent as columns every [`super::columns::BATCH`] steps and at the end.
@@ -76,13 +77,14 @@ impl RefineColumns {
         self.sah.push(sah);
         self.text_ticks.push(0);
         self.text.push(format!(
-            "refinement: up to {} passes, first batch {} of the nodes; SAH {sah:.6}",
-            params.passes, params.batch
+            "refinement: {} treelet passes ({} leaves), then up to {} reinsertion passes, first batch {} of the nodes; SAH {sah:.6}",
+            params.treelet_passes, params.treelet, params.passes, params.batch
         ));
         Ok(())
     }
 
-    /// One kept move; `boxes` = the moved subtree's and its new parent's, with geometry.
+    /// One kept step; `boxes` = the moved subtree's and its new parent's (a treelet root's box
+    /// twice), with geometry.
     pub(super) fn push(&mut self, s: &Step, boxes: Option<[BoxF32; 2]>) {
         self.tick.push(i64::from(s.step) + 1);
         self.sah.push(s.sah);
@@ -104,7 +106,7 @@ impl RefineColumns {
         if self.started {
             self.text_ticks.push(i64::from(self.steps));
             self.text.push(format!(
-                "refinement done: {} moves, SAH {:.6} → {:.6}",
+                "refinement done: {} steps, SAH {:.6} → {:.6}",
                 self.steps, self.first_sah, self.last_sah
             ));
         }

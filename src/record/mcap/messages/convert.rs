@@ -3,13 +3,20 @@
 use super::{MergeEvent, PartEvent, RefineStepEvent};
 use crate::geom::{Aabb, P3};
 use crate::grouping::{Merge, Part, PartKind};
+use crate::refine::StepKind;
 
 impl From<&crate::refine::Step> for RefineStepEvent {
     fn from(s: &crate::refine::Step) -> Self {
         let (a, p) = (&s.aabb, &s.parent_aabb);
+        let (kind, treelet_leaves) = match s.kind {
+            StepKind::Move => (0, 0),
+            StepKind::Treelet { leaves } => (1, leaves),
+        };
         RefineStepEvent {
             step: s.step,
             pass: s.pass,
+            kind,
+            treelet_leaves,
             node: s.node,
             parent: s.parent,
             sibling: s.sibling,
@@ -41,6 +48,12 @@ impl From<&RefineStepEvent> for crate::refine::Step {
         crate::refine::Step {
             step: e.step,
             pass: e.pass,
+            kind: match e.kind {
+                0 => StepKind::Move,
+                _ => StepKind::Treelet {
+                    leaves: e.treelet_leaves,
+                },
+            },
             node: e.node,
             parent: e.parent,
             sibling: e.sibling,

@@ -143,13 +143,17 @@ flat_message! {
 }
 
 flat_message! {
-    /// One kept move of the refinement (`record --refine`), on `/refine/step`: every field of
-    /// [`crate::refine::Step`].
+    /// One kept step of the refinement (`record --refine`), on `/refine/step`: every field of
+    /// [`crate::refine::Step`], its kind flattened.
     RefineStepEvent {
         /// 0-based step index.
         step: u32,
         /// Pass.
         pass: u32,
+        /// 0 a move, 1 a rebuilt treelet.
+        kind: u32,
+        /// The treelet's leaves (0 for a move).
+        treelet_leaves: u32,
         /// The moved subtree.
         node: u32,
         /// Its parent slot, moved with it.
