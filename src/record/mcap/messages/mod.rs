@@ -54,7 +54,7 @@ macro_rules! flat_message {
 }
 
 flat_message! {
-    /// One merge of step 4(a), on `/grouping/merge`: every field of [`Merge`].
+    /// One merge of step 4(a), on `/grouping/merge`: every field of [`Merge`](crate::grouping::Merge).
     MergeEvent {
         /// 0-based merge index.
         step: u32,
@@ -195,7 +195,7 @@ flat_message! {
 
 flat_message! {
     /// A part of the run (a chunk of the partitioned schedule, a component, a copy, the top),
-    /// on `/grouping/part`: every field of [`Part`], its kind flattened (fields a kind does not
+    /// on `/grouping/part`: every field of [`Part`](crate::grouping::Part), its kind flattened (fields a kind does not
     /// have are 0).
     PartEvent {
         /// 0-based part index.
