@@ -5,39 +5,9 @@ mod common;
 
 use common::{check_tree, run};
 use proptest::prelude::*;
-use wraptree::geom::P3;
 use wraptree::grouping::{PSet, Params, Weights};
-use wraptree::scene::{LoadOptions, PrimitiveKind, Scene, generate};
+use wraptree::scene::{LoadOptions, Scene, generate};
 use wraptree::wrap::{SphereMethod, sphere_tree};
-
-/// Random triangles: corners in a box of side `spread`, edge vectors up to `size` long.
-fn scene_from(tris: &[([f64; 3], [f64; 3], [f64; 3])]) -> Scene {
-    let mut s = Scene::new("prop");
-    for (c, u, v) in tris {
-        let b = s.points.len() as u32;
-        let c = P3::new(c[0], c[1], c[2]);
-        s.points.push(c);
-        s.points.push(c + nalgebra::Vector3::from(*u));
-        s.points.push(c + nalgebra::Vector3::from(*v));
-        s.push(
-            PrimitiveKind::Polygon,
-            &[b, b + 1, b + 2],
-            &[[b, b + 1, b + 2]],
-        );
-    }
-    s
-}
-
-fn arb_scene(max_n: usize) -> impl Strategy<Value = Scene> {
-    let coord = -50.0f64..50.0;
-    let edge = prop_oneof![Just(0.0f64), -3.0f64..3.0];
-    let tri = (
-        [coord.clone(), coord.clone(), coord],
-        [edge.clone(), edge.clone(), edge.clone()],
-        [edge.clone(), edge.clone(), edge],
-    );
-    prop::collection::vec(tri, 1..max_n).prop_map(|t| scene_from(&t))
-}
 
 fn arb_params() -> impl Strategy<Value = Params> {
     (
@@ -79,7 +49,7 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 256, .. ProptestConfig::default() })]
 
     #[test]
-    fn aabb_pset_invariants(scene in arb_scene(80), params in arb_params()) {
+    fn aabb_pset_invariants(scene in common::arb_triangles(1, 80), params in arb_params()) {
         let (g, log) = run(&scene, &params);
         check_tree(&scene, &g, &log);
         check_spheres(&scene, &g);
@@ -88,7 +58,7 @@ proptest! {
     }
 
     #[test]
-    fn hull_pset_invariants(scene in arb_scene(30), params in arb_params()) {
+    fn hull_pset_invariants(scene in common::arb_triangles(1, 30), params in arb_params()) {
         let params = Params { pset: PSet::Hull, ..params };
         let (g, log) = run(&scene, &params);
         check_tree(&scene, &g, &log);

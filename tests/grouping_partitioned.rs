@@ -8,13 +8,12 @@ mod common;
 use common::{check_tree, run, wraptree};
 use proptest::prelude::*;
 use std::sync::atomic::AtomicBool;
-use wraptree::geom::P3;
 use wraptree::grouping::partitioned::{Chunking, group_with};
 use wraptree::grouping::{
     Budget, EventLog, Mode, PSet, Params, PartKind, Schedule, StopReason, Weights, group,
     group_within,
 };
-use wraptree::scene::{LoadOptions, PrimitiveKind, Scene, generate};
+use wraptree::scene::{LoadOptions, generate};
 
 fn partitioned(mut p: Params) -> Params {
     p.mode = Mode {
@@ -31,34 +30,6 @@ fn on<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
         .build()
         .unwrap()
         .install(f)
-}
-
-fn scene_from(tris: &[([f64; 3], [f64; 3], [f64; 3])]) -> Scene {
-    let mut s = Scene::new("prop");
-    for (c, u, v) in tris {
-        let b = s.points.len() as u32;
-        let c = P3::new(c[0], c[1], c[2]);
-        s.points.push(c);
-        s.points.push(c + nalgebra::Vector3::from(*u));
-        s.points.push(c + nalgebra::Vector3::from(*v));
-        s.push(
-            PrimitiveKind::Polygon,
-            &[b, b + 1, b + 2],
-            &[[b, b + 1, b + 2]],
-        );
-    }
-    s
-}
-
-fn arb_scene(min_n: usize, max_n: usize) -> impl Strategy<Value = Scene> {
-    let coord = -50.0f64..50.0;
-    let edge = prop_oneof![Just(0.0f64), -3.0f64..3.0];
-    let tri = (
-        [coord.clone(), coord.clone(), coord],
-        [edge.clone(), edge.clone(), edge.clone()],
-        [edge.clone(), edge.clone(), edge],
-    );
-    prop::collection::vec(tri, min_n..max_n).prop_map(|t| scene_from(&t))
 }
 
 fn arb_params() -> impl Strategy<Value = Params> {
@@ -185,30 +156,33 @@ fn a_scene_smaller_than_a_chunk_gets_the_exact_tree() {
     ] {
         let mut runner = proptest::test_runner::TestRunner::deterministic();
         runner
-            .run(&(arb_scene(1, max_n), arb_params()), |(scene, params)| {
-                let exact = Params {
-                    mode: Mode::default(),
-                    ..params.clone()
-                };
-                let resolved = params.resolve(&scene);
-                let mut lp = EventLog::default();
-                let gp =
-                    group_with(&scene, &resolved, &chunking, &mut lp, &Budget::default()).unwrap();
-                let (ge, le) = run(&scene, &exact);
-                prop_assert_eq!(&gp.tree, &ge.tree);
-                let pairs = |l: &EventLog| {
-                    l.merges
-                        .iter()
-                        .map(|m| (m.a, m.b, m.round, m.cost.to_bits(), m.active))
-                        .collect::<Vec<_>>()
-                };
-                prop_assert_eq!(pairs(&lp), pairs(&le));
-                prop_assert_eq!(&lp.dormant, &le.dormant);
-                prop_assert_eq!(gp.rounds, ge.rounds);
-                prop_assert_eq!(le.parts.len(), 0);
-                prop_assert_eq!(lp.parts.len(), usize::from(scene.len() > 1));
-                Ok(())
-            })
+            .run(
+                &(common::arb_triangles(1, max_n), arb_params()),
+                |(scene, params)| {
+                    let exact = Params {
+                        mode: Mode::default(),
+                        ..params.clone()
+                    };
+                    let resolved = params.resolve(&scene);
+                    let mut lp = EventLog::default();
+                    let gp = group_with(&scene, &resolved, &chunking, &mut lp, &Budget::default())
+                        .unwrap();
+                    let (ge, le) = run(&scene, &exact);
+                    prop_assert_eq!(&gp.tree, &ge.tree);
+                    let pairs = |l: &EventLog| {
+                        l.merges
+                            .iter()
+                            .map(|m| (m.a, m.b, m.round, m.cost.to_bits(), m.active))
+                            .collect::<Vec<_>>()
+                    };
+                    prop_assert_eq!(pairs(&lp), pairs(&le));
+                    prop_assert_eq!(&lp.dormant, &le.dormant);
+                    prop_assert_eq!(gp.rounds, ge.rounds);
+                    prop_assert_eq!(le.parts.len(), 0);
+                    prop_assert_eq!(lp.parts.len(), usize::from(scene.len() > 1));
+                    Ok(())
+                },
+            )
             .unwrap();
     }
 }
@@ -218,7 +192,7 @@ proptest! {
 
     #[test]
     fn generated_scenes_give_valid_trees_identical_on_1_and_2_threads(
-        scene in arb_scene(1, 400),
+        scene in common::arb_triangles(1, 400),
         params in arb_params(),
     ) {
         // The default chunking gives these scenes (≤ `top` primitives) the exact tree; AAC's

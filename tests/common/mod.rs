@@ -6,6 +6,7 @@ pub mod readers;
 #[allow(unused_imports)]
 pub use readers::{python, rerun};
 
+use proptest::prelude::*;
 use wraptree::geom::P3;
 use wraptree::grouping::{EventLog, Grouping, Params, SubsetTree, group};
 use wraptree::scene::{PrimitiveKind, Scene};
@@ -34,6 +35,34 @@ pub fn triangles(corners: &[[f64; 3]], size: f64) -> Scene {
         );
     }
     s
+}
+
+/// Random triangles for property tests, `min_n..max_n` of them: corners in [-50, 50]³, edge
+/// vectors up to 3 long per axis, some axes exactly 0 (degenerate triangles included).
+pub fn arb_triangles(min_n: usize, max_n: usize) -> impl Strategy<Value = Scene> {
+    let coord = -50.0f64..50.0;
+    let edge = prop_oneof![Just(0.0f64), -3.0f64..3.0];
+    let tri = (
+        [coord.clone(), coord.clone(), coord],
+        [edge.clone(), edge.clone(), edge.clone()],
+        [edge.clone(), edge.clone(), edge],
+    );
+    prop::collection::vec(tri, min_n..max_n).prop_map(|t| {
+        let mut s = Scene::new("prop");
+        for (c, u, v) in t {
+            let b = s.points.len() as u32;
+            let c = P3::new(c[0], c[1], c[2]);
+            s.points.push(c);
+            s.points.push(c + nalgebra::Vector3::from(u));
+            s.points.push(c + nalgebra::Vector3::from(v));
+            s.push(
+                PrimitiveKind::Polygon,
+                &[b, b + 1, b + 2],
+                &[[b, b + 1, b + 2]],
+            );
+        }
+        s
+    })
 }
 
 /// Groups `scene` and returns the result with the full event log.
