@@ -85,6 +85,11 @@ pub(super) fn combine(
             .iter()
             .map(|&l| Body {
                 id: id(l),
+                rd: if (l as usize) < m {
+                    bodies[l as usize].rd
+                } else {
+                    ctx.dl.first(part.diameter[l as usize - m])
+                },
                 aabb: if (l as usize) < m {
                     bodies[l as usize].aabb
                 } else {

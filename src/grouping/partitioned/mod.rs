@@ -50,6 +50,7 @@ mod plan;
 mod small;
 #[cfg(test)]
 mod tests;
+mod tiny;
 
 use super::cluster;
 use super::events::{Event, Merge, Observer, Part, PartKind};
@@ -67,20 +68,23 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 /// Halves of at least this many primitives are grouped in parallel.
 const GRAIN: u32 = 2048;
 
-/// A body of a subproblem: its run-wide id, box and diameter.
+/// A body of a subproblem: its run-wide id, the first round in which it obeys DLimit, its box
+/// and diameter.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Body {
     id: u32,
+    rd: u32,
     aabb: Aabb,
     d: f64,
 }
 
-/// What a subproblem leaves: its bodies and, when a brute-force subproblem made them for a
-/// brute-force parent, the Cost (as `order_bits`) and first eligible round of each pair of
-/// them (`p < q`, row by row), so that the parent does not evaluate them again.
+/// What a subproblem leaves: the number of its bodies (at the start of its range of the arena)
+/// and, when a brute-force subproblem made them for a brute-force parent, the Cost (as
+/// `order_bits`) and first eligible round of each pair of them (`p < q`, row by row), so that
+/// the parent does not evaluate them again.
 #[derive(Debug, Default)]
 pub(super) struct Left {
-    bodies: Vec<Body>,
+    n: usize,
     pairs: Vec<(u64, u32)>,
 }
 
@@ -238,8 +242,11 @@ pub fn group_with<O: Observer>(
         return cluster::run(scene, params, observer, budget);
     }
     let n = scene.len();
-    let mut aabb: Vec<Aabb> = (0..n).into_par_iter().map(|i| scene.prim_aabb(i)).collect();
-    let mut diameter: Vec<f64> = aabb.par_iter().map(Aabb::diameter).collect();
+    // Room for the merged bodies from the start (no copy when they are added).
+    let mut aabb: Vec<Aabb> = Vec::with_capacity(2 * n - 1);
+    aabb.par_extend((0..n).into_par_iter().map(|i| scene.prim_aabb(i)));
+    let mut diameter: Vec<f64> = Vec::with_capacity(2 * n - 1);
+    diameter.par_extend(aabb.par_iter().map(Aabb::diameter));
     let codes = morton_order(&aabb);
     let nodes = plan(&codes, chunking);
     let ctx = Ctx {
@@ -265,11 +272,22 @@ pub fn group_with<O: Observer>(
     let exec = Exec {
         ctx: &ctx,
         nodes: &nodes,
-        codes: &codes,
         done: &done,
     };
-    let (leaf_aabb, new_aabb) = aabb.split_at_mut(n);
-    let (leaf_d, new_d) = diameter.split_at_mut(n);
+    // The leaves as bodies in Morton order: one gather (its loads overlap) instead of one per
+    // chunk; `rd` is set by their chunk.
+    let mut leaves: Vec<Body> = codes
+        .par_iter()
+        .map(|&(_, id)| Body {
+            id,
+            rd: 0,
+            aabb: aabb[id as usize],
+            d: diameter[id as usize],
+        })
+        .collect();
+    drop(codes);
+    let (_, new_aabb) = aabb.split_at_mut(n);
+    let (_, new_d) = diameter.split_at_mut(n);
     let out = Out {
         first_new: n as u32,
         children: &mut children,
@@ -278,7 +296,7 @@ pub fn group_with<O: Observer>(
         info: listens.then_some(&mut info[..]),
         stats: SubStats::default(),
     };
-    let (result, sub) = exec.node(nodes.len() as u32 - 1, (leaf_aabb, leaf_d), out, false);
+    let (result, sub) = exec.node(nodes.len() as u32 - 1, &mut leaves, out, false);
     // Events, in post-order, up to the first unfinished subproblem.
     let mut emitted = 0u32;
     let mut part = 0u32;
@@ -371,34 +389,29 @@ pub fn group_with<O: Observer>(
 struct Exec<'a> {
     ctx: &'a Ctx<'a>,
     nodes: &'a [Node],
-    codes: &'a [(u64, u32)],
     done: &'a [AtomicBool],
 }
 
 impl Exec<'_> {
-    /// Groups node `k`'s subtree into `out` (its merges, in post-order); returns the bodies it
-    /// leaves (`None` when the budget stopped it), with their pairs when `export`, and its
-    /// counters.
+    /// Groups node `k`'s subtree into `out` (its merges, in post-order). `arena` holds the
+    /// node's primitives as bodies (its range of the Morton order); the bodies it leaves end
+    /// up at its start. Returns how many it leaves (`None` when the budget stopped it), with
+    /// their pairs when `export`, and its counters.
     fn node(
         &self,
         k: u32,
-        leaves: (&[Aabb], &[f64]),
+        arena: &mut [Body],
         out: Out<'_>,
         export: bool,
     ) -> (Option<Left>, SubStats) {
         let node = self.nodes[k as usize];
         let (parts, mut own, mut stats) = match node.kids {
             None => {
-                let bodies: Vec<Body> = self.codes[node.lo as usize..node.hi as usize]
-                    .iter()
-                    .map(|&(_, id)| Body {
-                        id,
-                        aabb: leaves.0[id as usize],
-                        d: leaves.1[id as usize],
-                    })
-                    .collect();
+                for b in arena.iter_mut() {
+                    b.rd = self.ctx.dl.first(b.d);
+                }
                 let part = Left {
-                    bodies,
+                    n: arena.len(),
                     pairs: Vec::new(),
                 };
                 ([part, Left::default()], out, SubStats::default())
@@ -411,22 +424,23 @@ impl Exec<'_> {
                 let (rout, own) = rest.split(rm);
                 // The children's pairs serve this node's brute-force step.
                 let want = node.inputs as usize <= small::SMALL && node.inputs > node.keep;
+                let mid = (ln.hi - ln.lo) as usize;
+                let (la, ra) = arena.split_at_mut(mid);
                 let ((lb, ls), (rb, rs)) = if node.hi - node.lo >= GRAIN {
                     rayon::join(
-                        || self.node(l, leaves, lout, want),
-                        || self.node(r, leaves, rout, want),
+                        || self.node(l, la, lout, want),
+                        || self.node(r, ra, rout, want),
                     )
                 } else {
-                    (
-                        self.node(l, leaves, lout, want),
-                        self.node(r, leaves, rout, want),
-                    )
+                    (self.node(l, la, lout, want), self.node(r, ra, rout, want))
                 };
                 let mut stats = ls;
                 stats.add(&rs);
                 let (Some(lb), Some(rb)) = (lb, rb) else {
                     return (None, stats);
                 };
+                // The halves' bodies side by side at the node's start.
+                arena.copy_within(mid..mid + rb.n, lb.n);
                 ([lb, rb], own, stats)
             }
         };
@@ -434,16 +448,23 @@ impl Exec<'_> {
             return (None, stats);
         }
         let keep = node.keep as usize;
-        let m = parts[0].bodies.len() + parts[1].bodies.len();
+        let m = parts[0].n + parts[1].n;
         let left = if m <= small::SMALL {
-            Some(small::combine(self.ctx, parts, keep, &mut own, export))
+            Some(small::combine(
+                self.ctx,
+                &mut arena[..m],
+                parts,
+                keep,
+                &mut own,
+                export,
+            ))
         } else {
-            let [a, b] = parts;
-            let mut bodies = a.bodies;
-            bodies.extend_from_slice(&b.bodies);
-            big::combine(self.ctx, bodies, keep, &mut own).map(|bodies| Left {
-                bodies,
-                pairs: Vec::new(),
+            big::combine(self.ctx, arena[..m].to_vec(), keep, &mut own).map(|bodies| {
+                arena[..bodies.len()].copy_from_slice(&bodies);
+                Left {
+                    n: bodies.len(),
+                    pairs: Vec::new(),
+                }
             })
         };
         // Only a budget reads the shared count (an atomic add per node costs on 2 threads).

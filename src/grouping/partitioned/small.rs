@@ -21,7 +21,7 @@ use std::cell::RefCell;
 pub(super) const SMALL: usize = 64;
 
 /// A round that never comes (NaN sizes).
-const NEVER: u32 = u32::MAX;
+pub(super) const NEVER: u32 = u32::MAX;
 
 /// The limits of every round: `tab[r]` = `base` doubled `r` times, up to the first infinity.
 pub(super) struct Limits {
@@ -83,8 +83,6 @@ struct Table {
     live: Vec<usize>,
     best: Vec<usize>,
     next: Vec<u32>,
-    /// First round in which each body obeys DLimit.
-    rd: Vec<u32>,
 }
 
 /// No partner.
@@ -162,46 +160,48 @@ thread_local! {
         live: Vec::new(),
         best: Vec::new(),
         next: Vec::new(),
-        rd: Vec::new(),
     }) };
 }
 
-/// The Cost (as [`order_bits`]) and first eligible round of the pair `a`, `b`, whose bodies
-/// obey DLimit from rounds `ra` and `rb` on.
+/// The Cost (as [`order_bits`]) and first eligible round of the pair `a`, `b`.
 #[inline(always)]
-fn eval(ctx: &Ctx, a: &Body, b: &Body, ra: u32, rb: u32) -> (u64, u32) {
+pub(super) fn eval(ctx: &Ctx, a: &Body, b: &Body) -> (u64, u32) {
     let d = a.aabb.merge(&b.aabb).diameter();
     let (fill, balance) = fill_balance(d, a.d, b.d);
-    let round = ra.max(rb).max(ctx.gl.first(a.aabb.gap_linf(&b.aabb)));
+    let round = a.rd.max(b.rd).max(ctx.gl.first(a.aabb.gap_linf(&b.aabb)));
     (order_bits(ctx.params.weights.cost(d, fill, balance)), round)
 }
 
-/// Groups the bodies of `parts` (at most [`SMALL`] together) until `keep` remain, writing merge
-/// `i` to `out` at index `i` with new id `first_new + i`; returns the bodies left, with their
-/// pairs when `export` (the merges do not depend on the order of the bodies: every choice is
-/// by Cost and tie tags). A part's pairs, when given, are used instead of evaluating them again.
+/// Groups the bodies of `body` (at most [`SMALL`]: the first `parts[0].n` of one half, then
+/// `parts[1].n` of the other) until `keep` remain, writing merge `i` to `out` at index `i`
+/// with new id `first_new + i`; the bodies left end up at the start of `body`. Returns how many,
+/// with their pairs when `export` (the merges do not depend on the order of the bodies: every
+/// choice is by Cost and tie tags). A part's pairs, when given, are used instead of evaluating
+/// them again.
 pub(super) fn combine(
     ctx: &Ctx,
+    body: &mut [Body],
     parts: [Left; 2],
     keep: usize,
     out: &mut Out<'_>,
     export: bool,
 ) -> Left {
-    let [a, b] = parts;
-    if a.bodies.len() + b.bodies.len() <= keep {
-        let mut bodies = a.bodies;
-        bodies.extend_from_slice(&b.bodies);
+    if body.len() <= keep {
         return Left {
-            bodies,
+            n: body.len(),
             pairs: Vec::new(),
         };
     }
-    TABLE.with(|t| run(ctx, [a, b], keep, out, export, &mut t.borrow_mut()))
+    if body.len() <= super::tiny::TINY {
+        return super::tiny::run(ctx, body, parts, keep, out, export);
+    }
+    TABLE.with(|t| run(ctx, body, parts, keep, out, export, &mut t.borrow_mut()))
 }
 
 /// [`combine`] with the thread's table.
 fn run(
     ctx: &Ctx,
+    body: &mut [Body],
     parts: [Left; 2],
     keep: usize,
     out: &mut Out<'_>,
@@ -209,11 +209,9 @@ fn run(
     t: &mut Table,
 ) -> Left {
     let [a, b] = parts;
-    let ka = a.bodies.len();
-    let mut body = a.bodies;
-    body.extend_from_slice(&b.bodies);
+    let ka = a.n;
     let m = body.len();
-    debug_assert!(m <= SMALL && keep >= 1);
+    debug_assert!(m <= SMALL && keep >= 1 && ka + b.n == m);
     let mut st = SubStats::default();
     let w = ctx.params.weights;
     let seed = ctx.params.seed;
@@ -224,8 +222,6 @@ fn run(
     }
     t.tag.clear();
     t.tag.extend(body.iter().map(|b| tie_tag(seed, b.id)));
-    t.rd.clear();
-    t.rd.extend(body.iter().map(|b| ctx.dl.first(b.d)));
     t.live.clear();
     t.live.extend(0..m);
     t.best.clear();
@@ -243,7 +239,7 @@ fn run(
                     Some(it) => *it.next().expect("k(k-1)/2 pairs"),
                     None => {
                         st.candidates += 1;
-                        eval(ctx, &body[i], &body[j], t.rd[i], t.rd[j])
+                        eval(ctx, &body[i], &body[j])
                     }
                 };
                 (t.cost[i * m + j], t.round[i * m + j]) = (c, r);
@@ -253,7 +249,7 @@ fn run(
     }
     for i in 0..ka {
         for j in ka..m {
-            let (c, r) = eval(ctx, &body[i], &body[j], t.rd[i], t.rd[j]);
+            let (c, r) = eval(ctx, &body[i], &body[j]);
             (t.cost[i * m + j], t.round[i * m + j]) = (c, r);
             (t.cost[j * m + i], t.round[j * m + i]) = (c, r);
         }
@@ -286,23 +282,21 @@ fn run(
         let (a, b) = (body[i], body[j]);
         let merged = a.aabb.merge(&b.aabb);
         let d = merged.diameter();
-        let (fill, balance) = fill_balance(d, a.d, b.d);
-        let cost = w.cost(d, fill, balance);
         let active = d <= ctx.dl.at(round);
         let new = out.first_new + made as u32;
         st.pops += 1;
         // The new body takes slot i; slot j is gone.
         body[i] = Body {
             id: new,
+            rd: ctx.dl.first(d),
             aabb: merged,
             d,
         };
         t.tag[i] = tie_tag(seed, new);
-        t.rd[i] = ctx.dl.first(d);
         t.live.retain(|&k| k != j);
         for &k in &t.live {
             if k != i {
-                let (c, r) = eval(ctx, &body[i], &body[k], t.rd[i], t.rd[k]);
+                let (c, r) = eval(ctx, &body[i], &body[k]);
                 (t.cost[i * m + k], t.round[i * m + k]) = (c, r);
                 (t.cost[k * m + i], t.round[k * m + i]) = (c, r);
             }
@@ -328,25 +322,21 @@ fn run(
             }
         }
         t.scan_row(i, round);
-        let queued = if out.listens() {
-            t.live.iter().filter(|&&k| t.best[k] != NO).count() as u32
-        } else {
-            0
-        };
-        out.put(
-            made,
-            [a.id.min(b.id), a.id.max(b.id)],
-            merged,
-            d,
+        // What only events read.
+        let info = if out.listens() {
+            let (fill, balance) = fill_balance(d, a.d, b.d);
             Info {
                 round,
                 fill,
                 balance,
-                cost,
-                queue_len: queued,
+                cost: w.cost(d, fill, balance),
+                queue_len: t.live.iter().filter(|&&k| t.best[k] != NO).count() as u32,
                 active,
-            },
-        );
+            }
+        } else {
+            Info::default()
+        };
+        out.put(made, [a.id.min(b.id), a.id.max(b.id)], merged, d, info);
         made += 1;
     }
     st.rounds = round + 1;
@@ -369,9 +359,8 @@ fn run(
     for (k, &i) in t.live.iter().enumerate() {
         body[k] = body[i];
     }
-    body.truncate(t.live.len());
     Left {
-        bodies: body,
+        n: t.live.len(),
         pairs,
     }
 }

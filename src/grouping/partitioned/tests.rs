@@ -1,4 +1,4 @@
-//! The brute-force subproblem against the voxel-hash one on the same bodies.
+//! The brute-force subproblems (`tiny`, `small`) against the voxel-hash one on the same bodies.
 
 use super::{Body, Ctx, Info, Left, Out, SubStats, big, small};
 use crate::geom::Aabb;
@@ -11,9 +11,16 @@ use std::sync::atomic::{AtomicBool, AtomicU64};
 /// Children, Cost bits and round of each merge, and the ids of the bodies left.
 type Solved = (Vec<([u32; 2], u64, u32)>, Vec<u32>);
 
+/// Bodies and, when a brute-force subproblem left them, their pairs.
+#[derive(Default)]
+struct Half {
+    bodies: Vec<Body>,
+    pairs: Vec<(u64, u32)>,
+}
+
 /// A part of bodies without pairs.
-fn part(bodies: &[Body]) -> Left {
-    Left {
+fn part(bodies: &[Body]) -> Half {
+    Half {
         bodies: bodies.to_vec(),
         pairs: Vec::new(),
     }
@@ -24,7 +31,7 @@ fn part(bodies: &[Body]) -> Left {
 fn solve(ctx: &Ctx, bodies: &[Body], keep: usize, n: u32, brute: bool) -> Solved {
     solve_parts(
         ctx,
-        [part(bodies), Left::default()],
+        [part(bodies), Half::default()],
         keep,
         n,
         brute.then_some(false),
@@ -36,11 +43,11 @@ fn solve(ctx: &Ctx, bodies: &[Body], keep: usize, n: u32, brute: bool) -> Solved
 /// the merges and bodies left, and what the brute force left.
 fn solve_parts(
     ctx: &Ctx,
-    parts: [Left; 2],
+    parts: [Half; 2],
     keep: usize,
     n: u32,
     export: Option<bool>,
-) -> (Solved, Left) {
+) -> (Solved, Half) {
     let m = parts[0].bodies.len() + parts[1].bodies.len() - keep;
     let mut children = vec![[0u32; 2]; m];
     let mut aabb = vec![Aabb::EMPTY; m];
@@ -55,7 +62,25 @@ fn solve_parts(
         stats: SubStats::default(),
     };
     let left = match export {
-        Some(e) => small::combine(ctx, parts, keep, &mut out, e),
+        Some(e) => {
+            let [a, b] = parts;
+            let lefts = [
+                Left {
+                    n: a.bodies.len(),
+                    pairs: a.pairs,
+                },
+                Left {
+                    n: b.bodies.len(),
+                    pairs: b.pairs,
+                },
+            ];
+            let mut arena = [a.bodies, b.bodies].concat();
+            let left = small::combine(ctx, &mut arena, lefts, keep, &mut out, e);
+            Half {
+                bodies: arena[..left.n].to_vec(),
+                pairs: left.pairs,
+            }
+        }
         None => {
             let [a, b] = parts;
             let bodies = [a.bodies, b.bodies].concat();
@@ -73,7 +98,19 @@ fn solve_parts(
 #[test]
 fn brute_force_equals_the_voxel_hash_run() {
     let budget = Budget::default();
-    for (seed, n) in [(1u64, 64usize), (2, 40), (3, 17), (4, 64), (5, 2)] {
+    // Sizes for both brute-force solvers (`tiny` up to 8 bodies, `small` above).
+    for (seed, n) in [
+        (1u64, 64usize),
+        (2, 40),
+        (3, 17),
+        (4, 64),
+        (5, 2),
+        (6, 3),
+        (7, 5),
+        (8, 8),
+        (9, 7),
+        (10, 12),
+    ] {
         let scene = generate::soup(n, seed);
         for weights in [
             Weights {
@@ -108,6 +145,7 @@ fn brute_force_equals_the_voxel_hash_run() {
                     let aabb = scene.prim_aabb(i);
                     Body {
                         id: 3 * i as u32 + 1,
+                        rd: ctx.dl.first(aabb.diameter()),
                         aabb,
                         d: aabb.diameter(),
                     }
@@ -123,7 +161,7 @@ fn brute_force_equals_the_voxel_hash_run() {
             if n >= 6 {
                 let h = n / 2;
                 let half = |r: &[Body], keep, first| {
-                    solve_parts(&ctx, [part(r), Left::default()], keep, first, Some(true)).1
+                    solve_parts(&ctx, [part(r), Half::default()], keep, first, Some(true)).1
                 };
                 let (l0, l1) = (
                     half(&bodies[..h], h - 1, 1000),

@@ -1,0 +1,200 @@
+//! The brute-force step of [`small`](super::small) for subproblems of at most [`TINY`] bodies,
+//! most of the partitioned schedule's subproblems (AAC's chunks and the levels just above).
+//!
+//! With so few bodies, keeping each body's cheapest partner costs more than it saves: every
+//! step looks at all pairs of the bodies left. The pair merged next is the least by (its
+//! round, clamped to the current round; Cost; smaller tie tag; larger tie tag), which is the
+//! pair `small` merges: the cheapest pair eligible in the current round, or, when none is,
+//! the cheapest of those eligible first in a later round, which becomes the current one. The
+//! counters (eligible pairs at each round start, candidates, pops, rounds) and the events'
+//! queue length (bodies with an eligible partner after the merge) are those of `small`.
+
+use super::small::{NEVER, eval};
+use super::{Body, Ctx, Info, Left, Out, SubStats};
+use crate::grouping::cluster::{fill_balance, tie_tag};
+
+/// The most bodies a subproblem may have to be solved here.
+pub(super) const TINY: usize = 8;
+
+/// The pairs of the bodies in the slots `0..m`: Cost bits and first eligible round (`[i][j]`,
+/// `i < j`), the slots' tie tags and which slots hold a body.
+struct Pairs {
+    cost: [[u64; TINY]; TINY],
+    round: [[u32; TINY]; TINY],
+    tag: [u64; TINY],
+    live: [bool; TINY],
+    m: usize,
+}
+
+impl Pairs {
+    /// The number of pairs eligible in round `r`, and of bodies with an eligible partner.
+    fn eligible(&self, r: u32) -> (u64, u32) {
+        let (mut pairs, mut with) = (0u64, [false; TINY]);
+        for i in (0..self.m).filter(|&i| self.live[i]) {
+            for j in (i + 1..self.m).filter(|&j| self.live[j]) {
+                if self.round[i][j] <= r {
+                    pairs += 1;
+                    (with[i], with[j]) = (true, true);
+                }
+            }
+        }
+        (pairs, with.iter().filter(|&&w| w).count() as u32)
+    }
+
+    /// The pair merged next in round `r` and its round (clamped to `r`).
+    fn next(&self, r: u32) -> Option<(usize, usize, u32)> {
+        let mut best: Option<(u32, u64, usize, usize)> = None;
+        for i in (0..self.m).filter(|&i| self.live[i]) {
+            for j in (i + 1..self.m).filter(|&j| self.live[j]) {
+                let (pr, c) = (self.round[i][j].max(r), self.cost[i][j]);
+                let wins = match best {
+                    None => true,
+                    Some((br, bc, bi, bj)) => {
+                        pr < br
+                            || (pr == br
+                                && (c < bc || (c == bc && self.key(i, j) < self.key(bi, bj))))
+                    }
+                };
+                if wins {
+                    best = Some((pr, c, i, j));
+                }
+            }
+        }
+        best.map(|(pr, _, i, j)| (i, j, pr))
+    }
+
+    /// The pair's tie tags, smaller first.
+    #[inline]
+    fn key(&self, i: usize, j: usize) -> (u64, u64) {
+        let (a, b) = (self.tag[i], self.tag[j]);
+        (a.min(b), a.max(b))
+    }
+
+    #[inline]
+    fn set(&mut self, i: usize, j: usize, (c, r): (u64, u32)) {
+        let (i, j) = (i.min(j), i.max(j));
+        self.cost[i][j] = c;
+        self.round[i][j] = r;
+    }
+}
+
+/// [`small::combine`](super::small::combine) for at most [`TINY`] bodies (more than `keep`).
+pub(super) fn run(
+    ctx: &Ctx,
+    body: &mut [Body],
+    parts: [Left; 2],
+    keep: usize,
+    out: &mut Out<'_>,
+    export: bool,
+) -> Left {
+    let [a, b] = parts;
+    let (ka, m) = (a.n, body.len());
+    debug_assert!(m <= TINY && keep >= 1 && keep < m && ka + b.n == m);
+    let seed = ctx.params.seed;
+    let mut st = SubStats::default();
+    let mut p = Pairs {
+        cost: [[0; TINY]; TINY],
+        round: [[NEVER; TINY]; TINY],
+        tag: [0; TINY],
+        live: [false; TINY],
+        m,
+    };
+    for (k, b) in body.iter().enumerate() {
+        p.tag[k] = tie_tag(seed, b.id);
+        p.live[k] = true;
+    }
+    // Each part's own pairs (copied when it brings them), then the pairs across the parts.
+    for (lo, hi, pairs) in [(0, ka, &a.pairs), (ka, m, &b.pairs)] {
+        let k = hi - lo;
+        let mut given = (pairs.len() == k * (k.max(1) - 1) / 2).then_some(pairs.iter());
+        for i in lo..hi {
+            for j in i + 1..hi {
+                let pair = match &mut given {
+                    Some(it) => *it.next().expect("k(k-1)/2 pairs"),
+                    None => {
+                        st.candidates += 1;
+                        eval(ctx, &body[i], &body[j])
+                    }
+                };
+                p.set(i, j, pair);
+            }
+        }
+    }
+    for i in 0..ka {
+        for j in ka..m {
+            p.set(i, j, eval(ctx, &body[i], &body[j]));
+        }
+    }
+    st.candidates += (ka * (m - ka)) as u64;
+    let mut round = 0u32;
+    st.eligible_pairs += p.eligible(round).0;
+    let w = ctx.params.weights;
+    for made in 0..m - keep {
+        let (i, j, r) = p.next(round).expect("more than one body is left");
+        assert!(r != NEVER, "bodies of NaN size never become eligible");
+        if r > round {
+            // Step 5 until this pair is eligible: a round start.
+            round = r;
+            st.eligible_pairs += p.eligible(round).0;
+        }
+        let (x, y) = (body[i], body[j]);
+        let merged = x.aabb.merge(&y.aabb);
+        let d = merged.diameter();
+        let active = d <= ctx.dl.at(round);
+        let new = out.first_new + made as u32;
+        st.pops += 1;
+        // The new body takes slot i (the smaller); slot j is gone.
+        body[i] = Body {
+            id: new,
+            rd: ctx.dl.first(d),
+            aabb: merged,
+            d,
+        };
+        p.tag[i] = tie_tag(seed, new);
+        p.live[j] = false;
+        for k in 0..m {
+            if p.live[k] && k != i {
+                p.set(i, k, eval(ctx, &body[i], &body[k]));
+                st.candidates += 1;
+            }
+        }
+        // What only events read.
+        let info = if out.listens() {
+            let (fill, balance) = fill_balance(d, x.d, y.d);
+            Info {
+                round,
+                fill,
+                balance,
+                cost: w.cost(d, fill, balance),
+                queue_len: p.eligible(round).1,
+                active,
+            }
+        } else {
+            Info::default()
+        };
+        out.put(made, [x.id.min(y.id), x.id.max(y.id)], merged, d, info);
+    }
+    st.rounds = round + 1;
+    out.stats.add(&st);
+    // Keep the live slots' bodies, in slot order, and their pairs.
+    let mut slots = [0usize; TINY];
+    let mut n = 0;
+    for k in (0..m).filter(|&k| p.live[k]) {
+        slots[n] = k;
+        n += 1;
+    }
+    let live = &slots[..n];
+    let pairs = if export {
+        let mut v = Vec::with_capacity(live.len() * (live.len() - 1) / 2);
+        for (x, &i) in live.iter().enumerate() {
+            v.extend(live[x + 1..].iter().map(|&j| (p.cost[i][j], p.round[i][j])));
+        }
+        v
+    } else {
+        Vec::new()
+    };
+    for (k, &i) in live.iter().enumerate() {
+        body[k] = body[i];
+    }
+    Left { n, pairs }
+}
