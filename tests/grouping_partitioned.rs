@@ -265,7 +265,7 @@ fn replay_verifies_a_partitioned_recording() {
     let dir = tempfile::tempdir().unwrap();
     let mut obj = Vec::new();
     // More primitives than the default root share (`Chunking::top`), so chunks are recorded.
-    generate::soup(6_000, 4).write_obj(&mut obj).unwrap();
+    generate::soup(10_000, 4).write_obj(&mut obj).unwrap();
     std::fs::write(dir.path().join("s.obj"), obj).unwrap();
     let scene = wraptree::scene::load_path(&dir.path().join("s.obj"), &LoadOptions::default())
         .unwrap()

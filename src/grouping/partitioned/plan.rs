@@ -18,14 +18,15 @@ pub struct Chunking {
 }
 
 impl Chunking {
-    /// AAC's fast setting, δ = 4, ε = 0.2, with a root step of about 4,096 bodies: on the
-    /// bench scenes (README) the root share brought the trees' SAH and node tests per query
-    /// to within 1 % of the exact schedule's on average (worst 6 %, against 4 % and 13 %
-    /// without it); scenes of at most 4,096 primitives get the exact schedule's tree.
+    /// AAC's fast setting, δ = 4, ε = 0.2, with a root step of about 8,192 bodies: on the
+    /// bench scenes (README) this root share brought the trees' SAH and node tests per query
+    /// to within 2 % of the exact schedule's on all but two of them (worst 3.7 %, against 6 %
+    /// with 4,096 and 13 % without it) for 1.6 % more instructions at 10^6 than 4,096; scenes
+    /// of at most 8,192 primitives get the exact schedule's tree.
     pub const DEFAULT: Chunking = Chunking {
         delta: 4,
         epsilon: 0.2,
-        top: 4096,
+        top: 8192,
     };
 
     /// The bodies a node of `n` primitives leaves for the level above: f(n), at least 1.
