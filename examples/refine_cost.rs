@@ -5,7 +5,7 @@
 //! `wraptree bench`). How the refinement's defaults were chosen.
 //!
 //! `cargo run --release --example refine_cost [MAX_SOUP] [REPEAT] [VARIANT ...]` — default
-//! 100000, 3 and the default refinement. A variant is `T:K:P:B[:G[:E[:after]]]`: T
+//! 100000, 3 and the default refinement; `scene=NAME` arguments keep only those scenes. A variant is `T:K:P:B[:G[:E[:after]]]`: T
 //! treelet passes of K leaves rooted at the nodes of at least G leaves on every E-th height
 //! (defaults: [`Tuning::default`]'s), then P reinsertion passes of first batch B (`after`: the
 //! treelet passes after them); `default` is the defaults.
@@ -64,9 +64,14 @@ fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let max_soup = args.first().map_or(Ok(100_000), |a| a.parse())?;
     let repeat: u32 = args.get(1).map_or(Ok(3), |a| a.parse())?;
+    let only: Vec<&str> = args
+        .iter()
+        .filter_map(|a| a.strip_prefix("scene="))
+        .collect();
     let mut variants = args
         .iter()
         .skip(2)
+        .filter(|a| !a.starts_with("scene="))
         .map(|a| parse(a))
         .collect::<anyhow::Result<Vec<_>>>()?;
     if variants.is_empty() {
@@ -82,7 +87,10 @@ fn main() -> anyhow::Result<()> {
         " | ref/PLOC SAH/best qry/best".repeat(variants.len())
     );
     let mut sums = vec![(0.0, 0.0, 0.0, 0.0f64, 0.0f64, 0.0f64); variants.len()];
-    let scenes = target_scenes(max_soup)?;
+    let mut scenes = target_scenes(max_soup)?;
+    if !only.is_empty() {
+        scenes.retain(|s| only.contains(&s.name.as_str()));
+    }
     for scene in &scenes {
         let workload = Workload::standard(scene, 1);
         let quality = |tree: &SubsetTree| {

@@ -1,6 +1,7 @@
 //! Refinement of a finished Subset Tree (the grouping's or any peer's): first treelet
-//! restructuring (Karras and Aila 2013, [`treelet`]): every treelet of up to 7 leaves rebuilt in
-//! its SAH-optimal shape, bottom-up; then subtrees are moved to where they lower the SAH
+//! restructuring (Karras and Aila 2013, [`treelet`]): the treelets of up to 7 leaves rooted at
+//! the nodes of at least 64 leaves (Karras and Aila's γ, [`Tuning`]) rebuilt in their SAH-optimal
+//! shape, bottom-up; then subtrees are moved to where they lower the SAH
 //! ([`crate::metrics::sah`]) most, by insertion-based optimisation (Bittner, Hapala and Havran
 //! 2013) in the parallel form of Meister and Bittner 2018 ([`reinsert`]).
 //!
@@ -56,8 +57,9 @@ pub struct RefineParams {
 }
 
 impl Default for RefineParams {
-    /// One treelet pass of 7 leaves, then 3 reinsertion passes, first batch = a tenth of the
-    /// nodes (see the README's refinement section for the measurements behind it).
+    /// One treelet pass of 7 leaves (rooted at the nodes of [`Tuning::default`]'s ≥ 64 leaves),
+    /// then 3 reinsertion passes, first batch = a tenth of the nodes (see the README's
+    /// refinement section for the measurements behind it).
     fn default() -> Self {
         RefineParams {
             passes: 3,
@@ -94,7 +96,8 @@ impl RefineParams {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Tuning {
     /// Treelets are rooted only at nodes whose subtree has at least this many leaves (Karras
-    /// and Aila's γ); 3 = every node that has more than one shape.
+    /// and Aila's γ; default 64: about 1/32 of the interior nodes, where a treelet pass over
+    /// every node costs 2–3 obvhs PLOC builds); 3 = every node that has more than one shape.
     pub treelet_min: u32,
     /// Treelets are rooted only at every `treelet_every`-th height from the bottom (heights 2,
     /// 2 + e, 2 + 2e, …; 1 = every height).
@@ -107,7 +110,7 @@ impl Default for Tuning {
     /// See the README's refinement section for the measurements behind it.
     fn default() -> Self {
         Tuning {
-            treelet_min: 3,
+            treelet_min: 64,
             treelet_every: 1,
             treelet_after: false,
         }

@@ -6,8 +6,9 @@
 //! the 2^k − 1 leaf subsets (each subset's best split among its partitions), and replaces the
 //! treelet when it lowers that sum. The treelet leaves and the nodes above `r` are untouched.
 //!
-//! One pass visits every interior node whose subtree has ≥ 3 leaves, bottom-up by height (as
-//! computed when the pass starts). Nodes of one height are never ancestors of each other, and a
+//! One pass visits every interior node whose subtree has ≥ γ leaves (at least 3;
+//! [`super::Tuning::treelet_min`]), on every height or every e-th
+//! ([`super::Tuning::treelet_every`]), bottom-up by height (as computed when the pass starts). Nodes of one height are never ancestors of each other, and a
 //! restructuring only reorders nodes inside its own root's subtree, so the treelets of one height
 //! are disjoint and independent: they are solved in parallel on the frozen tree (rayon, from
 //! [`PARALLEL_MIN`] treelets up) and applied in root-id order, which makes the result the same
