@@ -10,7 +10,7 @@ use wraptree::geom::P3;
 use wraptree::grouping::{CostMeasure, EventLog, Params, SubsetTree, group};
 use wraptree::metrics::sah;
 use wraptree::peers::{self, Method};
-use wraptree::refine::{RefineParams, Refined, StepKind, refine};
+use wraptree::refine::{RefineParams, Refined, StepKind, Tuning, refine, refine_tuned};
 use wraptree::scene::{LoadOptions, PrimitiveKind, Scene, generate, load_path};
 
 /// Every leaf once under the root, children before parents and inside them, boxes exact
@@ -50,34 +50,58 @@ fn check_valid(scene: &Scene, t: &SubsetTree) {
     }
 }
 
-fn refined(tree: &SubsetTree) -> (Refined, EventLog) {
-    refined_with(tree, &RefineParams::default())
-}
+/// Parameters and tuning of a refinement run.
+type Setup = (RefineParams, Tuning);
 
-fn refined_with(tree: &SubsetTree, params: &RefineParams) -> (Refined, EventLog) {
+fn refined(tree: &SubsetTree) -> (Refined, EventLog) {
     let mut log = EventLog::default();
-    let r = refine(tree, params, &mut log);
+    let r = refine(tree, &RefineParams::default(), &mut log);
     (r, log)
 }
 
-/// Treelet restructuring alone: `passes` treelet passes of `k` leaves, no reinsertion.
-fn treelets(k: u32, passes: u32) -> RefineParams {
-    RefineParams {
+fn refined_with(tree: &SubsetTree, (params, tuning): &Setup) -> (Refined, EventLog) {
+    let mut log = EventLog::default();
+    let r = refine_tuned(tree, params, tuning, &mut log);
+    (r, log)
+}
+
+/// Treelet restructuring alone: `passes` treelet passes of `k` leaves rooted at every node
+/// with more than one shape, no reinsertion.
+fn treelets(k: u32, passes: u32) -> Setup {
+    let params = RefineParams {
         passes: 0,
         treelet: k,
         treelet_passes: passes,
         ..RefineParams::default()
-    }
+    };
+    let tuning = Tuning {
+        treelet_min: 3,
+        treelet_every: 1,
+        treelet_after: false,
+    };
+    (params, tuning)
 }
 
 /// Checks a refinement of `tree` over `scene`: valid, SAH not above, events consistent.
 fn check_refinement(scene: &Scene, tree: &SubsetTree) -> Refined {
-    check_refinement_with(scene, tree, &RefineParams::default())
+    check_refinement_with(scene, tree, &(RefineParams::default(), Tuning::default()))
 }
 
-/// [`check_refinement`] with `params`.
-fn check_refinement_with(scene: &Scene, tree: &SubsetTree, params: &RefineParams) -> Refined {
-    let (r, log) = refined_with(tree, params);
+/// [`check_refinement`] with `setup`.
+fn check_refinement_with(scene: &Scene, tree: &SubsetTree, setup: &Setup) -> Refined {
+    let (r, log) = refined_with(tree, setup);
+    let (params, tuning) = setup;
+    // Treelet passes come first, or after every reinsertion pass (`after`).
+    let reinsert_passes = log
+        .refine
+        .iter()
+        .filter(|s| s.kind == StepKind::Move)
+        .map(|s| s.pass);
+    let first_treelet_pass = if tuning.treelet_after {
+        reinsert_passes.max().map_or(0, |p| p + 1)
+    } else {
+        0
+    };
     check_valid(scene, &r.tree);
     assert!(
         r.sah_after <= r.sah_before,
@@ -93,9 +117,11 @@ fn check_refinement_with(scene: &Scene, tree: &SubsetTree, params: &RefineParams
         assert_eq!(s.step as usize, i);
         assert!(s.sah < s.sah_before, "every kept step lowers the SAH");
         match s.kind {
+            StepKind::Move if tuning.treelet_after => assert!(s.pass < first_treelet_pass),
             StepKind::Move => assert!(s.pass >= params.treelet_passes),
             StepKind::Treelet { leaves } => {
-                assert!(s.pass < params.treelet_passes);
+                assert!(s.pass >= first_treelet_pass);
+                assert!(tuning.treelet_after || s.pass < params.treelet_passes);
                 assert!((3..=params.treelet).contains(&leaves), "{s:?}");
                 assert_eq!(
                     s.aabb, s.parent_aabb,
@@ -330,6 +356,18 @@ proptest! {
         let m = [Method::Grouping, Method::ParryBinned, Method::MedianSplit][which];
         let b = peers::build(m, &scene, &Params::default()).unwrap();
         check_refinement_with(&scene, &b.tree, &treelets(k, 2));
+    }
+
+    #[test]
+    fn any_tuning_gives_valid_trees(
+        scene in arb_scene(),
+        min in 3u32..=40,
+        every in 1u32..=3,
+        after in any::<bool>(),
+    ) {
+        let b = peers::build(Method::Grouping, &scene, &Params::default()).unwrap();
+        let tuning = Tuning { treelet_min: min, treelet_every: every, treelet_after: after };
+        check_refinement_with(&scene, &b.tree, &(RefineParams::default(), tuning));
     }
 }
 

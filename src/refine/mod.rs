@@ -1,6 +1,7 @@
 //! Refinement of a finished Subset Tree (the grouping's or any peer's): first treelet
-//! restructuring (Karras and Aila 2013, [`treelet`]): every treelet of up to 7 leaves rebuilt in
-//! its SAH-optimal shape, bottom-up; then subtrees are moved to where they lower the SAH
+//! restructuring (Karras and Aila 2013, [`treelet`]): the treelets of up to 7 leaves rooted at
+//! the nodes of at least 64 leaves (Karras and Aila's γ, [`Tuning`]) rebuilt in their SAH-optimal
+//! shape, bottom-up; then subtrees are moved to where they lower the SAH
 //! ([`crate::metrics::sah`]) most, by insertion-based optimisation (Bittner, Hapala and Havran
 //! 2013) in the parallel form of Meister and Bittner 2018 ([`reinsert`]).
 //!
@@ -56,8 +57,9 @@ pub struct RefineParams {
 }
 
 impl Default for RefineParams {
-    /// One treelet pass of 7 leaves, then 3 reinsertion passes, first batch = a tenth of the
-    /// nodes (see the README's refinement section for the measurements behind it).
+    /// One treelet pass of 7 leaves (rooted at the nodes of [`Tuning::default`]'s ≥ 64 leaves),
+    /// then 3 reinsertion passes, first batch = a tenth of the nodes (see the README's
+    /// refinement section for the measurements behind it).
     fn default() -> Self {
         RefineParams {
             passes: 3,
@@ -85,6 +87,33 @@ impl RefineParams {
             ));
         }
         Ok(())
+    }
+}
+
+/// Knobs of a refinement run that recordings do not name (so `record --refine` and
+/// `replay --verify` always use [`Tuning::default`]); for measuring variants
+/// (`examples/refine_cost.rs`) through [`refine_tuned`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tuning {
+    /// Treelets are rooted only at nodes whose subtree has at least this many leaves (Karras
+    /// and Aila's γ; default 64: about 1/32 of the interior nodes, where a treelet pass over
+    /// every node costs 2–3 obvhs PLOC builds); 3 = every node that has more than one shape.
+    pub treelet_min: u32,
+    /// Treelets are rooted only at every `treelet_every`-th height from the bottom (heights 2,
+    /// 2 + e, 2 + 2e, …; 1 = every height).
+    pub treelet_every: u32,
+    /// The treelet passes run after the reinsertion passes instead of before.
+    pub treelet_after: bool,
+}
+
+impl Default for Tuning {
+    /// See the README's refinement section for the measurements behind it.
+    fn default() -> Self {
+        Tuning {
+            treelet_min: 64,
+            treelet_every: 1,
+            treelet_after: false,
+        }
     }
 }
 
@@ -158,7 +187,17 @@ pub struct Refined {
 
 /// Refines `tree` (see the module doc), reporting the start ([`Event::RefineStart`]) and each
 /// kept step ([`Event::Refine`]) to `observer`.
-pub fn refine<O: Observer>(tree: &SubsetTree, params: &RefineParams, mut observer: O) -> Refined {
+pub fn refine<O: Observer>(tree: &SubsetTree, params: &RefineParams, observer: O) -> Refined {
+    refine_tuned(tree, params, &Tuning::default(), observer)
+}
+
+/// [`refine`] with other [`Tuning`] than the default.
+pub fn refine_tuned<O: Observer>(
+    tree: &SubsetTree,
+    params: &RefineParams,
+    tuning: &Tuning,
+    mut observer: O,
+) -> Refined {
     let sah_before = metrics::sah(tree);
     observer.on_event(&Event::RefineStart {
         params: *params,
@@ -185,11 +224,16 @@ pub fn refine<O: Observer>(tree: &SubsetTree, params: &RefineParams, mut observe
         observer: &mut observer,
     };
     let mut passes = 0u32;
-    for pass in 0..params.treelet_passes {
-        passes += 1;
-        if run.treelet_pass(pass, params.treelet as usize) == 0 {
-            break;
+    let treelets = |run: &mut Run<'_, O>, passes: &mut u32| {
+        for _ in 0..params.treelet_passes {
+            *passes += 1;
+            if run.treelet_pass(*passes - 1, params.treelet as usize, tuning) == 0 {
+                break;
+            }
         }
+    };
+    if !tuning.treelet_after {
+        treelets(&mut run, &mut passes);
     }
     let nodes = run.w.parent.len() - 1;
     for k in 0..params.passes {
@@ -199,6 +243,9 @@ pub fn refine<O: Observer>(tree: &SubsetTree, params: &RefineParams, mut observe
         if kept == 0 {
             break;
         }
+    }
+    if tuning.treelet_after {
+        treelets(&mut run, &mut passes);
     }
     let (w, steps) = (run.w, run.steps);
     if steps == 0 {
@@ -236,9 +283,11 @@ impl<O: Observer> Run<'_, O> {
 
     /// One treelet pass ([`treelet`]): every height's treelets solved on the frozen tree, then
     /// applied in root order. Returns the treelets rebuilt.
-    fn treelet_pass(&mut self, pass: u32, k: usize) -> u32 {
+    fn treelet_pass(&mut self, pass: u32, k: usize, tuning: &Tuning) -> u32 {
         let mut kept = 0;
-        for roots in treelet::by_height(&self.w) {
+        let every = tuning.treelet_every.max(1) as usize;
+        let levels = treelet::by_height(&self.w, tuning.treelet_min);
+        for roots in levels.into_iter().step_by(every) {
             for plan in treelet::solve_all(&self.w, &roots, k, self.min_gain) {
                 let sah_before = self.sah();
                 self.w.restructure(&plan);

@@ -14,26 +14,41 @@ use std::collections::BinaryHeap;
 pub fn subset_tree(w: &WorkTree, input: &SubsetTree) -> Result<SubsetTree, String> {
     let n = w.n as usize;
     let slots = w.children.len();
-    // Children of a slot not yet numbered: 0, 1 or 2.
-    let mut waiting = vec![0u8; slots];
-    let mut ready = BinaryHeap::new();
-    for (i, k) in w.children.iter().enumerate() {
-        waiting[i] = k.iter().filter(|&&c| !w.is_leaf(c)).count() as u8;
-        if waiting[i] == 0 {
-            ready.push(Reverse(i as u32));
-        }
-    }
+    // Children of a slot not yet numbered: 0, 1 or 2. The smallest ready slot comes next: a
+    // scan in id order finds the slots that are ready when it reaches them; the others, ready
+    // only after the scan passed them, wait in a heap (few where the input's order holds).
+    let mut waiting: Vec<u8> = w
+        .children
+        .iter()
+        .map(|k| k.iter().filter(|&&c| !w.is_leaf(c)).count() as u8)
+        .collect();
+    let mut late = BinaryHeap::new();
+    let mut scan = 0u32;
     let mut new_id = vec![0u32; slots];
     let mut order = Vec::with_capacity(slots);
-    while let Some(Reverse(i)) = ready.pop() {
+    loop {
+        while (scan as usize) < slots && waiting[scan as usize] != 0 {
+            scan += 1;
+        }
+        let i = match late.peek() {
+            Some(&Reverse(j)) if j < scan || scan as usize == slots => {
+                late.pop();
+                j
+            }
+            _ if (scan as usize) < slots => {
+                scan += 1;
+                scan - 1
+            }
+            _ => break,
+        };
         new_id[i as usize] = (n + order.len()) as u32;
         order.push(i);
         let p = w.parent[n + i as usize];
         if p != crate::grouping::NONE {
-            let j = p as usize - n;
-            waiting[j] -= 1;
-            if waiting[j] == 0 {
-                ready.push(Reverse(j as u32));
+            let j = p - n as u32;
+            waiting[j as usize] -= 1;
+            if waiting[j as usize] == 0 && j < scan {
+                late.push(Reverse(j));
             }
         }
     }

@@ -6,8 +6,9 @@
 //! the 2^k − 1 leaf subsets (each subset's best split among its partitions), and replaces the
 //! treelet when it lowers that sum. The treelet leaves and the nodes above `r` are untouched.
 //!
-//! One pass visits every interior node whose subtree has ≥ 3 leaves, bottom-up by height (as
-//! computed when the pass starts). Nodes of one height are never ancestors of each other, and a
+//! One pass visits every interior node whose subtree has ≥ γ leaves (at least 3;
+//! [`super::Tuning::treelet_min`]), on every height or every e-th
+//! ([`super::Tuning::treelet_every`]), bottom-up by height (as computed when the pass starts). Nodes of one height are never ancestors of each other, and a
 //! restructuring only reorders nodes inside its own root's subtree, so the treelets of one height
 //! are disjoint and independent: they are solved in parallel on the frozen tree (rayon, from
 //! [`PARALLEL_MIN`] treelets up) and applied in root-id order, which makes the result the same
@@ -40,9 +41,11 @@ pub struct Plan {
 }
 
 /// The interior nodes of the tree bottom-up by height (1 = both children leaves), only those of
-/// height ≥ 2 (a subtree of 2 leaves has one shape); each height's nodes in id order.
-pub fn by_height(w: &WorkTree) -> Vec<Vec<u32>> {
+/// height ≥ 2 (a subtree of 2 leaves has one shape) and of at least `min_leaves` leaves; each
+/// height's nodes in id order.
+pub fn by_height(w: &WorkTree, min_leaves: u32) -> Vec<Vec<u32>> {
     let mut height = vec![0u32; w.parent.len()];
+    let mut count = vec![1u32; w.parent.len()];
     let mut order = Vec::with_capacity(w.children.len());
     let mut stack = vec![w.root];
     while let Some(x) = stack.pop() {
@@ -56,7 +59,8 @@ pub fn by_height(w: &WorkTree) -> Vec<Vec<u32>> {
         let [a, b] = w.kids(x);
         let h = height[a as usize].max(height[b as usize]) + 1;
         height[x as usize] = h;
-        if h >= 2 {
+        count[x as usize] = count[a as usize] + count[b as usize];
+        if h >= 2 && count[x as usize] >= min_leaves {
             let i = h as usize - 2;
             if levels.len() <= i {
                 levels.resize_with(i + 1, Vec::new);
