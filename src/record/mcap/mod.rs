@@ -1,7 +1,7 @@
 //! Foxglove `.mcap` recordings of a grouping run ([`McapRecorder`]) and their reader
 //! ([`read_recording`], used by `wraptree replay`).
 //!
-//! The file is chunked, zstd-compressed (level 2, single-threaded, so the same run gives the
+//! The file is chunked, LZ4-compressed (fast mode, single-threaded, so the same run gives the
 //! same bytes on every machine) with chunk, data-section, summary and attachment CRCs. Geometry
 //! uses the well-known `foxglove.SceneUpdate` schema; grouping events use small typed protobuf
 //! messages derived with `foxglove::Encode` ([`messages`]). Message encoding is `protobuf`
@@ -51,8 +51,9 @@ use scene_msgs::SceneMesh;
 use std::collections::BTreeMap;
 use std::io::{Seek, Write};
 
-/// Zstd level of every chunk.
-pub const ZSTD_LEVEL: u32 = 2;
+/// LZ4 level of every chunk: 0, the fast (not high-compression) mode. On the 10^6-triangle
+/// recording it compresses 3× faster than zstd level 2, for chunks 16 % larger (README).
+pub const LZ4_LEVEL: u32 = 0;
 /// Target uncompressed chunk size.
 pub const CHUNK_SIZE: u64 = 1 << 20;
 /// Media type of the embedded scene.
@@ -160,9 +161,8 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
     /// holds them), but not yet the scene.
     pub fn start(writer: W, info: &RunInfo<'a>) -> Result<Self> {
         let options = mcap::WriteOptions::new()
-            .compression(Some(mcap::Compression::Zstd))
-            .compression_level(ZSTD_LEVEL)
-            .compression_threads(0)
+            .compression(Some(mcap::Compression::Lz4))
+            .compression_level(LZ4_LEVEL)
             .chunk_size(Some(CHUNK_SIZE))
             .use_chunks(true)
             .profile(PROFILE)

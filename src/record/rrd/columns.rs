@@ -5,7 +5,11 @@
 //! Every `send_columns` call becomes one chunk, and the SDK spends about 60 µs on each chunk
 //! whatever its size, so rows are sent together, one chunk per entity per batch.
 
-use rerun::{RecordingStream, TimeColumn};
+use std::fmt::Write as _;
+use std::sync::Arc;
+
+use rerun::external::arrow::array::StringBuilder;
+use rerun::{RecordingStream, SerializedComponentBatch, TimeColumn};
 
 use super::BoxF32;
 use crate::grouping::Merge;
@@ -64,10 +68,12 @@ pub(super) struct Columns {
     /// Per merge drawn, the pair's two boxes then the new body's.
     box_centers: Vec<[f32; 3]>,
     box_halves: Vec<[f32; 3]>,
-    /// `log/doublings` rows: (merge, round) ticks, lines and levels.
+    /// `log/doublings` rows: (merge, round) ticks, then lines and levels written straight into
+    /// the Arrow string columns sent (no `String` per line: a partitioned run logs one line per
+    /// part, hundreds of thousands at 10^6 primitives).
     text_ticks: Vec<(i64, i64)>,
-    text: Vec<String>,
-    text_levels: Vec<rerun::components::TextLogLevel>,
+    text: StringBuilder,
+    text_levels: StringBuilder,
     /// `grouping/active` rows: (merge, round) ticks and box count, then every row's boxes.
     active_rows: Vec<(i64, i64, usize)>,
     active_centers: Vec<[f32; 3]>,
@@ -107,12 +113,15 @@ impl Columns {
         &mut self,
         merge: u32,
         round: u32,
-        line: String,
-        level: rerun::components::TextLogLevel,
+        line: std::fmt::Arguments<'_>,
+        level: &str,
     ) {
         self.text_ticks.push((i64::from(merge), i64::from(round)));
-        self.text.push(line);
-        self.text_levels.push(level);
+        // Writing to a `StringBuilder` only appends bytes and cannot fail; `append_value` then
+        // ends the row.
+        let _ = self.text.write_fmt(line);
+        self.text.append_value("");
+        self.text_levels.append_value(level);
     }
 
     /// Buffers one `grouping/active` row: the boxes of the bodies active at a round start.
@@ -138,8 +147,8 @@ impl Columns {
         self.box_centers.clear();
         self.box_halves.clear();
         self.text_ticks.clear();
-        self.text.clear();
-        self.text_levels.clear();
+        self.text = StringBuilder::new();
+        self.text_levels = StringBuilder::new();
         self.active_rows.clear();
         self.active_centers.clear();
         self.active_halves.clear();
@@ -152,7 +161,7 @@ impl Columns {
     }
 
     /// Sends the buffered text lines and active sets, one chunk each.
-    fn send_rounds(&self, rec: &RecordingStream) -> anyhow::Result<()> {
+    fn send_rounds(&mut self, rec: &RecordingStream) -> anyhow::Result<()> {
         let ticks = |rows: &mut dyn Iterator<Item = (i64, i64)>| {
             let (merge, round): (Vec<i64>, Vec<i64>) = rows.unzip();
             [
@@ -160,11 +169,18 @@ impl Columns {
                 TimeColumn::new_sequence("round", round),
             ]
         };
-        if !self.text.is_empty() {
-            let log = rerun::TextLog::update_fields()
-                .with_many_text(self.text.iter().map(String::as_str))
-                .with_many_level(self.text_levels.iter().cloned())
-                .columns_of_unit_batches()?;
+        if !self.text_ticks.is_empty() {
+            // The same columns as `TextLog::update_fields().with_many_text(..)
+            // .with_many_level(..).columns_of_unit_batches()`, built without a `Text` per line.
+            let rows = self.text_ticks.len();
+            let column = |builder: &mut StringBuilder, descriptor| {
+                SerializedComponentBatch::new(Arc::new(builder.finish()), descriptor)
+                    .partitioned(std::iter::repeat_n(1, rows))
+            };
+            let log = [
+                column(&mut self.text, rerun::TextLog::descriptor_text())?,
+                column(&mut self.text_levels, rerun::TextLog::descriptor_level())?,
+            ];
             rec.send_columns(
                 "log/doublings",
                 ticks(&mut self.text_ticks.iter().copied()),

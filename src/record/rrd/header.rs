@@ -123,8 +123,9 @@ impl RrdRecorder {
             "incomplete: stopped ({reason}) after {} merges; no tree levels",
             outcome.merges
         );
-        let warn = rerun::components::TextLogLevel::from(rerun::TextLogLevel::WARN);
-        self.columns.push_text(self.merges, self.round, line, warn);
+        let warn = rerun::TextLogLevel::WARN;
+        self.columns
+            .push_text(self.merges, self.round, format_args!("{line}"), warn);
         let rec = self.rec()?;
         let text = |s: String| [rerun::components::Text::from(s)];
         rec.send_property(

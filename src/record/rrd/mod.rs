@@ -268,9 +268,9 @@ impl RrdRecorder {
         self.rec.as_ref().ok_or_else(closed)
     }
 
-    fn text(&mut self, round: u32, line: String) {
-        let info = rerun::components::TextLogLevel::from(rerun::TextLogLevel::INFO);
-        self.columns.push_text(self.merges, round, line, info);
+    fn text(&mut self, round: u32, line: std::fmt::Arguments<'_>) {
+        self.columns
+            .push_text(self.merges, round, line, rerun::TextLogLevel::INFO);
     }
 
     fn handle(&mut self, event: &Event<'_>) -> anyhow::Result<()> {
@@ -295,7 +295,7 @@ impl RrdRecorder {
                 } else {
                     String::new()
                 };
-                self.text(round, format!("round {round}: {limits}, {sets}{note}"));
+                self.text(round, format_args!("round {round}: {limits}, {sets}{note}"));
                 if self.detail.merges() {
                     // Above the cap the row is empty: it still clears the previous round's boxes.
                     let drawn = if capped { &active[..0] } else { active };
@@ -317,9 +317,19 @@ impl RrdRecorder {
                             m.new
                         );
                     }
-                    let pair = [self.body(m.a)?, self.body(m.b)?];
+                    // Only the drawn merges read their pair's boxes (a random access into
+                    // every body's box); the others check that the pair exists.
+                    let drawn = boxes_drawn(m.step, self.primitives);
+                    let pair = if drawn {
+                        Some([self.body(m.a)?, self.body(m.b)?])
+                    } else if m.a.max(m.b) as usize >= expected {
+                        let id = m.a.max(m.b);
+                        bail!("event names body {id}, which does not exist yet");
+                    } else {
+                        None
+                    };
                     self.boxes.push(new);
-                    boxes_drawn(m.step, self.primitives).then_some((pair, new))
+                    pair.map(|pair| (pair, new))
                 } else {
                     None
                 };
@@ -348,7 +358,7 @@ impl RrdRecorder {
                     self.refine.flush(rec)?;
                 }
             }
-            Event::Part(p) => self.text(self.round, p.to_string()),
+            Event::Part(p) => self.text(self.round, format_args!("{p}")),
             Event::Doubling {
                 round,
                 merges,
@@ -356,7 +366,7 @@ impl RrdRecorder {
                 glimit,
             } => {
                 let limits = format!("DLimit → {dlimit:.6e}, GLimit → {glimit:.6e}");
-                let line = format!("doubling after round {round} ({merges} merges): {limits}");
+                let line = format_args!("doubling after round {round} ({merges} merges): {limits}");
                 self.text(round, line);
             }
             Event::Finish {
@@ -365,7 +375,7 @@ impl RrdRecorder {
                 merges,
             } => {
                 let line =
-                    format!("finished: root {root} after {rounds} rounds and {merges} merges");
+                    format_args!("finished: root {root} after {rounds} rounds and {merges} merges");
                 self.text(self.round, line);
             }
         }
