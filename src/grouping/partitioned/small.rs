@@ -172,6 +172,109 @@ pub(super) fn eval(ctx: &Ctx, a: &Body, b: &Body) -> (u64, u32) {
     (order_bits(ctx.params.weights.cost(d, fill, balance)), round)
 }
 
+/// Every pair of `body` (`set(i, j, pair)`, `i < j`): each part's own pairs (copied when the
+/// part brings them, else evaluated), then the pairs across the parts; evaluations are counted.
+#[inline(always)]
+pub(super) fn pairs_of(
+    ctx: &Ctx,
+    body: &[Body],
+    parts: &[Left; 2],
+    st: &mut SubStats,
+    mut set: impl FnMut(usize, usize, (u64, u32)),
+) {
+    let (ka, m) = (parts[0].n, body.len());
+    for (lo, hi, pairs) in [(0, ka, &parts[0].pairs), (ka, m, &parts[1].pairs)] {
+        let k = hi - lo;
+        let mut given = (pairs.len() == k * (k.max(1) - 1) / 2).then_some(pairs.iter());
+        for i in lo..hi {
+            for j in i + 1..hi {
+                let pair = match &mut given {
+                    Some(it) => *it.next().expect("k(k-1)/2 pairs"),
+                    None => {
+                        st.candidates += 1;
+                        eval(ctx, &body[i], &body[j])
+                    }
+                };
+                set(i, j, pair);
+            }
+        }
+    }
+    for i in 0..ka {
+        for j in ka..m {
+            set(i, j, eval(ctx, &body[i], &body[j]));
+        }
+    }
+    st.candidates += (ka * (m - ka)) as u64;
+}
+
+/// The body made by merging `x` and `y`, with id `new`.
+#[inline(always)]
+pub(super) fn merged(ctx: &Ctx, x: &Body, y: &Body, new: u32) -> Body {
+    let aabb = x.aabb.merge(&y.aabb);
+    let d = aabb.diameter();
+    Body {
+        id: new,
+        rd: ctx.dl.first(d),
+        aabb,
+        d,
+    }
+}
+
+/// Writes merge `made` of `x` and `y` into `nb` in round `round` to `out`, with what only
+/// events read (Fill, Balance, Cost, `queue_len`) when someone listens.
+#[inline(always)]
+pub(super) fn put_merge(
+    ctx: &Ctx,
+    out: &mut Out<'_>,
+    made: usize,
+    [x, y]: [&Body; 2],
+    nb: &Body,
+    round: u32,
+    queue_len: impl FnOnce() -> u32,
+) {
+    let d = nb.d;
+    let info = if out.listens() {
+        let (fill, balance) = fill_balance(d, x.d, y.d);
+        Info {
+            round,
+            fill,
+            balance,
+            cost: ctx.params.weights.cost(d, fill, balance),
+            queue_len: queue_len(),
+            active: d <= ctx.dl.at(round),
+        }
+    } else {
+        Info::default()
+    };
+    out.put(made, [x.id.min(y.id), x.id.max(y.id)], nb.aabb, d, info);
+}
+
+/// Moves the bodies of the `live` slots (increasing) to the start of `body` and returns them,
+/// with their pairs (`pair(i, j)`, row by row) when `export`.
+pub(super) fn leave(
+    body: &mut [Body],
+    live: &[usize],
+    export: bool,
+    pair: impl Fn(usize, usize) -> (u64, u32),
+) -> Left {
+    let pairs = if export {
+        let mut v = Vec::with_capacity(live.len() * (live.len() - 1) / 2);
+        for (x, &i) in live.iter().enumerate() {
+            v.extend(live[x + 1..].iter().map(|&j| pair(i, j)));
+        }
+        v
+    } else {
+        Vec::new()
+    };
+    for (k, &i) in live.iter().enumerate() {
+        body[k] = body[i];
+    }
+    Left {
+        n: live.len(),
+        pairs,
+    }
+}
+
 /// Groups the bodies of `body` (at most [`SMALL`]: the first `parts[0].n` of one half, then
 /// `parts[1].n` of the other) until `keep` remain, writing merge `i` to `out` at index `i`
 /// with new id `first_new + i`; the bodies left end up at the start of `body`. Returns how many,
@@ -208,12 +311,9 @@ fn run(
     export: bool,
     t: &mut Table,
 ) -> Left {
-    let [a, b] = parts;
-    let ka = a.n;
     let m = body.len();
-    debug_assert!(m <= SMALL && keep >= 1 && ka + b.n == m);
+    debug_assert!(m <= SMALL && keep >= 1 && parts[0].n + parts[1].n == m);
     let mut st = SubStats::default();
-    let w = ctx.params.weights;
     let seed = ctx.params.seed;
     t.m = m;
     if t.cost.len() < m * m {
@@ -229,32 +329,10 @@ fn run(
     // Not scanned yet: every row is scanned at the first round start.
     t.next.clear();
     t.next.resize(m, 0);
-    // Each part's own pairs (copied when it brings them), then the pairs across the parts.
-    for (lo, hi, pairs) in [(0, ka, &a.pairs), (ka, m, &b.pairs)] {
-        let k = hi - lo;
-        let mut given = (pairs.len() == k * (k.max(1) - 1) / 2).then_some(pairs.iter());
-        for i in lo..hi {
-            for j in i + 1..hi {
-                let (c, r) = match &mut given {
-                    Some(it) => *it.next().expect("k(k-1)/2 pairs"),
-                    None => {
-                        st.candidates += 1;
-                        eval(ctx, &body[i], &body[j])
-                    }
-                };
-                (t.cost[i * m + j], t.round[i * m + j]) = (c, r);
-                (t.cost[j * m + i], t.round[j * m + i]) = (c, r);
-            }
-        }
-    }
-    for i in 0..ka {
-        for j in ka..m {
-            let (c, r) = eval(ctx, &body[i], &body[j]);
-            (t.cost[i * m + j], t.round[i * m + j]) = (c, r);
-            (t.cost[j * m + i], t.round[j * m + i]) = (c, r);
-        }
-    }
-    st.candidates += (ka * (m - ka)) as u64;
+    pairs_of(ctx, body, &parts, &mut st, |i, j, (c, r)| {
+        (t.cost[i * m + j], t.round[i * m + j]) = (c, r);
+        (t.cost[j * m + i], t.round[j * m + i]) = (c, r);
+    });
     let mut round = 0u32;
     let mut made = 0usize;
     let mut fresh = true;
@@ -280,18 +358,10 @@ fn run(
         };
         let (i, j) = (i.min(j), i.max(j));
         let (a, b) = (body[i], body[j]);
-        let merged = a.aabb.merge(&b.aabb);
-        let d = merged.diameter();
-        let active = d <= ctx.dl.at(round);
         let new = out.first_new + made as u32;
         st.pops += 1;
         // The new body takes slot i; slot j is gone.
-        body[i] = Body {
-            id: new,
-            rd: ctx.dl.first(d),
-            aabb: merged,
-            d,
-        };
+        body[i] = merged(ctx, &a, &b, new);
         t.tag[i] = tie_tag(seed, new);
         t.live.retain(|&k| k != j);
         for &k in &t.live {
@@ -322,45 +392,15 @@ fn run(
             }
         }
         t.scan_row(i, round);
-        // What only events read.
-        let info = if out.listens() {
-            let (fill, balance) = fill_balance(d, a.d, b.d);
-            Info {
-                round,
-                fill,
-                balance,
-                cost: w.cost(d, fill, balance),
-                queue_len: t.live.iter().filter(|&&k| t.best[k] != NO).count() as u32,
-                active,
-            }
-        } else {
-            Info::default()
-        };
-        out.put(made, [a.id.min(b.id), a.id.max(b.id)], merged, d, info);
+        put_merge(ctx, out, made, [&a, &b], &body[i], round, || {
+            t.live.iter().filter(|&&k| t.best[k] != NO).count() as u32
+        });
         made += 1;
     }
     st.rounds = round + 1;
     out.stats.add(&st);
     // Keep the live slots' bodies, in slot order (`live` is increasing), and their pairs.
-    let pairs = if export {
-        let l = &t.live;
-        let mut p = Vec::with_capacity(l.len() * (l.len() - 1) / 2);
-        for (x, &i) in l.iter().enumerate() {
-            p.extend(
-                l[x + 1..]
-                    .iter()
-                    .map(|&j| (t.cost[i * m + j], t.round[i * m + j])),
-            );
-        }
-        p
-    } else {
-        Vec::new()
-    };
-    for (k, &i) in t.live.iter().enumerate() {
-        body[k] = body[i];
-    }
-    Left {
-        n: t.live.len(),
-        pairs,
-    }
+    leave(body, &t.live, export, |i, j| {
+        (t.cost[i * m + j], t.round[i * m + j])
+    })
 }

@@ -9,9 +9,9 @@
 //! counters (eligible pairs at each round start, candidates, pops, rounds) and the events'
 //! queue length (bodies with an eligible partner after the merge) are those of `small`.
 
-use super::small::{NEVER, eval};
-use super::{Body, Ctx, Info, Left, Out, SubStats};
-use crate::grouping::cluster::{fill_balance, tie_tag};
+use super::small::{NEVER, eval, leave, merged, pairs_of, put_merge};
+use super::{Body, Ctx, Left, Out, SubStats};
+use crate::grouping::cluster::tie_tag;
 
 /// The most bodies a subproblem may have to be solved here.
 pub(super) const TINY: usize = 8;
@@ -87,9 +87,8 @@ pub(super) fn run(
     out: &mut Out<'_>,
     export: bool,
 ) -> Left {
-    let [a, b] = parts;
-    let (ka, m) = (a.n, body.len());
-    debug_assert!(m <= TINY && keep >= 1 && keep < m && ka + b.n == m);
+    let m = body.len();
+    debug_assert!(m <= TINY && keep >= 1 && keep < m && parts[0].n + parts[1].n == m);
     let seed = ctx.params.seed;
     let mut st = SubStats::default();
     let mut p = Pairs {
@@ -103,32 +102,9 @@ pub(super) fn run(
         p.tag[k] = tie_tag(seed, b.id);
         p.live[k] = true;
     }
-    // Each part's own pairs (copied when it brings them), then the pairs across the parts.
-    for (lo, hi, pairs) in [(0, ka, &a.pairs), (ka, m, &b.pairs)] {
-        let k = hi - lo;
-        let mut given = (pairs.len() == k * (k.max(1) - 1) / 2).then_some(pairs.iter());
-        for i in lo..hi {
-            for j in i + 1..hi {
-                let pair = match &mut given {
-                    Some(it) => *it.next().expect("k(k-1)/2 pairs"),
-                    None => {
-                        st.candidates += 1;
-                        eval(ctx, &body[i], &body[j])
-                    }
-                };
-                p.set(i, j, pair);
-            }
-        }
-    }
-    for i in 0..ka {
-        for j in ka..m {
-            p.set(i, j, eval(ctx, &body[i], &body[j]));
-        }
-    }
-    st.candidates += (ka * (m - ka)) as u64;
+    pairs_of(ctx, body, &parts, &mut st, |i, j, pair| p.set(i, j, pair));
     let mut round = 0u32;
     st.eligible_pairs += p.eligible(round).0;
-    let w = ctx.params.weights;
     for made in 0..m - keep {
         let (i, j, r) = p.next(round).expect("more than one body is left");
         assert!(r != NEVER, "bodies of NaN size never become eligible");
@@ -138,18 +114,10 @@ pub(super) fn run(
             st.eligible_pairs += p.eligible(round).0;
         }
         let (x, y) = (body[i], body[j]);
-        let merged = x.aabb.merge(&y.aabb);
-        let d = merged.diameter();
-        let active = d <= ctx.dl.at(round);
         let new = out.first_new + made as u32;
         st.pops += 1;
         // The new body takes slot i (the smaller); slot j is gone.
-        body[i] = Body {
-            id: new,
-            rd: ctx.dl.first(d),
-            aabb: merged,
-            d,
-        };
+        body[i] = merged(ctx, &x, &y, new);
         p.tag[i] = tie_tag(seed, new);
         p.live[j] = false;
         for k in 0..m {
@@ -158,21 +126,9 @@ pub(super) fn run(
                 st.candidates += 1;
             }
         }
-        // What only events read.
-        let info = if out.listens() {
-            let (fill, balance) = fill_balance(d, x.d, y.d);
-            Info {
-                round,
-                fill,
-                balance,
-                cost: w.cost(d, fill, balance),
-                queue_len: p.eligible(round).1,
-                active,
-            }
-        } else {
-            Info::default()
-        };
-        out.put(made, [x.id.min(y.id), x.id.max(y.id)], merged, d, info);
+        put_merge(ctx, out, made, [&x, &y], &body[i], round, || {
+            p.eligible(round).1
+        });
     }
     st.rounds = round + 1;
     out.stats.add(&st);
@@ -183,18 +139,7 @@ pub(super) fn run(
         slots[n] = k;
         n += 1;
     }
-    let live = &slots[..n];
-    let pairs = if export {
-        let mut v = Vec::with_capacity(live.len() * (live.len() - 1) / 2);
-        for (x, &i) in live.iter().enumerate() {
-            v.extend(live[x + 1..].iter().map(|&j| (p.cost[i][j], p.round[i][j])));
-        }
-        v
-    } else {
-        Vec::new()
-    };
-    for (k, &i) in live.iter().enumerate() {
-        body[k] = body[i];
-    }
-    Left { n, pairs }
+    leave(body, &slots[..n], export, |i, j| {
+        (p.cost[i][j], p.round[i][j])
+    })
 }
