@@ -108,7 +108,10 @@ fn tick(v: f64, log: bool) -> String {
     let x = if log { 10f64.powf(v) } else { v };
     let a = x.abs();
     if a != 0.0 && !(1e-3..1e5).contains(&a) {
-        format!("{x:.0e}")
+        // Three significant digits, so that close ticks (1.05e5, 1.1e5) stay apart.
+        let e = format!("{x:.2e}");
+        let (m, exp) = e.split_once('e').expect("{:e} has an exponent");
+        format!("{}e{exp}", m.trim_end_matches('0').trim_end_matches('.'))
     } else if a >= 100.0 {
         format!("{x:.0}")
     } else if a >= 1.0 {
@@ -343,6 +346,15 @@ mod tests {
             (3.0, 1.0),
         ];
         assert_eq!(pareto_front(&pts), vec![0, 1, 3]);
+    }
+
+    #[test]
+    fn close_large_ticks_get_distinct_labels() {
+        assert_eq!(tick(1.05e5, false), "1.05e5");
+        assert_eq!(tick(1.1e5, false), "1.1e5");
+        assert_eq!(tick(2e6, false), "2e6");
+        assert_eq!(tick(2.0, true), "100");
+        assert_eq!(tick(0.0005, false), "5e-4");
     }
 
     #[test]
