@@ -143,9 +143,17 @@ fn exact_schedule_is_the_same_with_the_parallel_scan() {
 #[test]
 fn a_scene_smaller_than_a_chunk_gets_the_exact_tree() {
     // The default chunk (δ = 4) and a wide one, so that the brute-force step meets scenes of
-    // up to 63 primitives.
+    // up to 63 primitives; and a root share of 40, whose scenes of up to 60 primitives are one
+    // subproblem ([`Chunking::whole`]).
     for (chunking, max_n) in [
         (Chunking::DEFAULT, Chunking::DEFAULT.delta as usize),
+        (
+            Chunking {
+                top: 40,
+                ..Chunking::DEFAULT
+            },
+            60,
+        ),
         (
             Chunking {
                 delta: 64,
@@ -264,8 +272,10 @@ fn a_stopped_run_reports_a_prefix_of_the_merges() {
 fn replay_verifies_a_partitioned_recording() {
     let dir = tempfile::tempdir().unwrap();
     let mut obj = Vec::new();
-    // More primitives than the default root share (`Chunking::top`), so chunks are recorded.
-    generate::soup(10_000, 4).write_obj(&mut obj).unwrap();
+    // More primitives than one subproblem takes (`Chunking::whole`), so chunks are recorded.
+    let n = 13_000;
+    assert!(!Chunking::DEFAULT.whole(n));
+    generate::soup(n, 4).write_obj(&mut obj).unwrap();
     std::fs::write(dir.path().join("s.obj"), obj).unwrap();
     let scene = wraptree::scene::load_path(&dir.path().join("s.obj"), &LoadOptions::default())
         .unwrap()

@@ -4,7 +4,8 @@
 //! Clustering").
 //!
 //! 1. The primitives are sorted by the Morton code of their box centres (21 bits per axis over
-//!    the box of the centres; ties by id).
+//!    the cube on the longest side of the centres' box, so that a code's bits follow distance
+//!    alike on every axis; ties by id).
 //! 2. The sorted range is split top-down at its highest differing Morton bit (at the middle
 //!    when every code is equal) until a range holds fewer than δ = [`Chunking::delta`]
 //!    primitives: a *chunk*.
@@ -24,7 +25,8 @@
 //! subproblem's result depends only on its bodies, and merge steps are numbered in the split's
 //! post-order (left half, right half, then the node's own merges), fixed before any grouping
 //! starts, so the tree is identical for any number of threads. A scene of fewer than δ
-//! primitives, or of at most `top`, is one subproblem: the exact schedule's tree.
+//! primitives, or of at most 1.5 × `top` ([`Chunking::whole`]), is one subproblem: the exact
+//! schedule's tree.
 //!
 //! Events: after the grouping, each subproblem that merges anything is announced, in that
 //! post-order, by [`Event::Part`] (`Chunk { level, keep }`, the root `Top`), followed by its
@@ -260,8 +262,10 @@ pub fn group_with<O: Observer>(
     };
     let merges = n - 1;
     let mut children = vec![[0u32; 2]; merges];
-    aabb.resize(2 * n - 1, Aabb::EMPTY);
-    diameter.resize(2 * n - 1, 0.0);
+    // The merges' slots, filled on every thread (fresh pages are written, and faulted in, in
+    // parallel).
+    aabb.par_extend(rayon::iter::repeat_n(Aabb::EMPTY, n - 1));
+    diameter.par_extend(rayon::iter::repeat_n(0.0, n - 1));
     let listens = !observer.is_silent();
     let mut info = if listens {
         vec![Info::default(); merges]
@@ -275,14 +279,18 @@ pub fn group_with<O: Observer>(
         done: &done,
     };
     // The leaves as bodies in Morton order: one gather (its loads overlap) instead of one per
-    // chunk; `rd` is set by their chunk.
+    // chunk, of the box alone (the diameter is recomputed, the same value, rather than read at
+    // random from a second array); `rd` is set by their chunk.
     let mut leaves: Vec<Body> = codes
         .par_iter()
-        .map(|&(_, id)| Body {
-            id,
-            rd: 0,
-            aabb: aabb[id as usize],
-            d: diameter[id as usize],
+        .map(|&(_, id)| {
+            let aabb = aabb[id as usize];
+            Body {
+                id,
+                rd: 0,
+                aabb,
+                d: aabb.diameter(),
+            }
         })
         .collect();
     drop(codes);
@@ -318,10 +326,10 @@ pub fn group_with<O: Observer>(
                 id: part,
                 kind,
                 bodies: node.inputs,
-                first_step: node.own_step,
+                first_step: emitted,
             }));
             part += 1;
-            for step in node.own_step..node.own_step + made {
+            for step in emitted..emitted + made {
                 let s = step as usize;
                 let new = (n + s) as u32;
                 let i = info[s];
@@ -405,7 +413,7 @@ impl Exec<'_> {
         export: bool,
     ) -> (Option<Left>, SubStats) {
         let node = self.nodes[k as usize];
-        let (parts, mut own, mut stats) = match node.kids {
+        let (parts, mut own, mut stats) = match node.kids(k) {
             None => {
                 for b in arena.iter_mut() {
                     b.rd = self.ctx.dl.first(b.d);
