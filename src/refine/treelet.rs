@@ -46,16 +46,24 @@ pub struct Plan {
 pub fn by_height(w: &WorkTree, min_leaves: u32) -> Vec<Vec<u32>> {
     let mut height = vec![0u32; w.parent.len()];
     let mut count = vec![1u32; w.parent.len()];
-    let mut order = Vec::with_capacity(w.children.len());
-    let mut stack = vec![w.root];
-    while let Some(x) = stack.pop() {
-        if !w.is_leaf(x) {
-            order.push(x);
-            stack.extend(w.kids(x));
+    // Children before parents: the slots in id order while the work tree still has the
+    // Subset Tree's order (a sequential scan), else a reversed depth-first order.
+    let order: Vec<u32> = if w.topological {
+        (w.n..w.n + w.children.len() as u32).collect()
+    } else {
+        let mut order = Vec::with_capacity(w.children.len());
+        let mut stack = vec![w.root];
+        while let Some(x) = stack.pop() {
+            if !w.is_leaf(x) {
+                order.push(x);
+                stack.extend(w.kids(x));
+            }
         }
-    }
+        order.reverse();
+        order
+    };
     let mut levels: Vec<Vec<u32>> = Vec::new();
-    for &x in order.iter().rev() {
+    for &x in &order {
         let [a, b] = w.kids(x);
         let h = height[a as usize].max(height[b as usize]) + 1;
         height[x as usize] = h;
@@ -261,6 +269,7 @@ impl WorkTree {
     /// slots, the running interior sum kept in step, changed leaf sets marked. The root's box
     /// is its leaves' union either way, so nothing above it changes.
     pub fn restructure(&mut self, plan: &Plan) {
+        self.topological = false;
         for &(x, kids, bx, changed) in &plan.nodes {
             let i = (x - self.n) as usize;
             self.children[i] = kids;

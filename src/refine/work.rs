@@ -39,6 +39,9 @@ pub struct WorkTree {
     pub interior: f64,
     /// Whether an interior slot's leaf set changed (its diameter is then recomputed).
     pub changed: Vec<bool>,
+    /// Whether every interior slot's interior children still have smaller ids (true until the
+    /// first move or rebuilt treelet, as in the Subset Tree it was made from).
+    pub topological: bool,
     /// Scratch marks for [`WorkTree::reinsert`] (all false between calls).
     mark: Vec<bool>,
 }
@@ -57,6 +60,7 @@ impl WorkTree {
             area,
             root: tree.root(),
             changed: vec![false; tree.children.len()],
+            topological: true,
             mark: vec![false; tree.len()],
         }
     }
@@ -129,6 +133,7 @@ impl WorkTree {
     /// `node` is not the root, and `target` is neither `node`'s parent or sibling nor under
     /// `node`. Moving `node` back next to `s` undoes it exactly.
     pub fn reinsert(&mut self, node: u32, target: u32) -> Moved {
+        self.topological = false;
         let p = self.parent[node as usize];
         let s = self.sibling(node);
         let g = self.parent[p as usize];
