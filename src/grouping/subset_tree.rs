@@ -2,99 +2,9 @@
 //! interior nodes (ids `N..2N−1`, merge order) made by the grouping phase.
 
 use crate::geom::Aabb;
-use rayon::prelude::*;
-use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Marker for "no node" (the root's parent).
 pub const NONE: u32 = u32::MAX;
-
-/// Trees of at least this many nodes find parents and depths on every thread of the pool.
-const PAR_NODES: usize = 1 << 16;
-
-/// Subtrees this many levels below the root are walked on their own threads.
-const PAR_LEVELS: u32 = 6;
-
-/// Every node's parent and depth from the children of the interior nodes, or why they do not
-/// form one binary tree whose children precede their parents (the first bad merge).
-fn links_seq(children: &[[u32; 2]]) -> Result<(Vec<u32>, Vec<u32>), String> {
-    let n = children.len() + 1;
-    let total = 2 * n - 1;
-    let mut parent = vec![NONE; total];
-    for (i, &[a, b]) in children.iter().enumerate() {
-        let new = (n + i) as u32;
-        for c in [a, b] {
-            if c >= new || parent[c as usize] != NONE || a == b {
-                return Err(format!(
-                    "merge {i} ({a}, {b}) reuses or forward-references a body"
-                ));
-            }
-            parent[c as usize] = new;
-        }
-    }
-    let mut depth = vec![0u32; total];
-    for node in (0..total - 1).rev() {
-        depth[node] = depth[parent[node] as usize] + 1;
-    }
-    Ok((parent, depth))
-}
-
-/// [`links_seq`] on the pool's threads: the same parents and depths, or `None` when the
-/// children do not form such a tree (then [`links_seq`] names the first bad merge).
-fn links_par(children: &[[u32; 2]]) -> Option<(Vec<u32>, Vec<u32>)> {
-    let n = children.len() + 1;
-    let total = 2 * n - 1;
-    let mut parent = Vec::with_capacity(total);
-    parent.par_extend(rayon::iter::repeat_n(NONE, total));
-    let valid = {
-        let slots = as_atomic(&mut parent);
-        children.par_iter().enumerate().all(|(i, &[a, b])| {
-            let new = (n + i) as u32;
-            a != b
-                && [a, b]
-                    .iter()
-                    .all(|&c| c < new && slots[c as usize].swap(new, Ordering::Relaxed) == NONE)
-        })
-    };
-    // Each of the N − 1 merges claimed two distinct earlier nodes, so exactly the root is left
-    // without a parent: the merges form one tree.
-    if !valid {
-        return None;
-    }
-    let mut depth = Vec::with_capacity(total);
-    depth.par_extend(rayon::iter::repeat_n(0u32, total));
-    walk_depths(children, n, (total - 1) as u32, 0, as_atomic(&mut depth));
-    Some((parent, depth))
-}
-
-/// Sets the depth of `node` (at `d`) and of every node below it.
-fn walk_depths(children: &[[u32; 2]], n: usize, node: u32, d: u32, depth: &[AtomicU32]) {
-    let kids = |x: u32| (x as usize >= n).then(|| children[x as usize - n]);
-    if d < PAR_LEVELS {
-        depth[node as usize].store(d, Ordering::Relaxed);
-        if let Some([a, b]) = kids(node) {
-            rayon::join(
-                || walk_depths(children, n, a, d + 1, depth),
-                || walk_depths(children, n, b, d + 1, depth),
-            );
-        }
-        return;
-    }
-    let mut stack = vec![(node, d)];
-    while let Some((x, dx)) = stack.pop() {
-        depth[x as usize].store(dx, Ordering::Relaxed);
-        if let Some([a, b]) = kids(x) {
-            stack.push((b, dx + 1));
-            stack.push((a, dx + 1));
-        }
-    }
-}
-
-/// `v` as atomics, so that threads can write disjoint or contended slots of it.
-fn as_atomic(v: &mut [u32]) -> &[AtomicU32] {
-    // SAFETY: `AtomicU32` has the same size, alignment and bit validity as `u32`, and the
-    // exclusive borrow of `v` guarantees no other access for the returned lifetime.
-    unsafe { &*(v as *mut [u32] as *const [AtomicU32]) }
-}
 
 /// A binary Subset Tree with each node's AABB p-set wrapper and diameter.
 #[derive(Clone, Debug, PartialEq)]
@@ -145,14 +55,22 @@ impl SubsetTree {
                 diameter.len()
             ));
         }
-        let (parent, depth) = if total >= PAR_NODES && rayon::current_num_threads() > 1 {
-            match links_par(&children) {
-                Some(links) => links,
-                None => links_seq(&children)?,
+        let mut parent = vec![NONE; total];
+        for (i, &[a, b]) in children.iter().enumerate() {
+            let new = (n + i) as u32;
+            for c in [a, b] {
+                if c >= new || parent[c as usize] != NONE || a == b {
+                    return Err(format!(
+                        "merge {i} ({a}, {b}) reuses or forward-references a body"
+                    ));
+                }
+                parent[c as usize] = new;
             }
-        } else {
-            links_seq(&children)?
-        };
+        }
+        let mut depth = vec![0u32; total];
+        for node in (0..total - 1).rev() {
+            depth[node] = depth[parent[node] as usize] + 1;
+        }
         Ok(SubsetTree {
             n: n as u32,
             parent,
@@ -240,47 +158,5 @@ impl SubsetTree {
             .iter()
             .map(|&p| if p == NONE { -1 } else { p as i64 })
             .collect()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use rand::{Rng, SeedableRng};
-
-    /// Merges of `n` leaves by random pairs of the bodies left (a shuffled, unbalanced tree).
-    fn random_merges(n: usize, seed: u64) -> Vec<[u32; 2]> {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        let mut open: Vec<u32> = (0..n as u32).collect();
-        (0..n - 1)
-            .map(|i| {
-                let a = open.swap_remove(rng.random_range(0..open.len()));
-                let b = open.swap_remove(rng.random_range(0..open.len()));
-                open.push((n + i) as u32);
-                [a, b]
-            })
-            .collect()
-    }
-
-    #[test]
-    fn parallel_links_equal_sequential_ones() {
-        let children = random_merges(PAR_NODES, 7);
-        let want = links_seq(&children).unwrap();
-        for t in [1, 2, 3] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(t)
-                .build()
-                .unwrap();
-            assert_eq!(pool.install(|| links_par(&children)), Some(want.clone()));
-        }
-        let mut bad = children.clone();
-        bad[PAR_NODES / 2][1] = bad[PAR_NODES / 3][0];
-        assert_eq!(links_par(&bad), None);
-        let err = links_seq(&bad).unwrap_err();
-        assert!(err.contains(&format!("merge {}", PAR_NODES / 2)), "{err}");
-        let mut forward = children;
-        forward[3][0] = (2 * PAR_NODES - 2) as u32;
-        assert_eq!(links_par(&forward), None);
-        assert!(links_seq(&forward).is_err());
     }
 }
