@@ -6,6 +6,7 @@
 
 pub mod distance;
 pub mod hull;
+pub mod morton;
 pub mod pca;
 pub mod sphere;
 

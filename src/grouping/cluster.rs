@@ -12,6 +12,7 @@ use super::subset_tree::{NONE, SubsetTree};
 use super::voxel_hash::VoxelHash;
 use super::{Budget, Grouping, PSet, ResolvedParams, Stats, StopReason, Stopped};
 use crate::geom::Aabb;
+use crate::geom::morton::spread_bits;
 use crate::scene::Scene;
 use std::sync::atomic::Ordering;
 
@@ -22,7 +23,7 @@ mod scan;
 
 pub(crate) use boxes::{run_boxes, run_boxes_until};
 pub(in crate::grouping) use fill::{box_area, fill_balance};
-pub(in crate::grouping) use keys::{spread_bits, tie_tag};
+pub(in crate::grouping) use keys::tie_tag;
 
 /// Runs the grouping phase; see the module doc of [`super`] for the steps.
 pub(super) fn run<O: Observer>(

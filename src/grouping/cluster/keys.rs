@@ -1,4 +1,4 @@
-//! Per-body keys: seeded tie tags and Morton codes' bit spreading.
+//! Per-body keys: seeded tie tags.
 
 /// splitmix64: the seeded tie tag of a body id.
 pub(in crate::grouping) fn tie_tag(seed: Option<u64>, id: u32) -> u64 {
@@ -11,15 +11,4 @@ pub(in crate::grouping) fn tie_tag(seed: Option<u64>, id: u32) -> u64 {
             z ^ (z >> 31)
         }
     }
-}
-
-/// Spreads the low 21 bits of `v` to every third bit.
-pub(in crate::grouping) fn spread_bits(v: u64) -> u64 {
-    let mut x = v & 0x1f_ffff;
-    x = (x | x << 32) & 0x001f_0000_0000_ffff;
-    x = (x | x << 16) & 0x001f_0000_ff00_00ff;
-    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
-    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
-    x = (x | x << 2) & 0x1249_2492_4924_9249;
-    x
 }

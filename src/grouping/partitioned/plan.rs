@@ -2,7 +2,7 @@
 //! tree of chunks over it.
 
 use crate::geom::Aabb;
-use crate::grouping::cluster::spread_bits;
+use crate::geom::morton::spread_bits;
 use rayon::prelude::*;
 
 /// The split's parameters: chunk size δ, the reduction function's ε (AAC §3) and the root's share.
