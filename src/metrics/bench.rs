@@ -122,6 +122,14 @@ pub struct RefineRow {
     pub sah_per_best: f64,
     /// Node tests per query / the best of the same two.
     pub query_per_best: f64,
+    /// The partitioned grouping + refinement: time (s).
+    pub part_total_seconds: f64,
+    /// Its refinement time alone / obvhs PLOC build time.
+    pub part_refine_per_ploc: f64,
+    /// Its SAH / the best peer's (as `sah_per_best`).
+    pub part_sah_per_best: f64,
+    /// Its node tests per query / the best peer's (as `query_per_best`).
+    pub part_query_per_best: f64,
 }
 
 /// The §1.3 speed-ups (pre-grouping, instancing) on one scene and thread count, against obvhs
@@ -163,6 +171,7 @@ pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, 
     let (tb, sah_b, qc_b, _, _) = run(Method::ParryBinned)?;
     let (_, sah_r, qc_r, _, refined) = run(Method::GroupingRefine)?;
     let (_, sah_o, qc_o, ..) = run(Method::ObvhsPlocReinsert)?;
+    let (_, sah_pr, qc_pr, _, part_refined) = run(Method::GroupingPartitionedRefine)?;
     let refine = RefineRow {
         scene: scene.name.clone(),
         refine_seconds: refined.refine_seconds,
@@ -170,6 +179,10 @@ pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, 
         refine_per_ploc: refined.refine_seconds / tp,
         sah_per_best: sah_r / sah_b.min(sah_o),
         query_per_best: qc_r / qc_b.min(qc_o),
+        part_total_seconds: part_refined.seconds,
+        part_refine_per_ploc: part_refined.refine_seconds / tp,
+        part_sah_per_best: sah_pr / sah_b.min(sah_o),
+        part_query_per_best: qc_pr / qc_b.min(qc_o),
     };
     let volumes = n <= 50_000;
     let vol = |b: &peers::Built| super::level_volume(&b.tree, scene, 3);

@@ -71,15 +71,18 @@ pub enum Method {
     ParryBinnedRefine,
     /// [`Method::ObvhsPloc`] then the refinement pass.
     ObvhsPlocRefine,
+    /// [`Method::GroupingPartitioned`] then the refinement pass.
+    GroupingPartitionedRefine,
 }
 
 impl Method {
     /// Every method, ours first.
-    pub const ALL: [Method; 15] = [
+    pub const ALL: [Method; 16] = [
         Method::Grouping,
         Method::GroupingRefine,
         Method::GroupingHull,
         Method::GroupingPartitioned,
+        Method::GroupingPartitionedRefine,
         Method::GroupingPregroup,
         Method::GroupingInstanced,
         Method::GroupingObjects,
@@ -111,6 +114,7 @@ impl Method {
             Method::GroupingRefine => "grouping+refine",
             Method::ParryBinnedRefine => "parry-binned+refine",
             Method::ObvhsPlocRefine => "obvhs-ploc+refine",
+            Method::GroupingPartitionedRefine => "grouping-partitioned+refine",
         }
     }
 
@@ -136,6 +140,7 @@ impl Method {
                 | Method::GroupingInstanced
                 | Method::GroupingObjects
                 | Method::GroupingPartitioned
+                | Method::GroupingPartitionedRefine
         )
     }
 
@@ -150,6 +155,7 @@ impl Method {
             Method::GroupingRefine => Method::Grouping,
             Method::ParryBinnedRefine => Method::ParryBinned,
             Method::ObvhsPlocRefine => Method::ObvhsPloc,
+            Method::GroupingPartitionedRefine => Method::GroupingPartitioned,
             m => m,
         }
     }
@@ -266,7 +272,10 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
         | Method::GroupingInstanced
         | Method::GroupingObjects
         | Method::GroupingPartitioned => unreachable!("handled above"),
-        Method::GroupingRefine | Method::ParryBinnedRefine | Method::ObvhsPlocRefine => {
+        Method::GroupingRefine
+        | Method::ParryBinnedRefine
+        | Method::ObvhsPlocRefine
+        | Method::GroupingPartitionedRefine => {
             unreachable!("refined methods are built from their base")
         }
     };
