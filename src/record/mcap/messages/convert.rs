@@ -94,8 +94,8 @@ impl From<&Part> for PartEvent {
             } => {
                 e.kind = 2;
                 e.index = of;
-                [e.r0, e.r1, e.r2, e.r3, e.r4, e.r5, e.r6, e.r7, e.r8] = r;
-                [e.tx, e.ty, e.tz] = t;
+                [e.r0, e.r1, e.r2, e.r3, e.r4, e.r5, e.r6, e.r7, e.r8] = r.map(Some);
+                [e.tx, e.ty, e.tz] = t.map(Some);
             }
             PartKind::Top => e.kind = 3,
         }
@@ -112,11 +112,18 @@ impl TryFrom<&PartEvent> for Part {
                 keep: e.keep,
             },
             1 => PartKind::Component { index: e.index },
-            2 => PartKind::Copy {
-                of: e.index,
-                rotation: [e.r0, e.r1, e.r2, e.r3, e.r4, e.r5, e.r6, e.r7, e.r8],
-                translation: [e.tx, e.ty, e.tz],
-            },
+            2 => {
+                let r = [e.r0, e.r1, e.r2, e.r3, e.r4, e.r5, e.r6, e.r7, e.r8];
+                let t = [e.tx, e.ty, e.tz];
+                let (Some(rotation), Some(translation)) = (present(r), present(t)) else {
+                    return Err("a copy part without its rotation and translation".into());
+                };
+                PartKind::Copy {
+                    of: e.index,
+                    rotation,
+                    translation,
+                }
+            }
             3 => PartKind::Top,
             k => return Err(format!("unknown part kind {k}")),
         };
@@ -173,4 +180,13 @@ impl From<&MergeEvent> for Merge {
             active: e.active,
         }
     }
+}
+
+/// The values of `v` when every one is present.
+fn present<const K: usize>(v: [Option<f64>; K]) -> Option<[f64; K]> {
+    v.iter()
+        .copied()
+        .collect::<Option<Vec<f64>>>()?
+        .try_into()
+        .ok()
 }

@@ -24,10 +24,12 @@ macro_rules! flat_message {
         }
 
         impl $name {
-            /// Decodes a message written by the derived encoder; every field must be present once
-            /// with its declared wire type (unknown fields are ignored).
+            /// Decodes a message written by the derived encoder; every field that is not an
+            /// `Option` must be present, each with its declared wire type (unknown fields are
+            /// ignored).
             pub fn decode(buf: &[u8]) -> Result<Self, String> {
                 const FIELDS: &[&str] = &[$(stringify!($field)),+];
+                const OPTIONAL: &[bool] = &[$(<$ty as WireScalar>::OPTIONAL),+];
                 let mut out = Self::default();
                 let mut seen = 0u64;
                 for (number, wire, raw) in wire_fields(buf)? {
@@ -44,7 +46,9 @@ macro_rules! flat_message {
                         }
                     )+
                 }
-                if let Some(missing) = (0..FIELDS.len()).find(|&i| seen & (1 << i) == 0) {
+                if let Some(missing) =
+                    (0..FIELDS.len()).find(|&i| seen & (1 << i) == 0 && !OPTIONAL[i])
+                {
                     return Err(format!("field `{}` missing", FIELDS[missing]));
                 }
                 Ok(out)
@@ -195,8 +199,8 @@ flat_message! {
 
 flat_message! {
     /// A part of the run (a chunk of the partitioned schedule, a component, a copy, the top),
-    /// on `/grouping/part`: every field of [`Part`](crate::grouping::Part), its kind flattened (fields a kind does not
-    /// have are 0).
+    /// on `/grouping/part`: every field of [`Part`](crate::grouping::Part), its kind flattened (the
+    /// scalar fields a kind does not have are 0; the copy's transform is absent).
     PartEvent {
         /// 0-based part index.
         id: u32,
@@ -212,29 +216,30 @@ flat_message! {
         keep: u32,
         /// Component: its index; copy: the component it copies.
         index: u32,
-        /// Copy: rotation, row-major, 0 0.
-        r0: f64,
+        /// Copy: rotation, row-major, 0 0 (this and the eleven below are written for copies
+        /// only; other parts leave them out, 98 bytes less each, and protobuf readers see 0).
+        r0: Option<f64>,
         /// Rotation 0 1.
-        r1: f64,
+        r1: Option<f64>,
         /// Rotation 0 2.
-        r2: f64,
+        r2: Option<f64>,
         /// Rotation 1 0.
-        r3: f64,
+        r3: Option<f64>,
         /// Rotation 1 1.
-        r4: f64,
+        r4: Option<f64>,
         /// Rotation 1 2.
-        r5: f64,
+        r5: Option<f64>,
         /// Rotation 2 0.
-        r6: f64,
+        r6: Option<f64>,
         /// Rotation 2 1.
-        r7: f64,
+        r7: Option<f64>,
         /// Rotation 2 2.
-        r8: f64,
+        r8: Option<f64>,
         /// Copy: translation x.
-        tx: f64,
+        tx: Option<f64>,
         /// Translation y.
-        ty: f64,
+        ty: Option<f64>,
         /// Translation z.
-        tz: f64,
+        tz: Option<f64>,
     }
 }

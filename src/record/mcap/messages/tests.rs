@@ -75,6 +75,34 @@ fn merge_round_trips_with_distinct_values() {
 }
 
 #[test]
+fn only_copies_carry_a_transform() {
+    let part = |kind| Part {
+        id: 70_000,
+        kind,
+        bodies: 7,
+        first_step: 900_000,
+    };
+    let chunk = encode(&PartEvent::from(&part(PartKind::Chunk {
+        level: 12,
+        keep: 3,
+    })));
+    // Seven small varints, not twelve doubles of zeros besides.
+    assert!(chunk.len() <= 7 * 4, "{} bytes", chunk.len());
+    let decoded = PartEvent::decode(&chunk).unwrap();
+    assert_eq!((decoded.r0, decoded.tz), (None, None));
+    let copy = PartEvent::from(&part(PartKind::Copy {
+        of: 1,
+        rotation: [0.0; 9],
+        translation: [0.0; 3],
+    }));
+    // A copy's transform is written even when it is zero, and required when read.
+    let back = PartEvent::decode(&encode(&copy)).unwrap();
+    assert_eq!(back.r4, Some(0.0));
+    let torn = PartEvent { ty: None, ..back };
+    assert!(Part::try_from(&torn).unwrap_err().contains("translation"));
+}
+
+#[test]
 fn schema_is_protobuf() {
     let schema = MergeEvent::get_schema().unwrap();
     assert_eq!(schema.name, "mergeevent.MergeEvent");

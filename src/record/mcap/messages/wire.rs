@@ -5,8 +5,19 @@
 pub trait WireScalar: Sized {
     /// Protobuf wire type: 0 (varint) or 1 (64-bit).
     const WIRE: u8;
+    /// Whether the field may be absent (proto3 `optional`, a Rust `Option`).
+    const OPTIONAL: bool = false;
     /// Converts the raw field value.
     fn from_raw(raw: u64) -> Option<Self>;
+}
+
+/// An optional field: written only when `Some` (explicit presence), `None` when absent.
+impl<T: WireScalar> WireScalar for Option<T> {
+    const WIRE: u8 = T::WIRE;
+    const OPTIONAL: bool = true;
+    fn from_raw(raw: u64) -> Option<Self> {
+        T::from_raw(raw).map(Some)
+    }
 }
 
 impl WireScalar for u32 {
