@@ -328,3 +328,42 @@ fn replay_verifies_a_partitioned_recording() {
     let out = wraptree(&["group", "s.obj", "--threads", "0"], dir.path());
     common::assert_one_line_error(&out, "--threads");
 }
+
+#[test]
+fn a_chosen_root_share_is_recorded_and_replayed() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut obj = Vec::new();
+    // Whole under the default share (`Chunking::whole`), split under a share of 256.
+    let n = 3_000;
+    assert!(Chunking::DEFAULT.whole(n));
+    generate::soup(n, 6).write_obj(&mut obj).unwrap();
+    std::fs::write(dir.path().join("s.obj"), obj).unwrap();
+    let args = ["record", "s.obj", "--schedule", "partitioned", "-o"];
+    let out = wraptree(
+        &[&args[..], &["p", "--chunk-top", "256"]].concat(),
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rec = wraptree::record::mcap::read_recording(&dir.path().join("p.mcap")).unwrap();
+    assert_eq!(rec.params.mode.chunk_top, 256);
+    assert!(rec.parts.len() > 10, "{} parts recorded", rec.parts.len());
+    let out = wraptree(&["replay", "p.mcap", "--verify"], dir.path());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("verified"), "{text}");
+    // The default share groups this scene whole: one part, the top.
+    let out = wraptree(&[&args[..], &["d"]].concat(), dir.path());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rec = wraptree::record::mcap::read_recording(&dir.path().join("d.mcap")).unwrap();
+    assert_eq!(rec.params.mode.chunk_top, Chunking::DEFAULT.top);
+    assert_eq!(rec.parts.len(), 1);
+    let out = wraptree(&["group", "s.obj", "--chunk-top", "64"], dir.path());
+    common::assert_one_line_error(&out, "--chunk-top needs --schedule partitioned");
+}

@@ -129,6 +129,12 @@ pub struct GroupArgs {
     /// Size measure in the Cost: diameter (the paper's) or area (surface area of the box).
     #[arg(long, value_enum, default_value_t = CostMeasure::Diameter)]
     pub cost: CostMeasure,
+    /// Partitioned schedule: about how many bodies its root step (the exact schedule's) starts
+    /// from; scenes of at most 1.5× this are grouped whole. Smaller is faster on scenes of
+    /// 10^4–10^5 primitives and further from the exact tree; 0 = AAC's reduction alone
+    /// [default: 8192].
+    #[arg(long, value_name = "N")]
+    pub chunk_top: Option<u32>,
     /// Threads for the parallel steps (partitioned chunks, the exact run's round-start scans);
     /// the tree is the same for any count [default: all cores].
     #[arg(long, value_name = "N")]
@@ -161,8 +167,12 @@ impl GroupArgs {
                 pregroup: self.pregroup,
                 instancing: self.instancing,
                 cost: self.cost,
+                chunk_top: self.chunk_top.unwrap_or(Mode::default().chunk_top),
             },
         };
+        if self.chunk_top.is_some() && self.schedule != Schedule::Partitioned {
+            anyhow::bail!("--chunk-top needs --schedule partitioned");
+        }
         params.check().map_err(anyhow::Error::msg)?;
         Ok(params)
     }

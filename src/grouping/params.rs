@@ -141,7 +141,7 @@ pub enum CostMeasure {
 /// How a grouping run is organised beyond its Cost weights and limits. The default is the
 /// literal §2.2 run; every other setting is recorded in recordings' metadata so that
 /// `replay --verify` re-runs the same mode.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
 pub struct Mode {
     /// Exact or partitioned schedule.
@@ -152,6 +152,24 @@ pub struct Mode {
     pub instancing: bool,
     /// The size measure in the Cost.
     pub cost: CostMeasure,
+    /// The partitioned schedule's root share ([`Chunking::top`](crate::grouping::partitioned::Chunking::top)):
+    /// about how many bodies its root step starts from; scenes of at most 1.5× this are one
+    /// subproblem (the exact schedule's tree); 0 = AAC's reduction alone. The exact schedule
+    /// does not read it.
+    pub chunk_top: u32,
+}
+
+impl Default for Mode {
+    /// The literal §2.2 run; the partitioned schedule's default root share.
+    fn default() -> Self {
+        Mode {
+            schedule: Schedule::default(),
+            pregroup: Pregroup::default(),
+            instancing: false,
+            cost: CostMeasure::default(),
+            chunk_top: crate::grouping::partitioned::Chunking::DEFAULT.top,
+        }
+    }
 }
 
 impl Mode {

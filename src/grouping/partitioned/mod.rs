@@ -227,7 +227,11 @@ pub(crate) fn run<O: Observer>(
     observer: O,
     budget: &Budget<'_>,
 ) -> Result<Grouping, Stopped> {
-    group_with(scene, params, &Chunking::DEFAULT, observer, budget)
+    let chunking = Chunking {
+        top: params.mode.chunk_top,
+        ..Chunking::DEFAULT
+    };
+    group_with(scene, params, &chunking, observer, budget)
 }
 
 /// Runs the partitioned schedule with `chunking` instead of [`Chunking::DEFAULT`] (see the module

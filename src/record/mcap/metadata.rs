@@ -54,9 +54,9 @@ pub const KEYS: &[&str] = &[
 /// announced.
 pub const STOP_KEYS: &[&str] = &["stop_reason", "stop_eligible_pairs"];
 
-/// Keys the `wraptree` record adds for the partitioned schedule: its chunk size δ, the
-/// reduction function's ε and the root's share `top` ([`Chunking`]); informative, as a build
-/// has one fixed chunking.
+/// Keys the `wraptree` record adds for the partitioned schedule: its chunk size δ and the
+/// reduction function's ε ([`Chunking`]; informative, fixed in a build) and the root's share
+/// `top` (`--chunk-top`, read back by `replay`).
 pub const PARTITIONED_KEYS: &[&str] = &["chunk_delta", "chunk_epsilon", "chunk_top"];
 
 /// Keys the `wraptree` record adds when a cover is logged (`cover_budget` only for a cover
@@ -196,7 +196,7 @@ pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String,
         let ch = Chunking::DEFAULT;
         put("chunk_delta", ch.delta.to_string());
         put("chunk_epsilon", ch.epsilon.to_string());
-        put("chunk_top", ch.top.to_string());
+        put("chunk_top", p.mode.chunk_top.to_string());
     }
     put("detail", value_name(&info.detail));
     put("scene", info.scene.name.clone());
@@ -299,6 +299,10 @@ fn mode(m: &BTreeMap<String, String>) -> Result<Mode> {
         cost: match m.contains_key("cost") {
             true => parse_enum(m, "cost")?,
             false => d.cost,
+        },
+        chunk_top: match m.contains_key("chunk_top") {
+            true => parse(m, "chunk_top")?,
+            false => d.chunk_top,
         },
     })
 }
