@@ -104,6 +104,37 @@ fn range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     (lo - pad)..(hi + pad)
 }
 
+/// The corner of the plot for the legend of `rows` lines that covers the fewest of the points
+/// `all` (in axis coordinates over the ranges `xr`, `yr`); the upper right on a tie.
+fn legend_corner(
+    all: &[(f64, f64)],
+    xr: &std::ops::Range<f64>,
+    yr: &std::ops::Range<f64>,
+    rows: usize,
+) -> SeriesLabelPosition {
+    // The box's share of the plot: about 40 % of the width, 4.5 % of the height a line.
+    let (w, h) = (0.4, (0.045 * (rows as f64 + 1.0)).min(0.9));
+    let t = |v: f64, r: &std::ops::Range<f64>| (v - r.start) / (r.end - r.start);
+    let covered = |right: bool, upper: bool| {
+        all.iter()
+            .filter(|&&(x, y)| {
+                let (u, v) = (t(x, xr), t(y, yr));
+                (if right { u >= 1.0 - w } else { u <= w })
+                    && (if upper { v >= 1.0 - h } else { v <= h })
+            })
+            .count()
+    };
+    [
+        (true, true, SeriesLabelPosition::UpperRight),
+        (false, true, SeriesLabelPosition::UpperLeft),
+        (true, false, SeriesLabelPosition::LowerRight),
+        (false, false, SeriesLabelPosition::LowerLeft),
+    ]
+    .into_iter()
+    .min_by_key(|&(right, upper, _)| covered(right, upper))
+    .map_or(SeriesLabelPosition::UpperRight, |c| c.2)
+}
+
 fn tick(v: f64, log: bool) -> String {
     let x = if log { 10f64.powf(v) } else { v };
     let a = x.abs();
@@ -141,6 +172,8 @@ impl Scatter {
         let all: Vec<(f64, f64)> = mapped.iter().flatten().copied().collect();
         let xr = range(all.iter().map(|p| p.0));
         let yr = range(all.iter().map(|p| p.1));
+        let rows = self.series.len() + usize::from(self.pareto && all.len() > 1);
+        let corner = legend_corner(&all, &xr, &yr, rows);
         let mut buf = String::new();
         {
             let root = SVGBackend::with_string(&mut buf, (width, height)).into_drawing_area();
@@ -204,7 +237,7 @@ impl Scatter {
             if !self.series.is_empty() {
                 chart
                     .configure_series_labels()
-                    .position(SeriesLabelPosition::UpperRight)
+                    .position(corner)
                     .label_font((FONT, 12))
                     .background_style(WHITE.mix(0.85))
                     .border_style(RGBColor(160, 160, 160))
@@ -334,6 +367,22 @@ impl HeatMap {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_legend_goes_where_it_hides_no_point() {
+        let (xr, yr) = (0.0..10.0, 0.0..10.0);
+        // A point in the upper right (a slow, costly builder): the legend moves left.
+        let pts = [(9.5, 9.5), (1.0, 5.0), (5.0, 1.0)];
+        let c = legend_corner(&pts, &xr, &yr, 5);
+        assert!(matches!(c, SeriesLabelPosition::UpperLeft), "{c:?}");
+        // Points in both upper corners: a lower one.
+        let pts = [(9.5, 9.5), (0.5, 9.5), (5.0, 5.0)];
+        let c = legend_corner(&pts, &xr, &yr, 5);
+        assert!(matches!(c, SeriesLabelPosition::LowerRight), "{c:?}");
+        // Nothing in the way: the upper right, as before.
+        let c = legend_corner(&[(5.0, 5.0)], &xr, &yr, 5);
+        assert!(matches!(c, SeriesLabelPosition::UpperRight), "{c:?}");
+    }
 
     #[test]
     fn pareto_front_keeps_only_undominated_points() {
