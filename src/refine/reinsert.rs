@@ -185,37 +185,45 @@ pub fn candidates(w: &WorkTree, count: usize) -> Vec<u32> {
     if count == 0 {
         return Vec::new();
     }
-    // Rank key: descending A(p)² / min(A(x), A(s)) (f64 total order), then ascending id,
-    // packed in one integer so that selection compares plain numbers. Both children of a
-    // parent share the value, so the keys come from a sequential scan of the interior slots
-    // (two scattered reads per slot, not one per node up to its parent and over to its
-    // sibling); the root, no slot's child, is never a candidate.
+    // Both children of a slot share the value, so there is one key per interior slot, from a
+    // sequential scan of the slots (the root, no slot's child, is never a candidate): the f64
+    // mapped to an integer that sorts ascending from the best (largest) value.
     let n = w.n as usize;
-    let key = |k: f64, x: u32| -> u128 {
-        let b = k.to_bits() as i64;
-        let ordered = ((b ^ (((b >> 63) as u64) >> 1) as i64) as u64) ^ (1 << 63);
-        (u128::from(!ordered) << 32) | x as u128
-    };
-    let pair = |(i, &[a, b]): (usize, &[u32; 2])| -> [u128; 2] {
-        let ap = w.area[n + i];
+    let key = |&[a, b]: &[u32; 2], ap: f64| -> u64 {
         let small = w.area[a as usize].min(w.area[b as usize]);
         let k = ap * ap / small.max(f64::MIN_POSITIVE);
-        [key(k, a), key(k, b)]
+        let bits = k.to_bits() as i64;
+        !(((bits ^ (((bits >> 63) as u64) >> 1) as i64) as u64) ^ (1 << 63))
     };
-    let mut all: Vec<u128> = if nodes >= PARALLEL_MIN * 8 {
-        w.children
-            .par_iter()
-            .enumerate()
-            .flat_map_iter(pair)
+    let keys: Vec<u64> = if nodes >= PARALLEL_MIN * 8 {
+        (w.children.par_iter(), w.area[n..].par_iter())
+            .into_par_iter()
+            .map(|(k, &ap)| key(k, ap))
             .collect()
     } else {
-        w.children.iter().enumerate().flat_map(pair).collect()
+        w.children
+            .iter()
+            .zip(&w.area[n..])
+            .map(|(k, &ap)| key(k, ap))
+            .collect()
     };
-    if count < all.len() {
-        all.select_nth_unstable(count - 1);
-        all.truncate(count);
+    // Nodes in rank order are the slots' children, two per slot: node rank `count − 1` is a
+    // child of the slot of rank (count − 1) / 2. Every child of a slot with a smaller key is in;
+    // children of slots with that key fill the rest by id.
+    let mut ranked = keys.clone();
+    let (_, &mut last, _) = ranked.select_nth_unstable((count - 1) / 2);
+    let mut ids = Vec::with_capacity(count);
+    let mut tied = Vec::new();
+    for (&k, kids) in keys.iter().zip(&w.children) {
+        if k < last {
+            ids.extend_from_slice(kids);
+        } else if k == last {
+            tied.extend_from_slice(kids);
+        }
     }
-    let mut ids: Vec<u32> = all.iter().map(|&k| k as u32).collect();
+    tied.sort_unstable();
+    tied.truncate(count - ids.len());
+    ids.extend(tied);
     ids.sort_unstable();
     ids
 }
