@@ -268,6 +268,19 @@ fn a_stopped_run_reports_a_prefix_of_the_merges() {
     assert_eq!(cut.merges[..], full.merges[..cut.merges.len()]);
 }
 
+/// The recording `path` that the command whose output is `out` wrote (which must have succeeded).
+fn recorded(
+    out: &std::process::Output,
+    path: &std::path::Path,
+) -> wraptree::record::mcap::Recorded {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    wraptree::record::mcap::read_recording(path).unwrap()
+}
+
 #[test]
 fn replay_verifies_a_partitioned_recording() {
     let dir = tempfile::tempdir().unwrap();
@@ -295,12 +308,7 @@ fn replay_verifies_a_partitioned_recording() {
         ],
         dir.path(),
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let rec = wraptree::record::mcap::read_recording(&dir.path().join("p.mcap")).unwrap();
+    let rec = recorded(&out, &dir.path().join("p.mcap"));
     assert_eq!(rec.params.mode.schedule, Schedule::Partitioned);
     assert!(rec.parts.len() > 10, "{} parts recorded", rec.parts.len());
     let (_, log) = run(&scene, &partitioned(Params::default()));
@@ -343,12 +351,7 @@ fn a_chosen_root_share_is_recorded_and_replayed() {
         &[&args[..], &["p", "--chunk-top", "256"]].concat(),
         dir.path(),
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let rec = wraptree::record::mcap::read_recording(&dir.path().join("p.mcap")).unwrap();
+    let rec = recorded(&out, &dir.path().join("p.mcap"));
     assert_eq!(rec.params.mode.chunk_top, 256);
     assert!(rec.parts.len() > 10, "{} parts recorded", rec.parts.len());
     let out = wraptree(&["replay", "p.mcap", "--verify"], dir.path());
@@ -356,12 +359,7 @@ fn a_chosen_root_share_is_recorded_and_replayed() {
     assert!(out.status.success() && text.contains("verified"), "{text}");
     // The default share groups this scene whole: one part, the top.
     let out = wraptree(&[&args[..], &["d"]].concat(), dir.path());
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let rec = wraptree::record::mcap::read_recording(&dir.path().join("d.mcap")).unwrap();
+    let rec = recorded(&out, &dir.path().join("d.mcap"));
     assert_eq!(rec.params.mode.chunk_top, Chunking::DEFAULT.top);
     assert_eq!(rec.parts.len(), 1);
     let out = wraptree(&["group", "s.obj", "--chunk-top", "64"], dir.path());

@@ -15,6 +15,7 @@
 
 use super::work::WorkTree;
 use crate::geom::Aabb;
+use crate::geom::morton::spread_bits;
 use crate::grouping::NONE;
 use crate::metrics::area;
 use rayon::prelude::*;
@@ -141,17 +142,6 @@ pub fn spatial_order(w: &WorkTree, candidates: &[u32]) -> Vec<u32> {
     let mut keys: Vec<(u64, u32)> = candidates.par_iter().map(key).collect();
     keys.par_sort_unstable();
     keys.into_iter().map(|(_, x)| x).collect()
-}
-
-/// The low 21 bits of `v`, two zero bits after each (one axis of a 3-D Morton code).
-fn spread_bits(v: u64) -> u64 {
-    let mut x = v & 0x1f_ffff;
-    x = (x | x << 32) & 0x001f_0000_0000_ffff;
-    x = (x | x << 16) & 0x001f_0000_ff00_00ff;
-    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
-    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
-    x = (x | x << 2) & 0x1249_2492_4924_9249;
-    x
 }
 
 /// Fewest candidates searched in parallel.
