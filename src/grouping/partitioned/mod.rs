@@ -61,7 +61,7 @@ use super::{Budget, Grouping, PSet, ResolvedParams, Stats, StopReason, Stopped};
 use crate::geom::Aabb;
 use crate::scene::Scene;
 pub use plan::Chunking;
-use plan::{Node, morton_order, plan};
+use plan::{Node, morton_order, plan, post_order};
 use rayon::prelude::*;
 use small::Limits;
 use std::sync::Mutex;
@@ -308,12 +308,18 @@ pub fn group_with<O: Observer>(
         info: listens.then_some(&mut info[..]),
         stats: SubStats::default(),
     };
-    let (result, sub) = exec.node(nodes.len() as u32 - 1, &mut leaves, out, false);
+    let (result, sub) = exec.node(0, &mut leaves, out, false);
     // Events, in post-order, up to the first unfinished subproblem.
     let mut emitted = 0u32;
     let mut part = 0u32;
-    for (k, node) in nodes.iter().enumerate() {
-        if !done[k].load(Ordering::Relaxed) {
+    let order = if listens || result.is_none() {
+        post_order(&nodes)
+    } else {
+        Vec::new()
+    };
+    for &k in &order {
+        let node = &nodes[k as usize];
+        if !done[k as usize].load(Ordering::Relaxed) {
             break;
         }
         let made = node.inputs - node.keep;
@@ -429,9 +435,11 @@ impl Exec<'_> {
                 ([part, Left::default()], out, SubStats::default())
             }
             Some((l, r)) => {
-                let (ln, rn) = (self.nodes[l as usize], self.nodes[r as usize]);
-                let lm = (ln.hi - ln.lo - ln.keep) as usize;
-                let rm = (rn.hi - rn.lo - rn.keep) as usize;
+                // The left half is the next node; the right half's merges are the rest of
+                // those below this node (its entry is read when it is grouped).
+                let ln = self.nodes[l as usize];
+                let lm = ln.merges() as usize;
+                let rm = (node.below() - ln.merges()) as usize;
                 let (lout, rest) = out.split(lm);
                 let (rout, own) = rest.split(rm);
                 // The children's pairs serve this node's brute-force step.

@@ -53,15 +53,16 @@ impl Default for Chunking {
     }
 }
 
-/// A node of the split, in post-order.
+/// A node of the split, in pre-order (a node, its left half's subtree, then its right half's),
+/// so that the grouping, which descends the split depth first, reads the nodes in order.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Node {
     /// Range of the Morton-sorted primitives.
     pub(super) lo: u32,
     pub(super) hi: u32,
-    /// How far before the node its left half is (its right half is just before it); 0 for a
+    /// How far after the node its right half is (its left half is just after it); 0 for a
     /// chunk. Relative, so that blocks of nodes planned apart can be laid end to end.
-    left_back: u32,
+    right_ahead: u32,
     /// Depth (0 = the root).
     pub(super) level: u32,
     /// Bodies the node's own subproblem starts from.
@@ -74,8 +75,38 @@ impl Node {
     /// The indices of the two halves of node `k` (this node), or none for a chunk.
     #[inline]
     pub(super) fn kids(&self, k: u32) -> Option<(u32, u32)> {
-        (self.left_back > 0).then(|| (k - self.left_back, k - 1))
+        (self.right_ahead > 0).then(|| (k + 1, k + self.right_ahead))
     }
+
+    /// The merges made in the node's subtree below its own subproblem.
+    #[inline]
+    pub(super) fn below(&self) -> u32 {
+        self.hi - self.lo - self.inputs
+    }
+
+    /// The merges made in the node's subtree, its own included.
+    #[inline]
+    pub(super) fn merges(&self) -> u32 {
+        self.hi - self.lo - self.keep
+    }
+}
+
+/// The nodes of `nodes` (pre-order) in post-order (each node after its two halves' subtrees).
+pub(super) fn post_order(nodes: &[Node]) -> Vec<u32> {
+    let mut order = Vec::with_capacity(nodes.len());
+    // (node, whether its halves are done)
+    let mut stack = vec![(0u32, false)];
+    while let Some((k, expanded)) = stack.pop() {
+        match nodes[k as usize].kids(k) {
+            Some((l, r)) if !expanded => {
+                stack.push((k, true));
+                stack.push((r, false));
+                stack.push((l, false));
+            }
+            _ => order.push(k),
+        }
+    }
+    order
 }
 
 /// Below this many primitives f(n) comes from a table (most nodes are small).
@@ -122,9 +153,9 @@ impl Keep {
 /// Ranges of at least this many primitives plan their halves in parallel.
 const PLAN_GRAIN: u32 = 1 << 15;
 
-/// The split of `codes` (sorted) into chunks, nodes in post-order. Halves of large ranges are
-/// planned in parallel into blocks of nodes, laid end to end at the end (the same nodes as
-/// one sequential pass, whatever the number of threads).
+/// The split of `codes` (sorted) into chunks, nodes in pre-order (the root first). Halves of
+/// large ranges are planned in parallel into blocks of nodes, laid end to end at the end (the
+/// same nodes as one sequential pass, whatever the number of threads).
 pub(super) fn plan(codes: &[(u64, u32)], chunking: &Chunking) -> Vec<Node> {
     let keep = Keep::new(chunking, codes.len());
     let planner = Planner { codes, keep: &keep };
@@ -136,7 +167,7 @@ pub(super) fn plan(codes: &[(u64, u32)], chunking: &Chunking) -> Vec<Node> {
     nodes
 }
 
-/// A planned subtree: its nodes as blocks in post-order, the bodies its root leaves and its
+/// A planned subtree: its nodes as blocks in pre-order, the bodies its root leaves and its
 /// number of nodes.
 struct Planned {
     blocks: Vec<Vec<Node>>,
@@ -167,10 +198,10 @@ impl Planner<'_> {
             || self.blocks(lo, mid, level + 1),
             || self.blocks(mid, hi, level + 1),
         );
-        let node = self.inner(lo, hi, level, l.keep, r.keep, r.count);
-        let mut blocks = l.blocks;
+        let node = self.inner(lo, hi, level, l.keep, r.keep, l.count);
+        let mut blocks = vec![vec![node]];
+        blocks.extend(l.blocks);
         blocks.extend(r.blocks);
-        blocks.push(vec![node]);
         Planned {
             blocks,
             keep: node.keep,
@@ -191,7 +222,7 @@ impl Planner<'_> {
             nodes.push(Node {
                 lo,
                 hi,
-                left_back: 0,
+                right_ahead: 0,
                 level,
                 inputs: size,
                 keep,
@@ -199,10 +230,20 @@ impl Planner<'_> {
             return (keep, 1);
         }
         let mid = self.mid(lo, hi);
+        let at = nodes.len();
+        // A placeholder, replaced once the halves are planned.
+        nodes.push(Node {
+            lo,
+            hi,
+            right_ahead: 0,
+            level,
+            inputs: 0,
+            keep: 0,
+        });
         let (kl, cl) = self.build(lo, mid, level + 1, nodes);
         let (kr, cr) = self.build(mid, hi, level + 1, nodes);
-        let node = self.inner(lo, hi, level, kl, kr, cr);
-        nodes.push(node);
+        let node = self.inner(lo, hi, level, kl, kr, cl);
+        nodes[at] = node;
         (node.keep, cl + cr + 1)
     }
 
@@ -218,15 +259,15 @@ impl Planner<'_> {
         lo + part.partition_point(|c| c.0 >> bit & 1 == 0) as u32
     }
 
-    /// The inner node over `lo..hi` whose halves leave `kl` and `kr` bodies, the right one
-    /// having `right_count` nodes.
-    fn inner(&self, lo: u32, hi: u32, level: u32, kl: u32, kr: u32, right_count: u32) -> Node {
+    /// The inner node over `lo..hi` whose halves leave `kl` and `kr` bodies, the left one
+    /// having `left_count` nodes.
+    fn inner(&self, lo: u32, hi: u32, level: u32, kl: u32, kr: u32, left_count: u32) -> Node {
         let inputs = kl + kr;
         let size = hi - lo;
         Node {
             lo,
             hi,
-            left_back: right_count + 1,
+            right_ahead: left_count + 1,
             level,
             inputs,
             keep: if level == 0 {
@@ -321,13 +362,29 @@ mod tests {
             });
             assert_eq!(got[0], want);
             assert_eq!(got[1], want);
-            let root = want.len() as u32 - 1;
-            let (l, r) = want[root as usize].kids(root).unwrap();
+            let (l, r) = want[0].kids(0).unwrap();
             assert_eq!(
                 (want[l as usize].lo, want[r as usize].hi),
                 (0, items.len() as u32)
             );
             assert_eq!(want[l as usize].hi, want[r as usize].lo);
+            // Post-order: every node once, after both halves, the root last.
+            let order = post_order(&want);
+            let mut at = vec![usize::MAX; want.len()];
+            for (i, &k) in order.iter().enumerate() {
+                assert_eq!(at[k as usize], usize::MAX, "node {k} twice");
+                at[k as usize] = i;
+            }
+            assert_eq!(order.last(), Some(&0));
+            for (k, node) in want.iter().enumerate() {
+                if let Some((l, r)) = node.kids(k as u32) {
+                    assert!(at[l as usize] < at[r as usize] && at[r as usize] < at[k]);
+                    assert_eq!(
+                        node.below(),
+                        want[l as usize].merges() + want[r as usize].merges()
+                    );
+                }
+            }
         }
     }
 }
