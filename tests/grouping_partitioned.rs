@@ -1,7 +1,8 @@
 //! The partitioned schedule: valid trees on bundled and property-generated scenes, the same
 //! result on 1 and 2 threads, the exact schedule's tree for a scene smaller than one chunk,
-//! parts announced before their merges, `replay --verify` of a partitioned recording; and the
-//! exact schedule's merge sequence unchanged by its parallel round-start scan.
+//! parts announced before their merges, `replay --verify` of a partitioned recording, the same
+//! trees from primitive boxes; and the exact schedule's merge sequence unchanged by its parallel
+//! round-start scan.
 
 mod common;
 
@@ -11,7 +12,7 @@ use std::sync::atomic::AtomicBool;
 use wraptree::grouping::partitioned::{Chunking, group_with};
 use wraptree::grouping::{
     Budget, EventLog, Mode, PSet, Params, PartKind, Schedule, StopReason, Weights, group,
-    group_within,
+    group_boxes, group_within,
 };
 use wraptree::scene::{LoadOptions, generate};
 
@@ -121,6 +122,22 @@ fn large_soup_is_the_same_on_1_and_2_threads_and_close_to_exact() {
         wraptree::metrics::sah(&exact.tree),
     );
     assert!(s_p < 1.05 * s_e, "SAH partitioned {s_p} vs exact {s_e}");
+}
+
+#[test]
+fn grouping_from_boxes_gives_the_scenes_tree() {
+    // What the bench times: the tree, counters and resolved limits of `group` on both schedules.
+    let scene = generate::soup(20_000, 5);
+    let boxes: Vec<_> = (0..scene.len()).map(|i| scene.prim_aabb(i)).collect();
+    for params in [Params::default(), partitioned(Params::default())] {
+        let from_scene = group(&scene, &params, ());
+        let resolved = params.resolve_boxes(&boxes);
+        assert_eq!(resolved, params.resolve(&scene));
+        let from_boxes = group_boxes(boxes.clone(), &resolved, ());
+        assert_eq!(from_boxes.tree, from_scene.tree, "{:?}", params.mode);
+        assert_eq!(from_boxes.stats, from_scene.stats);
+        assert_eq!(from_boxes.rounds, from_scene.rounds);
+    }
 }
 
 #[test]

@@ -24,6 +24,7 @@ mod scan;
 pub(crate) use boxes::{run_boxes, run_boxes_until};
 pub(in crate::grouping) use fill::{box_area, fill_balance};
 pub(in crate::grouping) use keys::tie_tag;
+pub(in crate::grouping) use scan::pair_cost_any;
 
 /// Runs the grouping phase; see the module doc of [`super`] for the steps.
 pub(super) fn run<O: Observer>(

@@ -53,6 +53,7 @@ pub use params::{CostMeasure, Mode, PSet, Params, Pregroup, ResolvedParams, Sche
 pub use pregroup::Pregrouping;
 pub use subset_tree::{NONE, SubsetTree};
 
+use crate::geom::Aabb;
 use crate::scene::Scene;
 use std::sync::atomic::AtomicBool;
 
@@ -118,6 +119,24 @@ pub fn group_within<O: Observer>(
     budget: &Budget<'_>,
 ) -> Result<Grouping, Stopped> {
     run(scene, params, observer, budget)
+}
+
+/// Runs the grouping phase on primitives known by their boxes alone (primitive `i` is
+/// `boxes[i]`), with the AABB p-set and the schedule `params` names (its p-set and pre-grouping
+/// are not read: the hull p-set and pre-grouping need the polygons, see [`group`]). Gives the
+/// tree [`group`] gives for those settings on a scene whose [`Scene::prim_aabb`] are `boxes`.
+/// Panics only if `boxes` is empty.
+pub fn group_boxes<O: Observer>(
+    boxes: Vec<Aabb>,
+    params: &ResolvedParams,
+    observer: O,
+) -> Grouping {
+    let budget = Budget::default();
+    match params.mode.schedule {
+        Schedule::Exact => cluster::run_boxes(boxes, params, observer, &budget),
+        Schedule::Partitioned => partitioned::run_boxes(boxes, params, observer, &budget),
+    }
+    .expect("an unlimited budget never stops")
 }
 
 /// Runs the grouping phase in the schedule and mode that `params` names.

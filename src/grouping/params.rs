@@ -2,6 +2,7 @@
 //! GLimit (resolved from the scene by [`Params::resolve`]), the p-set wrapper and the [`Mode`]
 //! (schedule, pre-grouping, size measure).
 
+use crate::geom::Aabb;
 use crate::scene::Scene;
 
 /// The p-set wrapper bodies carry while grouping.
@@ -284,12 +285,37 @@ impl Params {
     /// DLimit ≤ 0 (or not finite) becomes 1; a given GLimit ≤ 0 becomes 1e-9 × DLimit0, since
     /// the paper's GLimit must be positive for scenes of several connected components.
     pub fn resolve(&self, scene: &Scene) -> ResolvedParams {
+        self.resolve_with(
+            || {
+                (0..scene.len())
+                    .map(|i| scene.prim_aabb(i).diameter())
+                    .collect()
+            },
+            || scene.aabb().diameter(),
+        )
+    }
+
+    /// [`Params::resolve`] for the primitives' boxes `boxes` (those of [`Scene::prim_aabb`] give
+    /// the same values): the median of their diagonals, and the diagonal of their union as the
+    /// scene's.
+    pub fn resolve_boxes(&self, boxes: &[Aabb]) -> ResolvedParams {
+        self.resolve_with(
+            || boxes.iter().map(Aabb::diameter).collect(),
+            || boxes.iter().fold(Aabb::EMPTY, |u, b| u.merge(b)).diameter(),
+        )
+    }
+
+    /// The resolution from the primitives' diameters and the scene's diagonal, each computed
+    /// only when needed.
+    fn resolve_with(
+        &self,
+        diameters: impl FnOnce() -> Vec<f64>,
+        diagonal: impl FnOnce() -> f64,
+    ) -> ResolvedParams {
         let dlimit0 = match self.dlimit {
             Some(d) => d,
             None => {
-                let mut d: Vec<f64> = (0..scene.len())
-                    .map(|i| scene.prim_aabb(i).diameter())
-                    .collect();
+                let mut d = diameters();
                 let median = if d.is_empty() {
                     0.0
                 } else {
@@ -299,7 +325,7 @@ impl Params {
                 if median > 0.0 {
                     median
                 } else {
-                    let diag = scene.aabb().diameter();
+                    let diag = diagonal();
                     if diag.is_finite() && diag > 0.0 {
                         diag * 1e-6
                     } else {

@@ -19,8 +19,10 @@
 //! A peer's reported time covers its own build only, from primitive boxes (`f32` relative to the
 //! scene centre for parry and obvhs, `f64` for ours) to its native tree; reading its topology
 //! into a Subset Tree ([`topology`]) is not timed. Box computation per primitive is shared and
-//! not timed either. The partitioned grouping, the pre-grouped ones (whose time includes
-//! finding the components and the copies) and obvhs PLOC (built with its `parallel` feature) use
+//! not timed either: the grouping and partitioned grouping (AABB p-set) are timed from the
+//! boxes, DLimit0's median included ([`grouping::group_boxes`]); the hull p-set and the
+//! pre-grouped methods, which need the polygons, from the scene. The partitioned grouping,
+//! the pre-grouped ones (whose time includes finding the components and the copies) and obvhs PLOC (built with its `parallel` feature) use
 //! the current rayon pool (run them inside `ThreadPool::install` to choose the thread count);
 //! every other builder is single-threaded. The refinement pass searches on rayon's threads and
 //! its time is added to the builder's: a refined method's time is the total,
@@ -225,6 +227,18 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
         if method == Method::GroupingPartitioned {
             p.pset = PSet::Aabb;
             p.mode.schedule = Schedule::Partitioned;
+        }
+        if p.pset == PSet::Aabb && pregroup == Pregroup::None {
+            // Like the peers', from the primitives' boxes, computed untimed (with room for
+            // the merged bodies' boxes, which the grouping appends).
+            let n = scene.len();
+            let mut boxes = Vec::with_capacity(2 * n - 1);
+            boxes.extend((0..n).map(|i| scene.prim_aabb(i)));
+            let t = Instant::now();
+            let resolved = p.resolve_boxes(&boxes);
+            let g = grouping::group_boxes(boxes, &resolved, ());
+            let seconds = t.elapsed().as_secs_f64();
+            return Ok(done(g.tree, Some(g.stats), seconds));
         }
         let g = grouping::group(scene, &p, ());
         let seconds = t.elapsed().as_secs_f64();

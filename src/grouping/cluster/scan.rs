@@ -74,6 +74,19 @@ fn pair_cost<const A: u8>(w: &Weights, d: f64, dx: f64, dy: f64) -> f64 {
     w.cost_scaled(scale, fill, balance)
 }
 
+/// [`pair_cost`] for any `w.a` (chosen per call): the Cost of the partitioned schedule's pairs,
+/// bit for bit the exact schedule's.
+#[inline(always)]
+pub(in crate::grouping) fn pair_cost_any(w: &Weights, d: f64, dx: f64, dy: f64) -> f64 {
+    if w.a == 1.0 {
+        pair_cost::<1>(w, d, dx, dy)
+    } else if w.a == 0.0 {
+        pair_cost::<0>(w, d, dx, dy)
+    } else {
+        pair_cost::<2>(w, d, dx, dy)
+    }
+}
+
 /// The Cost's size measures of a pair whose merged box has extents `e`: its diagonal and the
 /// bodies' diameters `dx`, `dy`, or with `area` the surface areas of the merged box and of the
 /// bodies' boxes `xa`, `ya`.

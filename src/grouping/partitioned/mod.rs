@@ -234,13 +234,28 @@ pub(crate) fn run<O: Observer>(
     group_with(scene, params, &chunking, observer, budget)
 }
 
+/// Runs the partitioned schedule on primitive boxes (see [`group_boxes`]) with the default
+/// [`Chunking`].
+pub(crate) fn run_boxes<O: Observer>(
+    aabb: Vec<Aabb>,
+    params: &ResolvedParams,
+    observer: O,
+    budget: &Budget<'_>,
+) -> Result<Grouping, Stopped> {
+    let chunking = Chunking {
+        top: params.mode.chunk_top,
+        ..Chunking::DEFAULT
+    };
+    group_boxes(aabb, params, &chunking, observer, budget)
+}
+
 /// Runs the partitioned schedule with `chunking` instead of [`Chunking::DEFAULT`] (see the module
 /// doc); `params.mode` is not read. Panics only if the scene is empty.
 pub fn group_with<O: Observer>(
     scene: &Scene,
     params: &ResolvedParams,
     chunking: &Chunking,
-    mut observer: O,
+    observer: O,
     budget: &Budget<'_>,
 ) -> Result<Grouping, Stopped> {
     assert!(!scene.is_empty(), "grouping needs at least one primitive");
@@ -251,6 +266,22 @@ pub fn group_with<O: Observer>(
     // Room for the merged bodies from the start (no copy when they are added).
     let mut aabb: Vec<Aabb> = Vec::with_capacity(2 * n - 1);
     aabb.par_extend((0..n).into_par_iter().map(|i| scene.prim_aabb(i)));
+    group_boxes(aabb, params, chunking, observer, budget)
+}
+
+/// The partitioned schedule (AABB p-set) on primitives whose boxes are `aabb`, the primitive
+/// ids being their indices (`aabb` grows to the tree's 2N − 1 boxes: give it that capacity to
+/// spare a copy). Panics only if `aabb` is empty.
+pub fn group_boxes<O: Observer>(
+    mut aabb: Vec<Aabb>,
+    params: &ResolvedParams,
+    chunking: &Chunking,
+    mut observer: O,
+    budget: &Budget<'_>,
+) -> Result<Grouping, Stopped> {
+    assert!(!aabb.is_empty(), "grouping needs at least one primitive");
+    let n = aabb.len();
+    aabb.reserve_exact(n - 1);
     let mut diameter: Vec<f64> = Vec::with_capacity(2 * n - 1);
     diameter.par_extend(aabb.par_iter().map(Aabb::diameter));
     let codes = morton_order(&aabb);

@@ -13,7 +13,7 @@
 //! the pairs across the two halves (a pair's Cost and round depend on its two bodies alone).
 
 use super::{Body, Ctx, Info, Left, Out, SubStats};
-use crate::grouping::cluster::{fill_balance, tie_tag};
+use crate::grouping::cluster::{fill_balance, pair_cost_any, tie_tag};
 use crate::grouping::mpairs::order_bits;
 use std::cell::RefCell;
 
@@ -167,9 +167,9 @@ thread_local! {
 #[inline(always)]
 pub(super) fn eval(ctx: &Ctx, a: &Body, b: &Body) -> (u64, u32) {
     let d = a.aabb.merge(&b.aabb).diameter();
-    let (fill, balance) = fill_balance(d, a.d, b.d);
     let round = a.rd.max(b.rd).max(ctx.gl.first(a.aabb.gap_linf(&b.aabb)));
-    (order_bits(ctx.params.weights.cost(d, fill, balance)), round)
+    let cost = pair_cost_any(&ctx.params.weights, d, a.d, b.d);
+    (order_bits(cost), round)
 }
 
 /// Every pair of `body` (`set(i, j, pair)`, `i < j`): each part's own pairs (copied when the

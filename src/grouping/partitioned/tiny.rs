@@ -41,12 +41,17 @@ impl Pairs {
         (pairs, with.iter().filter(|&&w| w).count() as u32)
     }
 
-    /// The pair merged next in round `r` and its round (clamped to `r`).
-    fn next(&self, r: u32) -> Option<(usize, usize, u32)> {
+    /// The pair merged next in round `r` and its round (clamped to `r`); with `COUNT`, also
+    /// the number of pairs eligible in round `r` (else 0), counted in the same pass.
+    fn next<const COUNT: bool>(&self, r: u32) -> (Option<(usize, usize, u32)>, u64) {
         let mut best: Option<(u32, u64, usize, usize)> = None;
+        let mut eligible = 0u64;
         for i in (0..self.m).filter(|&i| self.live[i]) {
             for j in (i + 1..self.m).filter(|&j| self.live[j]) {
                 let (pr, c) = (self.round[i][j].max(r), self.cost[i][j]);
+                if COUNT {
+                    eligible += u64::from(self.round[i][j] <= r);
+                }
                 let wins = match best {
                     None => true,
                     Some((br, bc, bi, bj)) => {
@@ -60,7 +65,7 @@ impl Pairs {
                 }
             }
         }
-        best.map(|(pr, _, i, j)| (i, j, pr))
+        (best.map(|(pr, _, i, j)| (i, j, pr)), eligible)
     }
 
     /// The pair's tie tags, smaller first.
@@ -104,9 +109,15 @@ pub(super) fn run(
     }
     pairs_of(ctx, body, &parts, &mut st, |i, j, pair| p.set(i, j, pair));
     let mut round = 0u32;
-    st.eligible_pairs += p.eligible(round).0;
     for made in 0..m - keep {
-        let (i, j, r) = p.next(round).expect("more than one body is left");
+        let (pair, eligible) = if made == 0 {
+            // The first round start's eligible pairs, counted by the same pass.
+            p.next::<true>(round)
+        } else {
+            p.next::<false>(round)
+        };
+        st.eligible_pairs += eligible;
+        let (i, j, r) = pair.expect("more than one body is left");
         assert!(r != NEVER, "bodies of NaN size never become eligible");
         if r > round {
             // Step 5 until this pair is eligible: a round start.
