@@ -40,6 +40,12 @@ impl Limits {
         Limits { tab }
     }
 
+    /// The number of rounds before the limit is infinite (the last one's is).
+    #[cfg(test)]
+    pub(super) fn rounds(&self) -> usize {
+        self.tab.len()
+    }
+
     /// The limit of round `r`.
     #[inline]
     pub(super) fn at(&self, r: u32) -> f64 {
@@ -57,9 +63,14 @@ impl Limits {
             return NEVER;
         }
         let last = t.len() - 1;
-        // The binary exponents differ by about the answer; step to it exactly.
-        let e = |v: f64| ((v.to_bits() >> 52) & 0x7ff) as i64;
-        let mut r = (e(x) - e(t[0])).clamp(0, last as i64) as usize;
+        // t[r] = t[0]·2^r exactly, so for normal numbers the answer is the difference of the
+        // binary exponents, plus one when x's mantissa is the larger (no branch to mispredict);
+        // the steps below then do nothing, and fix subnormal limits and the infinite end.
+        let (bx, b0) = (x.to_bits(), t[0].to_bits());
+        let e = |b: u64| ((b >> 52) & 0x7ff) as i64;
+        let frac = |b: u64| b & ((1 << 52) - 1);
+        let r = e(bx) - e(b0) + i64::from(frac(bx) > frac(b0));
+        let mut r = r.clamp(0, last as i64) as usize;
         while r < last && t[r] < x {
             r += 1;
         }

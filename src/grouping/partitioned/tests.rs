@@ -188,4 +188,22 @@ fn limits_give_the_first_round_that_admits_a_value() {
     }
     assert_eq!(l.first(f64::INFINITY), l.first(f64::INFINITY));
     assert!(l.at(l.first(f64::INFINITY)).is_infinite());
+    // Against a linear search, for normal and subnormal bases and values at, just above and
+    // just below every limit.
+    for base in [0.3, 1.0, 1.5, 1e-310, 5e-324, 1e300] {
+        let l = Limits::new(base);
+        let naive = |x: f64| (0u32..).find(|&r| x <= l.at(r)).unwrap();
+        for r in 0..l.rounds() as u32 {
+            let v = l.at(r);
+            for x in [
+                v,
+                f64::from_bits(v.to_bits() + 1),
+                f64::from_bits(v.to_bits() - 1),
+            ] {
+                if x.is_finite() && x > 0.0 {
+                    assert_eq!(l.first(x), naive(x), "base {base}, x {x}");
+                }
+            }
+        }
+    }
 }
