@@ -4,6 +4,7 @@
 
 use crate::geom::Aabb;
 use crate::scene::Scene;
+use rayon::prelude::*;
 
 /// The p-set wrapper bodies carry while grouping.
 #[derive(
@@ -300,7 +301,7 @@ impl Params {
     /// scene's.
     pub fn resolve_boxes(&self, boxes: &[Aabb]) -> ResolvedParams {
         self.resolve_with(
-            || boxes.iter().map(Aabb::diameter).collect(),
+            || boxes.par_iter().map(Aabb::diameter).collect(),
             || boxes.iter().fold(Aabb::EMPTY, |u, b| u.merge(b)).diameter(),
         )
     }
