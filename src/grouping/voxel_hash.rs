@@ -319,27 +319,15 @@ impl VoxelHash {
     /// in turn (the hardware prefetcher follows each cell's contiguous records).
     #[inline]
     pub fn prefetch(&self, c: u32) {
-        #[cfg(target_arch = "x86_64")]
         for r in self.recs(c).iter().take(2) {
-            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-            // SAFETY: SSE is part of x86-64; a prefetch reads nothing and cannot fault.
-            unsafe { _mm_prefetch::<_MM_HINT_T0>((r as *const Rec).cast()) };
+            prefetch(r);
         }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = c;
     }
 
     /// Asks the CPU to start loading cell `c`'s bounds and arena place (a no-op off x86-64).
     #[inline]
     pub fn prefetch_cell(&self, c: u32) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-            // SAFETY: SSE is part of x86-64; a prefetch reads nothing and cannot fault.
-            unsafe { _mm_prefetch::<_MM_HINT_T0>((&self.cells[c as usize] as *const Cell).cast()) };
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = c;
+        prefetch(&self.cells[c as usize]);
     }
 
     /// What cell `c` has held this round.
@@ -385,4 +373,17 @@ fn floor(v: f64) -> i64 {
 #[inline]
 fn key(v: [i64; 3]) -> u128 {
     (v[0] as u128) | ((v[1] as u128) << 42) | ((v[2] as u128) << 84)
+}
+/// Asks the CPU to start loading the cache line of `x` (a no-op off x86-64): for reads whose
+/// addresses are known ahead but that would each wait for a cache miss in turn.
+#[inline(always)]
+pub(crate) fn prefetch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        // SAFETY: SSE is part of x86-64; a prefetch reads nothing and cannot fault.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>((x as *const T).cast()) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
 }

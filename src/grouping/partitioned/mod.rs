@@ -57,6 +57,7 @@ mod tiny;
 use super::cluster;
 use super::events::{Event, Merge, Observer, Part, PartKind};
 use super::subset_tree::SubsetTree;
+use super::voxel_hash::prefetch;
 use super::{Budget, Grouping, PSet, ResolvedParams, Stats, StopReason, Stopped};
 use crate::geom::Aabb;
 use crate::scene::Scene;
@@ -66,6 +67,9 @@ use rayon::prelude::*;
 use small::Limits;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
+/// How many leaves ahead the gather asks for the box it will read (its reads are random).
+const GATHER_AHEAD: usize = 16;
 
 /// Halves of at least this many primitives are grouped in parallel.
 const GRAIN: u32 = 2048;
@@ -316,9 +320,13 @@ pub fn group_boxes<O: Observer>(
     // The leaves as bodies in Morton order: one gather (its loads overlap) instead of one per
     // chunk, of the box alone (the diameter is recomputed, the same value, rather than read at
     // random from a second array); `rd` is set by their chunk.
-    let mut leaves: Vec<Body> = codes
-        .par_iter()
-        .map(|&(_, id)| {
+    let mut leaves: Vec<Body> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            if let Some(&(_, ahead)) = codes.get(i + GATHER_AHEAD) {
+                prefetch(&aabb[ahead as usize]);
+            }
+            let id = codes[i].1;
             let aabb = aabb[id as usize];
             Body {
                 id,
