@@ -224,6 +224,14 @@ impl<'a> Out<'a> {
     }
 }
 
+/// The default [`Chunking`] with the root share `params.mode` names.
+fn chunking_of(params: &ResolvedParams) -> Chunking {
+    Chunking {
+        top: params.mode.chunk_top,
+        ..Chunking::DEFAULT
+    }
+}
+
 /// Runs the partitioned schedule with the default [`Chunking`].
 pub(crate) fn run<O: Observer>(
     scene: &Scene,
@@ -231,11 +239,7 @@ pub(crate) fn run<O: Observer>(
     observer: O,
     budget: &Budget<'_>,
 ) -> Result<Grouping, Stopped> {
-    let chunking = Chunking {
-        top: params.mode.chunk_top,
-        ..Chunking::DEFAULT
-    };
-    group_with(scene, params, &chunking, observer, budget)
+    group_with(scene, params, &chunking_of(params), observer, budget)
 }
 
 /// Runs the partitioned schedule on primitive boxes (see [`group_boxes`]) with the default
@@ -246,11 +250,7 @@ pub(crate) fn run_boxes<O: Observer>(
     observer: O,
     budget: &Budget<'_>,
 ) -> Result<Grouping, Stopped> {
-    let chunking = Chunking {
-        top: params.mode.chunk_top,
-        ..Chunking::DEFAULT
-    };
-    group_boxes(aabb, params, &chunking, observer, budget)
+    group_boxes(aabb, params, &chunking_of(params), observer, budget)
 }
 
 /// Runs the partitioned schedule with `chunking` instead of [`Chunking::DEFAULT`] (see the module
