@@ -160,10 +160,32 @@ pub(super) fn plan(codes: &[(u64, u32)], chunking: &Chunking) -> Vec<Node> {
     let keep = Keep::new(chunking, codes.len());
     let planner = Planner { codes, keep: &keep };
     let blocks = planner.blocks(0, codes.len() as u32, 0).blocks;
-    let mut nodes = Vec::with_capacity(blocks.iter().map(Vec::len).sum());
-    for b in &blocks {
-        nodes.extend_from_slice(b);
+    let total = blocks.iter().map(Vec::len).sum();
+    let mut nodes: Vec<Node> = Vec::with_capacity(total);
+    if rayon::current_num_threads() == 1 {
+        for b in &blocks {
+            nodes.extend_from_slice(b);
+        }
+        return nodes;
     }
+    // On several threads each block is copied to its place by any thread (so are the fresh
+    // pages faulted in).
+    let mut rest = &mut nodes.spare_capacity_mut()[..total];
+    let mut places = Vec::with_capacity(blocks.len());
+    for b in &blocks {
+        let (place, after) = std::mem::take(&mut rest).split_at_mut(b.len());
+        places.push(place);
+        rest = after;
+    }
+    places
+        .into_par_iter()
+        .zip(&blocks)
+        .with_max_len(1)
+        .for_each(|(place, b)| {
+            place.write_copy_of_slice(b);
+        });
+    // SAFETY: the places cover the first `total` slots, and each was written above.
+    unsafe { nodes.set_len(total) };
     nodes
 }
 
