@@ -374,6 +374,7 @@ fn floor(v: f64) -> i64 {
 fn key(v: [i64; 3]) -> u128 {
     (v[0] as u128) | ((v[1] as u128) << 42) | ((v[2] as u128) << 84)
 }
+
 /// Asks the CPU to start loading the cache line of `x` (a no-op off x86-64): for reads whose
 /// addresses are known ahead but that would each wait for a cache miss in turn.
 #[inline(always)]

@@ -118,8 +118,6 @@ struct Keep {
     chunking: Chunking,
     small: Vec<u32>,
     n: u64,
-    /// The scene is one subproblem ([`Chunking::whole`]): every node keeps all it has.
-    whole: bool,
 }
 
 impl Keep {
@@ -131,16 +129,12 @@ impl Keep {
             chunking: *chunking,
             small,
             n: n as u64,
-            whole: chunking.whole(n),
         }
     }
 
     /// max(f(`f_of`), ⌈top·`size`/N⌉).
     #[inline]
     fn at(&self, f_of: u32, size: u32) -> u32 {
-        if self.whole {
-            return size;
-        }
         let f = match self.small.get(f_of as usize) {
             Some(&f) => f,
             None => self.chunking.keep(f_of),
@@ -157,9 +151,21 @@ const PLAN_GRAIN: u32 = 1 << 15;
 /// large ranges are planned in parallel into blocks of nodes, laid end to end at the end (the
 /// same nodes as one sequential pass, whatever the number of threads).
 pub(super) fn plan(codes: &[(u64, u32)], chunking: &Chunking) -> Vec<Node> {
+    let n = codes.len() as u32;
+    if chunking.whole(codes.len()) {
+        // One subproblem: the root over every primitive, the exact schedule's step.
+        return vec![Node {
+            lo: 0,
+            hi: n,
+            right_ahead: 0,
+            level: 0,
+            inputs: n,
+            keep: 1,
+        }];
+    }
     let keep = Keep::new(chunking, codes.len());
     let planner = Planner { codes, keep: &keep };
-    let blocks = planner.blocks(0, codes.len() as u32, 0).blocks;
+    let blocks = planner.blocks(0, n, 0).blocks;
     let total = blocks.iter().map(Vec::len).sum();
     let mut nodes: Vec<Node> = Vec::with_capacity(total);
     if rayon::current_num_threads() == 1 {
