@@ -1,7 +1,8 @@
 //! obvhs's PLOC builder (Meister and Bittner, "Parallel Locally-Ordered Clustering for Bounding
 //! Volume Hierarchy Construction", 2018), optionally followed by its SAH reinsertion optimiser
 //! (Meister and Bittner, "Parallel Reinsertion for Bounding Volume Hierarchy Optimization",
-//! 2018), with one primitive per leaf and obvhs's single-threaded build (no `parallel` feature).
+//! 2018), with one primitive per leaf, built with obvhs's `parallel` feature on the current rayon
+//! pool (one thread in a one-thread pool).
 
 use super::topology::Node;
 use obvhs::aabb::Aabb;
