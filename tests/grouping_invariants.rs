@@ -176,3 +176,47 @@ fn far_offset_gives_the_same_tree() {
         );
     }
 }
+
+/// The exact schedule with its round-start scans on several threads (rounds of at least 2,048
+/// active bodies) gives the merge sequence and events of one thread: a soup whose late rounds
+/// hold thousands of bodies in a few cells, and clusters of coincident triangles (equal boxes,
+/// ties) under other weights and seeded tie tags.
+#[test]
+fn exact_schedule_is_the_same_on_1_2_and_3_threads() {
+    let soup = generate::soup(20_000, 3);
+    let corners: Vec<[f64; 3]> = (0..3000)
+        .map(|i| [(i % 7) as f64 * 5.0, (i % 3) as f64 * 5.0, 0.0])
+        .collect();
+    let stacked = common::triangles(&corners, 1.0);
+    let weighted = Params {
+        weights: Weights {
+            a: 2.0,
+            b: 1.0,
+            c: 1.0,
+        },
+        seed: Some(11),
+        ..Params::default()
+    };
+    for (scene, params) in [
+        (&soup, Params::default()),
+        (&soup, weighted.clone()),
+        (&stacked, Params::default()),
+        (&stacked, weighted),
+    ] {
+        let on = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| run(scene, &params))
+        };
+        let (g1, log1) = on(1);
+        check_tree(scene, &g1, &log1);
+        for threads in [2, 3] {
+            let (g, log) = on(threads);
+            assert_eq!(g.tree, g1.tree, "{threads} threads, {:?}", params.weights);
+            assert_eq!(g.stats, g1.stats);
+            assert_eq!(log, log1);
+        }
+    }
+}

@@ -1,10 +1,11 @@
 //! Step 3's round-start scan (AABB p-set) on several threads, with the same result as the
 //! sequential scan.
 //!
-//! The voxel hash's cells are cut into contiguous ranges, scanned in parallel exactly as the
-//! sequential scan does (each pair of cells once, each eligible pair once). A range offers a
-//! pair to the partner lists of its own bodies directly — every body lies in one cell, so no two
-//! ranges write the same list — and buffers the offers to bodies of other ranges, which are
+//! The records of the voxel hash, taken cell by cell, are cut into contiguous ranges of equal
+//! length (a late round holds many bodies in a few cells, so ranges of cells would be uneven),
+//! scanned in parallel exactly as the sequential scan does (each pair of cells once, each
+//! eligible pair once). A range offers a pair to the partner lists of its own bodies directly —
+//! every body is one record, so no two ranges write the same list — and buffers the offers to bodies of other ranges, which are
 //! made after the parallel part. A list holds the first partners in (Cost, tie tag) order,
 //! which does not depend on the order of the offers, and the Cost filter that skips offers only
 //! skips ones that could not enter a list, so every list, the pair count and the candidate count
@@ -25,14 +26,14 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Rounds with fewer active bodies scan on one thread.
-pub(super) const MIN_BODIES: usize = 8192;
+pub(super) const MIN_BODIES: usize = 2048;
 
-/// Cell ranges per thread (more than one evens out uneven ranges).
+/// Record ranges per thread (more than one evens out uneven ranges).
 const RANGES_PER_THREAD: usize = 8;
 
 /// Whether a round-start scan of `bodies` active bodies under `limit` runs in parallel.
 pub(super) fn worth_it(bodies: usize, limit: &ScanLimit<'_>) -> bool {
-    bodies >= MIN_BODIES && limit.room == u64::MAX && rayon::current_num_threads() > 1
+    bodies >= MIN_BODIES && limit.budget.max_pairs.is_none() && rayon::current_num_threads() > 1
 }
 
 /// The partner lists, shared by the ranges; each range writes only its own bodies' lists.
@@ -56,7 +57,7 @@ impl Lists {
     }
 }
 
-/// What one cell range found.
+/// What one record range found.
 #[derive(Default)]
 struct Found {
     pairs: u64,
@@ -77,20 +78,32 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         let hash = &self.hash;
         let half_ext = self.half_ext;
         let tags: &[u64] = &self.tag;
-        let cells = hash.cells() as usize;
-        let parts = (rayon::current_num_threads() * RANGES_PER_THREAD).clamp(1, cells.max(1));
+        let cells = hash.cells();
+        // Each cell's first position in the records taken in cell order: ranges are cut by
+        // records, not cells, since a late round holds many bodies in a few cells.
+        let mut first = Vec::with_capacity(cells as usize + 1);
+        let mut total = 0usize;
+        for c in 0..cells {
+            first.push(total);
+            total += hash.recs(c).len();
+        }
+        first.push(total);
+        let first = &first;
+        let parts = (rayon::current_num_threads() * RANGES_PER_THREAD).clamp(1, total.max(1));
         let lists = self.partners.lists_mut();
         let slots = lists.len();
         let lists = Lists(lists.as_mut_ptr());
         let halt = AtomicBool::new(false);
         let (budget, timed) = (limit.budget, limit.timed);
         let scan = |p: usize| -> (Found, Option<crate::grouping::StopReason>) {
-            let (lo, hi) = ((p * cells / parts) as u32, ((p + 1) * cells / parts) as u32);
+            let (lo, hi) = (p * total / parts, (p + 1) * total / parts);
+            let ours = |cell: u32, i: usize| (lo..hi).contains(&(first[cell as usize] + i));
             let mut f = Found::default();
             let mut near: Vec<u32> = Vec::with_capacity(27);
             let mut fwd: Vec<u32> = Vec::with_capacity(27);
             let mut bodies = 0u32;
-            for c in lo..hi {
+            let c0 = first.partition_point(|&s| s <= lo).saturating_sub(1) as u32;
+            for c in (c0..cells).take_while(|&c| first[c as usize] < hi) {
                 let vc = hash.coords(c);
                 let (mut clo, mut chi) = (
                     P3::new(f64::MAX, f64::MAX, f64::MAX),
@@ -107,7 +120,8 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                         near.push(cell);
                     }
                 });
-                for i in 0..hash.recs(c).len() {
+                let at = first[c as usize];
+                for i in lo.saturating_sub(at)..hash.recs(c).len().min(hi - at) {
                     if timed {
                         bodies = bodies.wrapping_add(1);
                         if bodies.is_multiple_of(Budget::CLOCK_EVERY) {
@@ -129,12 +143,10 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                             .copied()
                             .filter(|&cell| reachable(hash.bounds(cell), &xa, glimit)),
                     );
-                    let own = (&hash.recs(c)[i + 1..], true);
-                    let segs = fwd
-                        .iter()
-                        .map(|&cell| (hash.recs(cell), (lo..hi).contains(&cell)));
-                    for (seg, local) in std::iter::once(own).chain(segs) {
-                        for yr in seg {
+                    let own = (c, i + 1);
+                    let segs = fwd.iter().map(|&cell| (cell, 0));
+                    for (cell, from) in std::iter::once(own).chain(segs) {
+                        for (j, yr) in hash.recs(cell).iter().enumerate().skip(from) {
                             if finite && yr.aabb.min.x - xa.max.x > glimit {
                                 break;
                             }
@@ -145,10 +157,10 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                             f.pairs += 1;
                             let e = merged_extents(&xa, &yr.aabb);
                             let sy = yr.slot as usize;
-                            // SAFETY: `x` lies in a cell of this range, which alone writes
-                            // its list; `y` too when `local`; `x != y`.
+                            // SAFETY: `x` is a record of this range, which alone writes its
+                            // list; `y` too when it is ours; `x != y`.
                             let lx = unsafe { lists.get(sx) };
-                            if local {
+                            if ours(cell, j) {
                                 // SAFETY: as above.
                                 let ly = unsafe { lists.get(sy) };
                                 if let Some(q) = quick {
