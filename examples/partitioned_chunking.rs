@@ -2,8 +2,9 @@
 //! scenes: SAH and node tests per query (AABB BVs, standard workload) of each chunking's tree
 //! over the exact tree's, and its grouping time on one thread. How the defaults were chosen.
 //!
-//! `cargo run --release --example partitioned_chunking [MAX_SOUP] [DELTA:EPSILON[:TOP] ...]`
-//! — default 100000 and 4:0.2 (the default chunking) and 20:0.1 (AAC's high-quality setting).
+//! `cargo run --release --example partitioned_chunking [MAX_SOUP] [DELTA:EPSILON[:TOP] ...]
+//! [FILE.obj ...]` — default 100000 and the default chunking and 20:0.1 (AAC's high-quality
+//! setting); OBJ files are grouped after the targets scenes (held-out scenes).
 
 use std::time::Instant;
 use wraptree::grouping::partitioned::{Chunking, group_with};
@@ -27,6 +28,7 @@ fn main() -> anyhow::Result<()> {
     let mut chunkings = args
         .iter()
         .skip(1)
+        .filter(|a| !a.ends_with(".obj"))
         .map(|a| parse(a))
         .collect::<anyhow::Result<Vec<_>>>()?;
     if chunkings.is_empty() {
@@ -41,7 +43,10 @@ fn main() -> anyhow::Result<()> {
     }
     println!();
     let mut sums = vec![(0.0, 0.0, 0.0, 0.0); chunkings.len()];
-    let scenes = target_scenes(max_soup)?;
+    let mut scenes = target_scenes(max_soup)?;
+    for path in args.iter().filter(|a| a.ends_with(".obj")) {
+        scenes.push(wraptree::scene::load_path(path.as_ref(), &Default::default())?.scene);
+    }
     for scene in &scenes {
         let workload = Workload::standard(scene, 1);
         let quality = |tree: &SubsetTree| {

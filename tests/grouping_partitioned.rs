@@ -355,7 +355,7 @@ fn replay_verifies_a_partitioned_recording() {
 }
 
 #[test]
-fn a_chosen_root_share_is_recorded_and_replayed() {
+fn a_chosen_root_share_and_epsilon_are_recorded_and_replayed() {
     let dir = tempfile::tempdir().unwrap();
     let mut obj = Vec::new();
     // Whole under the default share (`Chunking::whole`), split under a share of 256.
@@ -374,6 +374,26 @@ fn a_chosen_root_share_is_recorded_and_replayed() {
     let out = wraptree(&["replay", "p.mcap", "--verify"], dir.path());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success() && text.contains("verified"), "{text}");
+    // AAC's fast ε (the default before ε = 0.5) gives another run, recorded and reproduced.
+    let out = wraptree(
+        &[
+            &args[..],
+            &["e", "--chunk-top", "256", "--chunk-epsilon", "0.2"],
+        ]
+        .concat(),
+        dir.path(),
+    );
+    let rec_e = recorded(&out, &dir.path().join("e.mcap"));
+    assert_eq!(rec_e.params.mode.chunk_epsilon, 0.2);
+    assert_ne!(rec_e.merges, rec.merges);
+    let out = wraptree(&["replay", "e.mcap", "--verify"], dir.path());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("verified"), "{text}");
+    let out = wraptree(
+        &[&args[..], &["f", "--chunk-epsilon", "0.7"]].concat(),
+        dir.path(),
+    );
+    common::assert_one_line_error(&out, "--chunk-epsilon must be in [0, 0.5]");
     // The default share groups this scene whole: one part, the top.
     let out = wraptree(&[&args[..], &["d"]].concat(), dir.path());
     let rec = recorded(&out, &dir.path().join("d.mcap"));
@@ -381,4 +401,6 @@ fn a_chosen_root_share_is_recorded_and_replayed() {
     assert_eq!(rec.parts.len(), 1);
     let out = wraptree(&["group", "s.obj", "--chunk-top", "64"], dir.path());
     common::assert_one_line_error(&out, "--chunk-top needs --schedule partitioned");
+    let out = wraptree(&["group", "s.obj", "--chunk-epsilon", "0.2"], dir.path());
+    common::assert_one_line_error(&out, "--chunk-epsilon needs --schedule partitioned");
 }

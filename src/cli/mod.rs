@@ -135,6 +135,11 @@ pub struct GroupArgs {
     /// [default: 8192].
     #[arg(long, value_name = "N")]
     pub chunk_top: Option<u32>,
+    /// Partitioned schedule: ε of AAC's reduction f(n) = ⌈c·n^(1/2 − ε)⌉, c = δ^(1/2 + ε)/2
+    /// (δ = 4), the bodies a node of n primitives leaves below the root share: 0.5 leaves 2
+    /// per node, AAC's fast setting 0.2 more (slower) [default: 0.5].
+    #[arg(long, value_name = "E")]
+    pub chunk_epsilon: Option<f64>,
     /// Threads for the parallel steps (partitioned chunks, the exact run's round-start scans);
     /// the tree is the same for any count [default: all cores].
     #[arg(long, value_name = "N")]
@@ -168,10 +173,14 @@ impl GroupArgs {
                 instancing: self.instancing,
                 cost: self.cost,
                 chunk_top: self.chunk_top.unwrap_or(Mode::default().chunk_top),
+                chunk_epsilon: self.chunk_epsilon.unwrap_or(Mode::default().chunk_epsilon),
             },
         };
         if self.chunk_top.is_some() && self.schedule != Schedule::Partitioned {
             anyhow::bail!("--chunk-top needs --schedule partitioned");
+        }
+        if self.chunk_epsilon.is_some() && self.schedule != Schedule::Partitioned {
+            anyhow::bail!("--chunk-epsilon needs --schedule partitioned");
         }
         params.check().map_err(anyhow::Error::msg)?;
         Ok(params)

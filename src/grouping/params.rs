@@ -143,7 +143,7 @@ pub enum CostMeasure {
 /// How a grouping run is organised beyond its Cost weights and limits. The default is the
 /// literal §2.2 run; every other setting is recorded in recordings' metadata so that
 /// `replay --verify` re-runs the same mode.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
 pub struct Mode {
     /// Exact or partitioned schedule.
@@ -159,6 +159,9 @@ pub struct Mode {
     /// subproblem (the exact schedule's tree); 0 = AAC's reduction alone. The exact schedule
     /// does not read it.
     pub chunk_top: u32,
+    /// The partitioned schedule's ε in AAC's reduction f(n) = ⌈c·n^(1/2 − ε)⌉
+    /// ([`Chunking::epsilon`](crate::grouping::partitioned::Chunking::epsilon)), in [0, 1/2].
+    pub chunk_epsilon: f64,
 }
 
 impl Default for Mode {
@@ -170,6 +173,7 @@ impl Default for Mode {
             instancing: false,
             cost: CostMeasure::default(),
             chunk_top: crate::grouping::partitioned::Chunking::DEFAULT.top,
+            chunk_epsilon: crate::grouping::partitioned::Chunking::DEFAULT.epsilon,
         }
     }
 }
@@ -188,6 +192,12 @@ impl Mode {
         }
         if self.pregroup != Pregroup::None && pset != PSet::Aabb {
             return Err("--pregroup needs --pset aabb (parts are grouped as boxes)".to_string());
+        }
+        if !(0.0..=0.5).contains(&self.chunk_epsilon) {
+            return Err(format!(
+                "--chunk-epsilon must be in [0, 0.5], got {}",
+                self.chunk_epsilon
+            ));
         }
         Ok(())
     }

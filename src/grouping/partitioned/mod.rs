@@ -228,6 +228,7 @@ impl<'a> Out<'a> {
 fn chunking_of(params: &ResolvedParams) -> Chunking {
     Chunking {
         top: params.mode.chunk_top,
+        epsilon: params.mode.chunk_epsilon,
         ..Chunking::DEFAULT
     }
 }

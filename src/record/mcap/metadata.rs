@@ -195,7 +195,7 @@ pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String,
     if p.mode.schedule == Schedule::Partitioned {
         let ch = Chunking::DEFAULT;
         put("chunk_delta", ch.delta.to_string());
-        put("chunk_epsilon", ch.epsilon.to_string());
+        put("chunk_epsilon", p.mode.chunk_epsilon.to_string());
         put("chunk_top", p.mode.chunk_top.to_string());
     }
     put("detail", value_name(&info.detail));
@@ -303,6 +303,11 @@ fn mode(m: &BTreeMap<String, String>) -> Result<Mode> {
         chunk_top: match m.contains_key("chunk_top") {
             true => parse(m, "chunk_top")?,
             false => d.chunk_top,
+        },
+        // Recordings before ε became a setting hold the chunking they were made with.
+        chunk_epsilon: match m.contains_key("chunk_epsilon") {
+            true => parse(m, "chunk_epsilon")?,
+            false => d.chunk_epsilon,
         },
     })
 }
