@@ -23,9 +23,10 @@ impl Chunking {
     /// bodies, and the nodes above it leave ⌈top·n/N⌉, with a root step of about 8,192 bodies.
     /// Against AAC's fast setting ε = 0.2 (README, "How the chunking was chosen") it took 26 %
     /// less time at 10^6 on one and two threads, for trees as close to the exact schedule's on
-    /// the bench scenes (within 2 % on all but the 10^5 soup, SAH 3.5 %) and closer on held-out
-    /// real meshes (within 2 %, against 2.3–3.6 %); scenes of at most 12,288 primitives get the
-    /// exact schedule's tree.
+    /// the bench scenes (within 2 % on all but the 10^5 soup, SAH 3.5 %), closer on three
+    /// pybullet meshes (within 2 %, against 2.3–3.6 %) and farther on large assemblies of copies
+    /// (800 robot bases: SAH 11 % over, against 7 %); scenes of at most 12,288 primitives get
+    /// the exact schedule's tree.
     pub const DEFAULT: Chunking = Chunking {
         delta: 4,
         epsilon: 0.5,
