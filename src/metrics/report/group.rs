@@ -14,9 +14,18 @@ pub fn group_text(scene: &Scene, g: &Grouping, threads: usize, seconds: f64) -> 
         "params      A={} B={} C={} DLimit0={:.6e} GLimit0={:.6e} pset={:?}",
         p.weights.a, p.weights.b, p.weights.c, p.dlimit0, p.glimit0, p.pset
     );
+    let chunking = match p.mode.schedule {
+        grouping::Schedule::Partitioned => format!(
+            " (chunks of δ = {}, ε = {}, root share {})",
+            grouping::partitioned::Chunking::DEFAULT.delta,
+            p.mode.chunk_epsilon,
+            p.mode.chunk_top
+        ),
+        grouping::Schedule::Exact => String::new(),
+    };
     let _ = writeln!(
         s,
-        "schedule    {:?} on {threads} thread{}",
+        "schedule    {:?} on {threads} thread{}{chunking}",
         p.mode.schedule,
         if threads == 1 { "" } else { "s" }
     );
