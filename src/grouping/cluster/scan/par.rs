@@ -5,11 +5,12 @@
 //! length (a late round holds many bodies in a few cells, so ranges of cells would be uneven),
 //! scanned in parallel exactly as the sequential scan does (each pair of cells once, each
 //! eligible pair once). A range offers a pair to the partner lists of its own bodies directly —
-//! every body is one record, so no two ranges write the same list — and buffers the offers to bodies of other ranges, which are
-//! made after the parallel part. A list holds the first partners in (Cost, tie tag) order,
-//! which does not depend on the order of the offers, and the Cost filter that skips offers only
-//! skips ones that could not enter a list, so every list, the pair count and the candidate count
-//! are those of the sequential scan, for any number of threads.
+//! every body is one record, so no two ranges write the same list — and buffers the offers to
+//! bodies of other ranges, which are made after the parallel part. A list holds the first
+//! partners in (Cost, tie tag) order, which does not depend on the order of the offers, and the
+//! Cost filter that skips offers only skips ones that could not enter a list, so every list, the
+//! pair count and the candidate count are those of the sequential scan, for any number of
+//! threads.
 //!
 //! It runs when the pool has several threads, the round has at least [`MIN_BODIES`] active
 //! bodies and the budget has no `max_pairs` (where a scan stops then depends on the order in
