@@ -22,11 +22,12 @@
 //! not timed either: the grouping and partitioned grouping (AABB p-set) are timed from the
 //! boxes, DLimit0's median included ([`grouping::group_boxes`]); the hull p-set and the
 //! pre-grouped methods, which need the polygons, from the scene. The partitioned grouping, the
-//! pre-grouped ones (whose time includes finding the components and the copies) and obvhs PLOC
-//! (built with its `parallel` feature) use the current rayon pool (run them inside
-//! `ThreadPool::install` to choose the thread count); every other builder is single-threaded. The refinement pass searches on rayon's threads and
-//! its time is added to the builder's: a refined method's time is the total,
-//! [`Built::refine_seconds`] the refinement's part.
+//! exact grouping's round-start scans (rounds of at least 2,048 active bodies), the pre-grouped
+//! methods (whose time includes finding the components and the copies) and obvhs PLOC (built
+//! with its `parallel` feature) use the current rayon pool (run them inside
+//! `ThreadPool::install` to choose the thread count); every other builder is single-threaded.
+//! The refinement pass searches on rayon's threads and its time is added to the builder's: a
+//! refined method's time is the total, [`Built::refine_seconds`] the refinement's part.
 
 pub mod goldsmith_salmon;
 pub mod median_split;
