@@ -2,7 +2,7 @@
 //! scenes: SAH and node tests per query (AABB BVs, standard workload) of each chunking's tree
 //! over the exact tree's, and its grouping time on one thread. How the defaults were chosen.
 //!
-//! `cargo run --release --example partitioned_chunking [MAX_SOUP] [DELTA:EPSILON[:TOP] ...]
+//! `cargo run --release --example partitioned_chunking [MAX_SOUP] [DELTA:EPSILON[:TOP[:SAH]] ...]
 //! [FILE.obj ...]` — default 100000 and the default chunking and 20:0.1 (AAC's high-quality
 //! setting); OBJ files are grouped after the targets scenes (held-out scenes).
 
@@ -19,6 +19,7 @@ fn parse(s: &str) -> anyhow::Result<Chunking> {
     ch.delta = v[0].parse()?;
     ch.epsilon = v.get(1).map_or(Ok(ch.epsilon), |e| e.parse())?;
     ch.top = v.get(2).map_or(Ok(ch.top), |e| e.parse())?;
+    ch.sah_below = v.get(3).map_or(Ok(ch.sah_below), |e| e.parse())?;
     Ok(ch)
 }
 
@@ -38,7 +39,7 @@ fn main() -> anyhow::Result<()> {
     let budget = Budget::default();
     print!("{:<18} {:>8} {:>9}", "scene", "N", "exact ms");
     for ch in &chunkings {
-        let name = format!("{}:{}:{}", ch.delta, ch.epsilon, ch.top);
+        let name = format!("{}:{}:{}:{}", ch.delta, ch.epsilon, ch.top, ch.sah_below);
         print!(" | {name:>17} {:>6} {:>6}", "SAH", "qry");
     }
     println!();

@@ -356,7 +356,7 @@ fn replay_verifies_a_partitioned_recording() {
 }
 
 #[test]
-fn a_chosen_root_share_and_epsilon_are_recorded_and_replayed() {
+fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
     let dir = tempfile::tempdir().unwrap();
     let mut obj = Vec::new();
     // Whole under the default share (`Chunking::whole`), split under a share of 256.
@@ -390,6 +390,23 @@ fn a_chosen_root_share_and_epsilon_are_recorded_and_replayed() {
     let out = wraptree(&["replay", "e.mcap", "--verify"], dir.path());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success() && text.contains("verified"), "{text}");
+    // Morton cuts throughout (the split before the SAH cuts): another run, recorded and
+    // reproduced; a recording that does not name its SAH cuts (made before them) reads as one.
+    let out = wraptree(
+        &[&args[..], &["m", "--chunk-top", "256", "--chunk-sah", "0"]].concat(),
+        dir.path(),
+    );
+    let rec_m = recorded(&out, &dir.path().join("m.mcap"));
+    assert_eq!(rec.params.mode.chunk_sah, Chunking::DEFAULT.sah_below);
+    assert_eq!(rec_m.params.mode.chunk_sah, 0);
+    assert_ne!(rec_m.merges, rec.merges);
+    let out = wraptree(&["replay", "m.mcap", "--verify"], dir.path());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("verified"), "{text}");
+    let mut old = rec.metadata.clone();
+    old.remove("chunk_sah");
+    let params = wraptree::record::mcap::metadata::params(&old).unwrap();
+    assert_eq!(params.mode.chunk_sah, 0);
     let out = wraptree(
         &[&args[..], &["f", "--chunk-epsilon", "0.7"]].concat(),
         dir.path(),
@@ -404,4 +421,6 @@ fn a_chosen_root_share_and_epsilon_are_recorded_and_replayed() {
     common::assert_one_line_error(&out, "--chunk-top needs --schedule partitioned");
     let out = wraptree(&["group", "s.obj", "--chunk-epsilon", "0.2"], dir.path());
     common::assert_one_line_error(&out, "--chunk-epsilon needs --schedule partitioned");
+    let out = wraptree(&["group", "s.obj", "--chunk-sah", "0"], dir.path());
+    common::assert_one_line_error(&out, "--chunk-sah needs --schedule partitioned");
 }

@@ -140,6 +140,11 @@ pub struct GroupArgs {
     /// per node, AAC's fast setting 0.2 more (slower) [default: 0.5].
     #[arg(long, value_name = "E")]
     pub chunk_epsilon: Option<f64>,
+    /// Partitioned schedule: ranges of at most N primitives are cut where binned SAH on the
+    /// longest axis of their centres puts the cut, not at a Morton bit (which runs through
+    /// clusters); 0 = Morton cuts throughout, the split before session 11 [default: 256].
+    #[arg(long, value_name = "N")]
+    pub chunk_sah: Option<u32>,
     /// Threads for the parallel steps (partitioned chunks, the exact run's round-start scans);
     /// the tree is the same for any count [default: all cores].
     #[arg(long, value_name = "N")]
@@ -174,6 +179,7 @@ impl GroupArgs {
                 cost: self.cost,
                 chunk_top: self.chunk_top.unwrap_or(Mode::default().chunk_top),
                 chunk_epsilon: self.chunk_epsilon.unwrap_or(Mode::default().chunk_epsilon),
+                chunk_sah: self.chunk_sah.unwrap_or(Mode::default().chunk_sah),
             },
         };
         if self.chunk_top.is_some() && self.schedule != Schedule::Partitioned {
@@ -181,6 +187,9 @@ impl GroupArgs {
         }
         if self.chunk_epsilon.is_some() && self.schedule != Schedule::Partitioned {
             anyhow::bail!("--chunk-epsilon needs --schedule partitioned");
+        }
+        if self.chunk_sah.is_some() && self.schedule != Schedule::Partitioned {
+            anyhow::bail!("--chunk-sah needs --schedule partitioned");
         }
         params.check().map_err(anyhow::Error::msg)?;
         Ok(params)

@@ -162,6 +162,11 @@ pub struct Mode {
     /// The partitioned schedule's ε in AAC's reduction f(n) = ⌈c·n^(1/2 − ε)⌉
     /// ([`Chunking::epsilon`](crate::grouping::partitioned::Chunking::epsilon)), in [0, 1/2].
     pub chunk_epsilon: f64,
+    /// The partitioned schedule's SAH cuts: ranges of at most this many primitives are cut by
+    /// binned SAH instead of at a Morton bit
+    /// ([`Chunking::sah_below`](crate::grouping::partitioned::Chunking::sah_below)); 0 =
+    /// Morton cuts throughout.
+    pub chunk_sah: u32,
 }
 
 impl Default for Mode {
@@ -174,6 +179,7 @@ impl Default for Mode {
             cost: CostMeasure::default(),
             chunk_top: crate::grouping::partitioned::Chunking::DEFAULT.top,
             chunk_epsilon: crate::grouping::partitioned::Chunking::DEFAULT.epsilon,
+            chunk_sah: crate::grouping::partitioned::Chunking::DEFAULT.sah_below,
         }
     }
 }

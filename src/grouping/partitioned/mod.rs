@@ -8,7 +8,10 @@
 //!    alike on every axis; ties by id).
 //! 2. The sorted range is split top-down at its highest differing Morton bit (at the middle
 //!    when every code is equal) until a range holds fewer than δ = [`Chunking::delta`]
-//!    primitives: a *chunk*.
+//!    primitives: a *chunk*. Ranges of at most [`Chunking::sah_below`] primitives are cut
+//!    instead at the binned-SAH boundary on the longest axis of their centres (`split`; they
+//!    are reordered, each side keeping its Morton order), where a Morton cut would run through
+//!    clusters.
 //! 3. Bottom-up, each chunk groups its primitives until at most f(δ) bodies remain, and each
 //!    inner node of the split groups the bodies its two halves left until at most f(n) remain,
 //!    n its number of primitives, with AAC's reduction function f(n) = ⌈c·n^(1/2 − ε)⌉,
@@ -50,6 +53,7 @@
 mod big;
 mod plan;
 mod small;
+mod split;
 #[cfg(test)]
 mod tests;
 mod tiny;
@@ -62,9 +66,10 @@ use super::{Budget, Grouping, PSet, ResolvedParams, Stats, StopReason, Stopped};
 use crate::geom::Aabb;
 use crate::scene::Scene;
 pub use plan::Chunking;
-use plan::{Node, morton_order, plan, post_order};
+use plan::{Node, plan, post_order};
 use rayon::prelude::*;
 use small::Limits;
+use split::morton_order;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
@@ -229,6 +234,7 @@ fn chunking_of(params: &ResolvedParams) -> Chunking {
     Chunking {
         top: params.mode.chunk_top,
         epsilon: params.mode.chunk_epsilon,
+        sah_below: params.mode.chunk_sah,
         ..Chunking::DEFAULT
     }
 }
@@ -289,8 +295,30 @@ pub fn group_boxes<O: Observer>(
     aabb.reserve_exact(n - 1);
     let mut diameter: Vec<f64> = Vec::with_capacity(2 * n - 1);
     diameter.par_extend(aabb.par_iter().map(Aabb::diameter));
-    let codes = morton_order(&aabb);
-    let nodes = plan(&codes, chunking);
+    let mut codes = morton_order(&aabb);
+    // The leaves as bodies in Morton order: one gather (its loads overlap) instead of one per
+    // chunk, of the box alone (the diameter is recomputed, the same value, rather than read at
+    // random from a second array); `rd` is set by their chunk.
+    let mut leaves: Vec<Body> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            if let Some(&(_, ahead)) = codes.get(i + GATHER_AHEAD) {
+                prefetch(&aabb[ahead as usize]);
+            }
+            let id = codes[i].1;
+            let aabb = aabb[id as usize];
+            Body {
+                id,
+                rd: 0,
+                aabb,
+                d: aabb.diameter(),
+            }
+        })
+        .collect();
+    // Planned on the leaves themselves: the SAH cuts read their boxes in order, and reorder
+    // them with their codes.
+    let nodes = plan(&mut codes, &mut leaves, chunking);
+    drop(codes);
     let ctx = Ctx {
         params: *params,
         dl: Limits::new(params.dlimit0),
@@ -318,26 +346,6 @@ pub fn group_boxes<O: Observer>(
         nodes: &nodes,
         done: &done,
     };
-    // The leaves as bodies in Morton order: one gather (its loads overlap) instead of one per
-    // chunk, of the box alone (the diameter is recomputed, the same value, rather than read at
-    // random from a second array); `rd` is set by their chunk.
-    let mut leaves: Vec<Body> = (0..n)
-        .into_par_iter()
-        .map(|i| {
-            if let Some(&(_, ahead)) = codes.get(i + GATHER_AHEAD) {
-                prefetch(&aabb[ahead as usize]);
-            }
-            let id = codes[i].1;
-            let aabb = aabb[id as usize];
-            Body {
-                id,
-                rd: 0,
-                aabb,
-                d: aabb.diameter(),
-            }
-        })
-        .collect();
-    drop(codes);
     let (_, new_aabb) = aabb.split_at_mut(n);
     let (_, new_d) = diameter.split_at_mut(n);
     let out = Out {

@@ -1,8 +1,10 @@
 //! The top-down split: its parameters ([`Chunking`]), the Morton order of the primitives and the
 //! tree of chunks over it.
 
+use super::Body;
+use super::split::{Zone, morton_cut};
+#[cfg(test)]
 use crate::geom::Aabb;
-use crate::geom::morton::spread_bits;
 use rayon::prelude::*;
 
 /// The split's parameters: chunk size δ, the reduction function's ε (AAC §3) and the root's share.
@@ -16,6 +18,10 @@ pub struct Chunking {
     /// subproblem (the exact schedule's step) starts from about `top` bodies; 0 = AAC's f alone.
     /// A scene of at most 1.5 × `top` primitives is one subproblem (see [`Chunking::whole`]).
     pub top: u32,
+    /// Ranges of at most this many primitives are cut by binned SAH on the longest axis of
+    /// their centres instead of at their highest differing Morton bit (`split`); 0 = Morton
+    /// cuts throughout (the split before session 11).
+    pub sah_below: u32,
 }
 
 impl Chunking {
@@ -31,6 +37,7 @@ impl Chunking {
         delta: 4,
         epsilon: 0.5,
         top: 8192,
+        sah_below: 256,
     };
 
     /// Whether a scene of `n` primitives is grouped as one subproblem, the exact schedule's
@@ -150,10 +157,17 @@ impl Keep {
 /// Ranges of at least this many primitives plan their halves in parallel.
 const PLAN_GRAIN: u32 = 1 << 15;
 
-/// The split of `codes` (sorted) into chunks, nodes in pre-order (the root first). Halves of
-/// large ranges are planned in parallel into blocks of nodes, laid end to end at the end (the
-/// same nodes as one sequential pass, whatever the number of threads).
-pub(super) fn plan(codes: &[(u64, u32)], chunking: &Chunking) -> Vec<Node> {
+/// The split of the primitives into chunks, nodes in pre-order (the root first): `codes`
+/// sorted, `leaves` the primitives in the same order. Ranges of at most
+/// [`Chunking::sah_below`] primitives are cut by binned SAH ([`split`](super::split)), which
+/// reorders `codes` and `leaves` alike within them; the nodes' ranges index the new order.
+/// Halves of large ranges are planned in parallel into blocks of nodes, laid end to end at the
+/// end (the same nodes and order as one sequential pass, whatever the number of threads).
+pub(super) fn plan(
+    codes: &mut [(u64, u32)],
+    leaves: &mut [Body],
+    chunking: &Chunking,
+) -> Vec<Node> {
     let n = codes.len() as u32;
     if chunking.whole(codes.len()) {
         // One subproblem: the root over every primitive, the exact schedule's step.
@@ -167,8 +181,8 @@ pub(super) fn plan(codes: &[(u64, u32)], chunking: &Chunking) -> Vec<Node> {
         }];
     }
     let keep = Keep::new(chunking, codes.len());
-    let planner = Planner { codes, keep: &keep };
-    let blocks = planner.blocks(0, n, 0).blocks;
+    let planner = Planner { keep: &keep };
+    let blocks = planner.blocks(codes, leaves, 0, 0).blocks;
     let total = blocks.iter().map(Vec::len).sum();
     let mut nodes: Vec<Node> = Vec::with_capacity(total);
     if rayon::current_num_threads() == 1 {
@@ -208,28 +222,38 @@ struct Planned {
 
 /// The inputs of the split.
 struct Planner<'a> {
-    codes: &'a [(u64, u32)],
     keep: &'a Keep,
 }
 
 impl Planner<'_> {
-    /// Plans `lo..hi`, its halves in parallel while they are large.
-    fn blocks(&self, lo: u32, hi: u32, level: u32) -> Planned {
-        if hi - lo < PLAN_GRAIN.max(self.keep.chunking.delta.max(2)) {
+    /// Plans the range of `codes` and `leaves` that starts at primitive `lo`, its halves in
+    /// parallel while they are large.
+    fn blocks(
+        &self,
+        codes: &mut [(u64, u32)],
+        leaves: &mut [Body],
+        lo: u32,
+        level: u32,
+    ) -> Planned {
+        let size = codes.len() as u32;
+        if size < PLAN_GRAIN.max(self.keep.chunking.delta.max(2)) || self.sah(size) {
             let mut nodes = Vec::new();
-            let (keep, count) = self.build(lo, hi, level, &mut nodes);
+            let (keep, count) = self.build(codes, leaves, lo, level, &mut nodes);
             return Planned {
                 blocks: vec![nodes],
                 keep,
                 count,
             };
         }
-        let mid = self.mid(lo, hi);
+        let mid = morton_cut(codes);
+        let (lc, rc) = codes.split_at_mut(mid);
+        let (ll, rl) = leaves.split_at_mut(mid);
+        let m = lo + mid as u32;
         let (l, r) = rayon::join(
-            || self.blocks(lo, mid, level + 1),
-            || self.blocks(mid, hi, level + 1),
+            || self.blocks(lc, ll, lo, level + 1),
+            || self.blocks(rc, rl, m, level + 1),
         );
-        let node = self.inner(lo, hi, level, l.keep, r.keep, l.count);
+        let node = self.inner(lo, lo + size, level, l.keep, r.keep, l.count);
         let mut blocks = vec![vec![node]];
         blocks.extend(l.blocks);
         blocks.extend(r.blocks);
@@ -240,54 +264,91 @@ impl Planner<'_> {
         }
     }
 
-    /// Plans `lo..hi` into `nodes`; returns the bodies its root leaves and its number of nodes.
-    fn build(&self, lo: u32, hi: u32, level: u32, nodes: &mut Vec<Node>) -> (u32, u32) {
-        let size = hi - lo;
-        let ch = &self.keep.chunking;
-        if size < ch.delta.max(2) {
-            let keep = if level == 0 {
-                1
-            } else {
-                size.min(self.keep.at(ch.delta, size))
-            };
-            nodes.push(Node {
+    /// Whether a range of `size` primitives (and everything below it) is cut by SAH.
+    fn sah(&self, size: u32) -> bool {
+        size <= self.keep.chunking.sah_below && size >= self.keep.chunking.delta.max(2)
+    }
+
+    /// Plans the range that starts at primitive `lo` into `nodes`, cut at Morton bits down to
+    /// the SAH zones; returns the bodies its root leaves and its number of nodes.
+    fn build(
+        &self,
+        codes: &mut [(u64, u32)],
+        leaves: &mut [Body],
+        lo: u32,
+        level: u32,
+        nodes: &mut Vec<Node>,
+    ) -> (u32, u32) {
+        let size = codes.len() as u32;
+        if self.sah(size) {
+            let mut zone = Zone::new(codes, leaves);
+            let planned = self.build_with(
+                &mut |start, len| zone.cut(start, len),
+                0,
+                size,
                 lo,
-                hi,
-                right_ahead: 0,
                 level,
-                inputs: size,
-                keep,
-            });
-            return (keep, 1);
+                nodes,
+            );
+            zone.apply();
+            return planned;
         }
-        let mid = self.mid(lo, hi);
+        if size < self.keep.chunking.delta.max(2) {
+            return self.chunk(lo, size, level, nodes);
+        }
+        let mid = morton_cut(codes);
         let at = nodes.len();
-        // A placeholder, replaced once the halves are planned.
-        nodes.push(Node {
-            lo,
-            hi,
-            right_ahead: 0,
-            level,
-            inputs: 0,
-            keep: 0,
-        });
-        let (kl, cl) = self.build(lo, mid, level + 1, nodes);
-        let (kr, cr) = self.build(mid, hi, level + 1, nodes);
-        let node = self.inner(lo, hi, level, kl, kr, cl);
+        nodes.push(PLACEHOLDER);
+        let (lc, rc) = codes.split_at_mut(mid);
+        let (ll, rl) = leaves.split_at_mut(mid);
+        let (kl, cl) = self.build(lc, ll, lo, level + 1, nodes);
+        let (kr, cr) = self.build(rc, rl, lo + mid as u32, level + 1, nodes);
+        let node = self.inner(lo, lo + size, level, kl, kr, cl);
         nodes[at] = node;
         (node.keep, cl + cr + 1)
     }
 
-    /// Where `lo..hi` splits: at its highest differing Morton bit, or the middle when every
-    /// code is equal.
-    fn mid(&self, lo: u32, hi: u32) -> u32 {
-        let (a, b) = (self.codes[lo as usize].0, self.codes[hi as usize - 1].0);
-        if a == b {
-            return lo + (hi - lo) / 2;
+    /// Plans positions `start..start + size` of a zone (primitives from `lo`), each range cut
+    /// by `cut(start, len)`, which returns the left side's length.
+    fn build_with(
+        &self,
+        cut: &mut dyn FnMut(usize, usize) -> usize,
+        start: usize,
+        size: u32,
+        lo: u32,
+        level: u32,
+        nodes: &mut Vec<Node>,
+    ) -> (u32, u32) {
+        if size < self.keep.chunking.delta.max(2) {
+            return self.chunk(lo, size, level, nodes);
         }
-        let bit = 63 - (a ^ b).leading_zeros();
-        let part = &self.codes[lo as usize..hi as usize];
-        lo + part.partition_point(|c| c.0 >> bit & 1 == 0) as u32
+        let mid = cut(start, size as usize);
+        let at = nodes.len();
+        nodes.push(PLACEHOLDER);
+        let (kl, cl) = self.build_with(cut, start, mid as u32, lo, level + 1, nodes);
+        let right = size - mid as u32;
+        let (kr, cr) = self.build_with(cut, start + mid, right, lo + mid as u32, level + 1, nodes);
+        let node = self.inner(lo, lo + size, level, kl, kr, cl);
+        nodes[at] = node;
+        (node.keep, cl + cr + 1)
+    }
+
+    /// A chunk of `size` primitives from `lo`.
+    fn chunk(&self, lo: u32, size: u32, level: u32, nodes: &mut Vec<Node>) -> (u32, u32) {
+        let keep = if level == 0 {
+            1
+        } else {
+            size.min(self.keep.at(self.keep.chunking.delta, size))
+        };
+        nodes.push(Node {
+            lo,
+            hi: lo + size,
+            right_ahead: 0,
+            level,
+            inputs: size,
+            keep,
+        });
+        (keep, 1)
     }
 
     /// The inner node over `lo..hi` whose halves leave `kl` and `kr` bodies, the left one
@@ -310,39 +371,15 @@ impl Planner<'_> {
     }
 }
 
-/// The primitives' ids sorted by the Morton code of their box centres (ties by id), quantised
-/// on one scale for all axes: the cube on the longest side of the centres' box. Scaling each axis
-/// to its own extent (as many builders do) stretches flat or long scenes: 50,000 stacked slabs,
-/// 0.001 apart in z with 0.05 of jitter in x and y, were ordered by their jitter, and their
-/// partitioned tree's SAH was 1.28× the exact tree's (0.96× with the cube).
-pub(super) fn morton_order(boxes: &[Aabb]) -> Vec<(u64, u32)> {
-    let cb = boxes
-        .par_iter()
-        .fold(|| Aabb::EMPTY, |b, x| b.grow(&x.center()))
-        .reduce(|| Aabb::EMPTY, |a, b| a.merge(&b));
-    let ext = cb.extents().max();
-    let s = if ext > 0.0 && ext.is_finite() {
-        2_097_151.0 / ext
-    } else {
-        0.0
-    };
-    let scale = [s; 3];
-    let mut codes: Vec<(u64, u32)> = boxes
-        .par_iter()
-        .enumerate()
-        .map(|(i, b)| {
-            let c = b.center();
-            let mut key = 0u64;
-            for k in 0..3 {
-                let t = ((c[k] - cb.min[k]) * scale[k]).clamp(0.0, 2_097_151.0) as u64;
-                key |= spread_bits(t) << k;
-            }
-            (key, i as u32)
-        })
-        .collect();
-    codes.par_sort_unstable();
-    codes
-}
+/// A node replaced once its halves are planned.
+const PLACEHOLDER: Node = Node {
+    lo: 0,
+    hi: 0,
+    right_ahead: 0,
+    level: 0,
+    inputs: 0,
+    keep: 0,
+};
 
 #[cfg(test)]
 mod tests {
@@ -365,34 +402,75 @@ mod tests {
             .collect()
     }
 
+    /// A leaf for each of `codes`: a small box at a random place (not its code's).
+    fn leaves(codes: &[(u64, u32)], seed: u64) -> Vec<Body> {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        codes
+            .iter()
+            .map(|&(_, id)| {
+                let c = crate::geom::P3::new(
+                    rng.random_range(0.0..100.0),
+                    rng.random_range(0.0..10.0),
+                    rng.random_range(0.0..1.0),
+                );
+                let aabb = Aabb::EMPTY
+                    .grow(&c)
+                    .grow(&(c + crate::geom::V3::repeat(0.5)));
+                Body {
+                    id,
+                    rd: 0,
+                    aabb,
+                    d: aabb.diameter(),
+                }
+            })
+            .collect()
+    }
+
     #[test]
     fn parallel_plan_equals_one_sequential_pass() {
         let mut items = codes(5 * PLAN_GRAIN as usize + 17, 5);
         items.sort_unstable();
+        let bodies = leaves(&items, 6);
         for chunking in [
             Chunking::DEFAULT,
             Chunking {
                 delta: 8,
                 epsilon: 0.1,
                 top: 0,
+                sah_below: 0,
+            },
+            // SAH cuts in the parallel part of the plan too.
+            Chunking {
+                sah_below: 4 * PLAN_GRAIN,
+                ..Chunking::DEFAULT
             },
         ] {
             let keep = Keep::new(&chunking, items.len());
-            let planner = Planner {
-                codes: &items,
-                keep: &keep,
-            };
+            let planner = Planner { keep: &keep };
             let mut want = Vec::new();
-            planner.build(0, items.len() as u32, 0, &mut want);
-            let got = [1, 2].map(|t| {
-                rayon::ThreadPoolBuilder::new()
+            let (mut wc, mut wl) = (items.clone(), bodies.clone());
+            planner.build(&mut wc, &mut wl, 0, 0, &mut want);
+            let want_ids: Vec<u32> = wl.iter().map(|b| b.id).collect();
+            assert!(wc.iter().zip(&wl).all(|(c, b)| c.1 == b.id));
+            for t in [1, 2] {
+                let (mut c, mut l) = (items.clone(), bodies.clone());
+                let got = rayon::ThreadPoolBuilder::new()
                     .num_threads(t)
                     .build()
                     .unwrap()
-                    .install(|| plan(&items, &chunking))
-            });
-            assert_eq!(got[0], want);
-            assert_eq!(got[1], want);
+                    .install(|| plan(&mut c, &mut l, &chunking));
+                assert_eq!(got, want);
+                assert_eq!(c, wc);
+                assert_eq!(l.iter().map(|b| b.id).collect::<Vec<_>>(), want_ids);
+            }
+            // The SAH cuts moved leaves (and only within their ranges: every id once).
+            let mut ids = want_ids.clone();
+            assert_eq!(
+                chunking.sah_below == 0,
+                ids == items.iter().map(|c| c.1).collect::<Vec<_>>()
+            );
+            ids.sort_unstable();
+            assert_eq!(ids, (0..items.len() as u32).collect::<Vec<_>>());
             let (l, r) = want[0].kids(0).unwrap();
             assert_eq!(
                 (want[l as usize].lo, want[r as usize].hi),

@@ -16,10 +16,11 @@ pub fn group_text(scene: &Scene, g: &Grouping, threads: usize, seconds: f64) -> 
     );
     let chunking = match p.mode.schedule {
         grouping::Schedule::Partitioned => format!(
-            " (chunks of δ = {}, ε = {}, root share {})",
+            " (chunks of δ = {}, ε = {}, root share {}, SAH cuts up to {})",
             grouping::partitioned::Chunking::DEFAULT.delta,
             p.mode.chunk_epsilon,
-            p.mode.chunk_top
+            p.mode.chunk_top,
+            p.mode.chunk_sah
         ),
         grouping::Schedule::Exact => String::new(),
     };

@@ -54,10 +54,11 @@ pub const KEYS: &[&str] = &[
 /// announced.
 pub const STOP_KEYS: &[&str] = &["stop_reason", "stop_eligible_pairs"];
 
-/// Keys the `wraptree` record adds for the partitioned schedule: its chunk size δ and the
-/// reduction function's ε ([`Chunking`]; informative, fixed in a build) and the root's share
-/// `top` (`--chunk-top`, read back by `replay`).
-pub const PARTITIONED_KEYS: &[&str] = &["chunk_delta", "chunk_epsilon", "chunk_top"];
+/// Keys the `wraptree` record adds for the partitioned schedule ([`Chunking`]): its chunk size
+/// δ (informative, fixed in a build), the reduction function's ε (`--chunk-epsilon`), the
+/// root's share `top` (`--chunk-top`) and the SAH cuts' range size (`--chunk-sah`), the last
+/// three read back by `replay` (a recording without `chunk_sah` was cut at Morton bits only).
+pub const PARTITIONED_KEYS: &[&str] = &["chunk_delta", "chunk_epsilon", "chunk_top", "chunk_sah"];
 
 /// Keys the `wraptree` record adds when a cover is logged (`cover_budget` only for a cover
 /// asked for by budget).
@@ -197,6 +198,7 @@ pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String,
         put("chunk_delta", ch.delta.to_string());
         put("chunk_epsilon", p.mode.chunk_epsilon.to_string());
         put("chunk_top", p.mode.chunk_top.to_string());
+        put("chunk_sah", p.mode.chunk_sah.to_string());
     }
     put("detail", value_name(&info.detail));
     put("scene", info.scene.name.clone());
@@ -308,6 +310,13 @@ fn mode(m: &BTreeMap<String, String>) -> Result<Mode> {
         chunk_epsilon: match m.contains_key("chunk_epsilon") {
             true => parse(m, "chunk_epsilon")?,
             false => d.chunk_epsilon,
+        },
+        // Partitioned recordings from before the SAH cuts (session 11) were split at Morton
+        // bits throughout; other schedules do not write the chunking.
+        chunk_sah: match (m.contains_key("chunk_sah"), m.contains_key("chunk_top")) {
+            (true, _) => parse(m, "chunk_sah")?,
+            (false, true) => 0,
+            (false, false) => d.chunk_sah,
         },
     })
 }
