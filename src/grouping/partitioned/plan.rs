@@ -32,7 +32,9 @@ impl Chunking {
     /// the bench scenes (within 2 % on all but the 10^5 soup, SAH 3.5 %), closer on three
     /// pybullet meshes (within 2 %, against 2.3–3.6 %) and farther on large assemblies of copies
     /// (800 robot bases: SAH 11 % over, against 7 %); scenes of at most 12,288 primitives get
-    /// the exact schedule's tree.
+    /// the exact schedule's tree. SAH cuts of ranges up to 256 primitives (session 11, README
+    /// "Where the split cuts") brought the 10^5 soup within 2 % (SAH 1.006) and the robot bases
+    /// closer (8 %), for about 0.1 s more at 10^6 on one thread.
     pub const DEFAULT: Chunking = Chunking {
         delta: 4,
         epsilon: 0.5,
