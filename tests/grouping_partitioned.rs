@@ -350,7 +350,10 @@ fn replay_verifies_a_partitioned_recording() {
     );
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("Partitioned on 1 thread"), "{text}");
-    assert!(text.contains("δ = 4, ε = 0.5, root share 8192"), "{text}");
+    assert!(
+        text.contains("δ = 4, ε = 0.5, root share 8192, SAH cuts up to 256 primitives"),
+        "{text}"
+    );
     let out = wraptree(&["group", "s.obj", "--threads", "0"], dir.path());
     common::assert_one_line_error(&out, "--threads");
 }

@@ -16,11 +16,14 @@ pub fn group_text(scene: &Scene, g: &Grouping, threads: usize, seconds: f64) -> 
     );
     let chunking = match p.mode.schedule {
         grouping::Schedule::Partitioned => format!(
-            " (chunks of δ = {}, ε = {}, root share {}, SAH cuts up to {})",
+            " (chunks of δ = {}, ε = {}, root share {}, {})",
             grouping::partitioned::Chunking::DEFAULT.delta,
             p.mode.chunk_epsilon,
             p.mode.chunk_top,
-            p.mode.chunk_sah
+            match p.mode.chunk_sah {
+                0 => "Morton cuts only".to_string(),
+                n => format!("SAH cuts up to {n} primitives"),
+            }
         ),
         grouping::Schedule::Exact => String::new(),
     };
