@@ -247,7 +247,7 @@ impl Planner<'_> {
                 count,
             };
         }
-        let mid = morton_cut(codes);
+        let mid = morton_cut(codes, |c| c.0);
         let (lc, rc) = codes.split_at_mut(mid);
         let (ll, rl) = leaves.split_at_mut(mid);
         let m = lo + mid as u32;
@@ -298,7 +298,7 @@ impl Planner<'_> {
         if size < self.keep.chunking.delta.max(2) {
             return self.chunk(lo, size, level, nodes);
         }
-        let mid = morton_cut(codes);
+        let mid = morton_cut(codes, |c| c.0);
         let at = nodes.len();
         nodes.push(PLACEHOLDER);
         let (lc, rc) = codes.split_at_mut(mid);

@@ -24,17 +24,17 @@ use crate::grouping::mpairs::order_bits;
 use rayon::prelude::*;
 
 /// Bins along the axis.
-pub(super) const BINS: usize = 16;
+const BINS: usize = 16;
 
-/// Where sorted `codes` (at least 2) split: at their highest differing Morton bit, or the
-/// middle when every code is equal.
-pub(super) fn morton_cut(codes: &[(u64, u32)]) -> usize {
-    let (a, b) = (codes[0].0, codes[codes.len() - 1].0);
+/// Where `items` (at least 2), sorted by their Morton `code`, split: at their highest
+/// differing bit, or the middle when every code is equal.
+pub(super) fn morton_cut<T>(items: &[T], code: impl Fn(&T) -> u64) -> usize {
+    let (a, b) = (code(&items[0]), code(&items[items.len() - 1]));
     if a == b {
-        return codes.len() / 2;
+        return items.len() / 2;
     }
     let bit = 63 - (a ^ b).leading_zeros();
-    codes.partition_point(|c| c.0 >> bit & 1 == 0)
+    items.partition_point(|x| code(x) >> bit & 1 == 0)
 }
 
 /// The primitives' ids sorted by the Morton code of their box centres (ties by id), quantised
@@ -73,7 +73,7 @@ pub(super) fn morton_order(boxes: &[Aabb]) -> Vec<(u64, u32)> {
 
 /// Ranges of at most this many primitives are cut by an exact sweep over their sorted centres
 /// instead of bins (the bins' fixed cost would dominate).
-pub(super) const SWEEP: usize = 16;
+const SWEEP: usize = 16;
 
 /// A range of at most [`Chunking::sah_below`](super::Chunking::sah_below) primitives, planned
 /// as a permutation of its leaves (moving 4-byte positions, not 64-byte bodies, at each cut)
@@ -182,21 +182,14 @@ impl<'z> Zone<'z> {
         }
         // Positions keep their entry order within a side, so the codes are sorted.
         let codes = &*self.codes;
-        let part = &self.perm[start..start + len];
-        let (a, b) = (codes[part[0] as usize].0, codes[part[len - 1] as usize].0);
-        if a == b {
-            return len / 2;
-        }
-        let bit = 63 - (a ^ b).leading_zeros();
-        part.partition_point(|&p| codes[p as usize].0 >> bit & 1 == 0)
+        morton_cut(&self.perm[start..start + len], |&p| codes[p as usize].0)
     }
 
     /// The SAH cut of `start..start + len`, if any (moving the left side to the front).
     fn sah(&mut self, start: usize, len: usize) -> Option<usize> {
-        let (leaves, cen) = (&*self.leaves, &self.cen);
         let part = &self.perm[start..start + len];
         // The box of the doubled centres (min + max: the same cut, a product less).
-        let cb = centres(cen, part.iter().copied());
+        let cb = centres(&self.cen, part.iter().copied());
         let e = [
             cb.hi[0] - cb.lo[0],
             cb.hi[1] - cb.lo[1],
@@ -214,96 +207,12 @@ impl<'z> Zone<'z> {
         if !(w > 0.0 && w.is_finite()) {
             return None;
         }
-        let least = (len / 4).max(1);
         self.bin.clear();
         let nl = if len <= SWEEP {
-            // Sorted by centre, ties in range order (a NaN centre first, -0 as 0): the exact
-            // sweep.
-            let mut keys = [(0u64, 0u8); SWEEP];
-            for (i, &p) in part.iter().enumerate() {
-                let c = cen[p as usize][axis];
-                let c = if c.is_nan() {
-                    f64::NEG_INFINITY
-                } else {
-                    c + 0.0
-                };
-                keys[i] = (order_bits(c), i as u8);
-            }
-            keys[..len].sort_unstable();
-            let mut order = [0u8; SWEEP];
-            for (o, k) in order.iter_mut().zip(&keys[..len]) {
-                *o = k.1;
-            }
-            let aabb = |i: usize| &leaves[part[order[i] as usize] as usize].aabb;
-            let mut right = [Bounds::EMPTY; SWEEP];
-            let mut acc = Bounds::EMPTY;
-            for i in (1..len).rev() {
-                acc.add(aabb(i));
-                right[i] = acc;
-            }
-            let mut best: Option<(f64, usize)> = None;
-            let mut left = Bounds::EMPTY;
-            for (i, r) in right.iter().enumerate().take(len).skip(1) {
-                left.add(aabb(i - 1));
-                if i < least || len - i < least {
-                    continue;
-                }
-                let cost = left.area() * i as f64 + r.area() * (len - i) as f64;
-                if best.is_none_or(|(c, _)| cost < c) {
-                    best = Some((cost, i));
-                }
-            }
-            let (_, nl) = best?;
-            self.bin.resize(len, 1);
-            for &o in &order[..nl] {
-                self.bin[o as usize] = 0;
-            }
-            nl
+            self.sweep(start, len, axis)
         } else {
-            let scale = BINS as f64 / w;
-            let mut counts = [0usize; BINS];
-            self.bin.resize(len, 0);
-            for (k, &p) in self.bin.iter_mut().zip(part) {
-                // A NaN centre goes to bin 0 (`as` saturates), the same on every run.
-                let b = (((cen[p as usize][axis] - c0) * scale) as usize).min(BINS - 1);
-                *k = b as u8;
-                counts[b] += 1;
-            }
-            // Two banks of bins, for even and odd positions: neighbours (often in one bin)
-            // then grow different boxes.
-            let mut banks = [[Bounds::EMPTY; BINS]; 2];
-            for (i, (&k, &p)) in self.bin.iter().zip(part).enumerate() {
-                banks[i & 1][k as usize].add(&leaves[p as usize].aabb);
-            }
-            let mut boxes = banks[0];
-            for (b, o) in boxes.iter_mut().zip(&banks[1]) {
-                *b = b.join(o);
-            }
-            let mut right = [(Bounds::EMPTY, 0usize); BINS];
-            let mut acc = (Bounds::EMPTY, 0usize);
-            for k in (1..BINS).rev() {
-                acc = (acc.0.join(&boxes[k]), acc.1 + counts[k]);
-                right[k] = acc;
-            }
-            let mut best: Option<(f64, usize, usize)> = None;
-            let mut left = (Bounds::EMPTY, 0usize);
-            for cut in 1..BINS {
-                left = (left.0.join(&boxes[cut - 1]), left.1 + counts[cut - 1]);
-                let (rb, rn) = right[cut];
-                if left.1 < least || rn < least {
-                    continue;
-                }
-                let cost = left.0.area() * left.1 as f64 + rb.area() * rn as f64;
-                if best.is_none_or(|(c, _, _)| cost < c) {
-                    best = Some((cost, cut, left.1));
-                }
-            }
-            let (_, cut, nl) = best?;
-            for k in self.bin.iter_mut() {
-                *k = u8::from(*k as usize >= cut);
-            }
-            nl
-        };
+            self.binned(start, len, axis, c0, w)
+        }?;
         // A stable partition of the positions (side 0 first), without branches.
         self.tmp.resize(len, 0);
         let part = &mut self.perm[start..start + len];
@@ -316,6 +225,107 @@ impl<'z> Zone<'z> {
             ri += right;
         }
         part.copy_from_slice(&self.tmp[..len]);
+        Some(nl)
+    }
+
+    /// The exact cut of a range of at most [`SWEEP`]: the primitives sorted by centre on
+    /// `axis`, ties in range order (a NaN centre first, −0 as 0), the boundary of least SAH
+    /// leaving a quarter on each side; sets `bin` to each primitive's side.
+    fn sweep(&mut self, start: usize, len: usize, axis: usize) -> Option<usize> {
+        let (leaves, cen) = (&*self.leaves, &self.cen);
+        let part = &self.perm[start..start + len];
+        let least = (len / 4).max(1);
+        let mut keys = [(0u64, 0u8); SWEEP];
+        for (i, &p) in part.iter().enumerate() {
+            let c = cen[p as usize][axis];
+            let c = if c.is_nan() {
+                f64::NEG_INFINITY
+            } else {
+                c + 0.0
+            };
+            keys[i] = (order_bits(c), i as u8);
+        }
+        keys[..len].sort_unstable();
+        let mut order = [0u8; SWEEP];
+        for (o, k) in order.iter_mut().zip(&keys[..len]) {
+            *o = k.1;
+        }
+        let aabb = |i: usize| &leaves[part[order[i] as usize] as usize].aabb;
+        let mut right = [Bounds::EMPTY; SWEEP];
+        let mut acc = Bounds::EMPTY;
+        for i in (1..len).rev() {
+            acc.add(aabb(i));
+            right[i] = acc;
+        }
+        let mut best: Option<(f64, usize)> = None;
+        let mut left = Bounds::EMPTY;
+        for (i, r) in right.iter().enumerate().take(len).skip(1) {
+            left.add(aabb(i - 1));
+            if i < least || len - i < least {
+                continue;
+            }
+            let cost = left.area() * i as f64 + r.area() * (len - i) as f64;
+            if best.is_none_or(|(c, _)| cost < c) {
+                best = Some((cost, i));
+            }
+        }
+        let (_, nl) = best?;
+        self.bin.resize(len, 1);
+        for &o in &order[..nl] {
+            self.bin[o as usize] = 0;
+        }
+        Some(nl)
+    }
+
+    /// The binned cut of a longer range: centres in [`BINS`] equal bins of `c0..c0 + w` on
+    /// `axis`, the bin boundary of least SAH leaving a quarter on each side; sets `bin` to each
+    /// primitive's side.
+    fn binned(&mut self, start: usize, len: usize, axis: usize, c0: f64, w: f64) -> Option<usize> {
+        let (leaves, cen) = (&*self.leaves, &self.cen);
+        let part = &self.perm[start..start + len];
+        let least = (len / 4).max(1);
+        let scale = BINS as f64 / w;
+        let mut counts = [0usize; BINS];
+        self.bin.resize(len, 0);
+        for (k, &p) in self.bin.iter_mut().zip(part) {
+            // A NaN centre goes to bin 0 (`as` saturates), the same on every run.
+            let b = (((cen[p as usize][axis] - c0) * scale) as usize).min(BINS - 1);
+            *k = b as u8;
+            counts[b] += 1;
+        }
+        // Two banks of bins, for even and odd positions: neighbours (often in one bin) then
+        // grow different boxes.
+        let mut banks = [[Bounds::EMPTY; BINS]; 2];
+        for (i, (&k, &p)) in self.bin.iter().zip(part).enumerate() {
+            banks[i & 1][k as usize].add(&leaves[p as usize].aabb);
+        }
+        let mut boxes = banks[0];
+        for (b, o) in boxes.iter_mut().zip(&banks[1]) {
+            *b = b.join(o);
+        }
+        let mut right = [(Bounds::EMPTY, 0usize); BINS];
+        let mut acc = (Bounds::EMPTY, 0usize);
+        for k in (1..BINS).rev() {
+            acc = (acc.0.join(&boxes[k]), acc.1 + counts[k]);
+            right[k] = acc;
+        }
+        let mut best: Option<(f64, usize, usize)> = None;
+        let mut left = (Bounds::EMPTY, 0usize);
+        for cut in 1..BINS {
+            left = (left.0.join(&boxes[cut - 1]), left.1 + counts[cut - 1]);
+            let (rb, rn) = right[cut];
+            if left.1 < least || rn < least {
+                continue;
+            }
+            let cost = left.0.area() * left.1 as f64 + rb.area() * rn as f64;
+            if best.is_none_or(|(c, _, _)| cost < c) {
+                best = Some((cost, cut, left.1));
+            }
+        }
+        let (_, cut, nl) = best?;
+        for k in self.bin.iter_mut() {
+            *k = u8::from(*k as usize >= cut);
+        }
         Some(nl)
     }
 
