@@ -182,14 +182,15 @@ impl GroupArgs {
                 chunk_sah: self.chunk_sah.unwrap_or(Mode::default().chunk_sah),
             },
         };
-        if self.chunk_top.is_some() && self.schedule != Schedule::Partitioned {
-            anyhow::bail!("--chunk-top needs --schedule partitioned");
-        }
-        if self.chunk_epsilon.is_some() && self.schedule != Schedule::Partitioned {
-            anyhow::bail!("--chunk-epsilon needs --schedule partitioned");
-        }
-        if self.chunk_sah.is_some() && self.schedule != Schedule::Partitioned {
-            anyhow::bail!("--chunk-sah needs --schedule partitioned");
+        let chunking = [
+            (self.chunk_top.is_some(), "--chunk-top"),
+            (self.chunk_epsilon.is_some(), "--chunk-epsilon"),
+            (self.chunk_sah.is_some(), "--chunk-sah"),
+        ];
+        if let Some((_, flag)) = chunking.iter().find(|(set, _)| *set)
+            && self.schedule != Schedule::Partitioned
+        {
+            anyhow::bail!("{flag} needs --schedule partitioned");
         }
         params.check().map_err(anyhow::Error::msg)?;
         Ok(params)
