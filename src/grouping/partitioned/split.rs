@@ -98,7 +98,20 @@ fn area(lo: &[f64; 3], hi: &[f64; 3]) -> f64 {
     e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
 }
 
-/// A box as corner arrays, grown by plain min/max (a NaN coordinate is skipped).
+/// The lesser of `a` and `b`, `a` when `b` is NaN: one `minsd` (`f64::min` also checks `a`).
+#[inline(always)]
+fn lesser(a: f64, b: f64) -> f64 {
+    if b < a { b } else { a }
+}
+
+/// The greater of `a` and `b`, `a` when `b` is NaN.
+#[inline(always)]
+fn greater(a: f64, b: f64) -> f64 {
+    if b > a { b } else { a }
+}
+
+/// A box as corner arrays, grown by plain min/max (a NaN coordinate is skipped: the corners
+/// start infinite and never become NaN).
 #[derive(Clone, Copy)]
 struct Bounds {
     lo: [f64; 3],
@@ -114,8 +127,8 @@ impl Bounds {
     #[inline(always)]
     fn add(&mut self, b: &Aabb) {
         for k in 0..3 {
-            self.lo[k] = self.lo[k].min(b.min[k]);
-            self.hi[k] = self.hi[k].max(b.max[k]);
+            self.lo[k] = lesser(self.lo[k], b.min[k]);
+            self.hi[k] = greater(self.hi[k], b.max[k]);
         }
     }
 
@@ -123,8 +136,8 @@ impl Bounds {
     fn join(&self, o: &Bounds) -> Bounds {
         let mut b = *self;
         for k in 0..3 {
-            b.lo[k] = b.lo[k].min(o.lo[k]);
-            b.hi[k] = b.hi[k].max(o.hi[k]);
+            b.lo[k] = lesser(b.lo[k], o.lo[k]);
+            b.hi[k] = greater(b.hi[k], o.hi[k]);
         }
         b
     }
@@ -132,8 +145,8 @@ impl Bounds {
     #[inline(always)]
     fn grow(&mut self, c: &[f64; 3]) {
         for ((lo, hi), &x) in self.lo.iter_mut().zip(&mut self.hi).zip(c) {
-            *lo = lo.min(x);
-            *hi = hi.max(x);
+            *lo = lesser(*lo, x);
+            *hi = greater(*hi, x);
         }
     }
 
@@ -229,13 +242,15 @@ impl<'z> Zone<'z> {
     }
 
     /// The exact cut of a range of at most [`SWEEP`]: the primitives sorted by centre on
-    /// `axis`, ties in range order (a NaN centre first, −0 as 0), the boundary of least SAH
-    /// leaving a quarter on each side; sets `bin` to each primitive's side.
+    /// `axis`, ties (and centres within 16 units in the last place) in range order (a NaN centre
+    /// first, −0 as 0), the boundary of least SAH leaving a quarter on each side; sets `bin` to
+    /// each primitive's side.
     fn sweep(&mut self, start: usize, len: usize, axis: usize) -> Option<usize> {
         let (leaves, cen) = (&*self.leaves, &self.cen);
         let part = &self.perm[start..start + len];
         let least = (len / 4).max(1);
-        let mut keys = [(0u64, 0u8); SWEEP];
+        // The centre's order bits with the position in the low 4: one integer compare per step.
+        let mut keys = [0u64; SWEEP];
         for (i, &p) in part.iter().enumerate() {
             let c = cen[p as usize][axis];
             let c = if c.is_nan() {
@@ -243,12 +258,12 @@ impl<'z> Zone<'z> {
             } else {
                 c + 0.0
             };
-            keys[i] = (order_bits(c), i as u8);
+            keys[i] = order_bits(c) & !0xF | i as u64;
         }
         keys[..len].sort_unstable();
         let mut order = [0u8; SWEEP];
         for (o, k) in order.iter_mut().zip(&keys[..len]) {
-            *o = k.1;
+            *o = (k & 0xF) as u8;
         }
         let aabb = |i: usize| &leaves[part[order[i] as usize] as usize].aabb;
         let mut right = [Bounds::EMPTY; SWEEP];
