@@ -9,7 +9,7 @@
 //!
 //! | topic | schema | what | written when |
 //! |---|---|---|---|
-//! | `/scene` | `foxglove.SceneUpdate` | entity `scene`: every input primitive in one indexed `TriangleListPrimitive`, light grey | always, once |
+//! | `/scene` | `foxglove.SceneUpdate` | entity `scene`: every input primitive in one indexed `TriangleListPrimitive` (no indices when no vertex is shared, as in a soup), light grey | always, once |
 //! | `/grouping/round` | `roundevent.RoundEvent` | each round start (DLimit, GLimit, active, dormant, eligible pairs) and each DLimit doubling (`doubling = true`, merges of the ended round, new limits) | always |
 //! | `/grouping/merge` | `mergeevent.MergeEvent` | every merge: step, round, a, b, new, AABB, diameter, Fill, Balance, Cost, queue length, active | always |
 //! | `/grouping/part` | `partevent.PartEvent` | each part of the run (partitioned schedule's chunks and top, pre-grouping's components and copies): id, kind (0 chunk, 1 component, 2 copy, 3 top), bodies, first step, chunk level and keep, component index (or the copied one), copy rotation and translation (written for copies only; absent, read as 0, in other parts); the merges up to the next part belong to it | runs with parts, from the first part on |
@@ -234,7 +234,7 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
         mesh.add(0..scene.len());
         entity
             .triangles
-            .push(mesh.primitive(scene_msgs::SCENE_COLOR));
+            .push(mesh.into_primitive(scene_msgs::SCENE_COLOR));
         emit(
             &mut self.writer,
             &mut self.buf,

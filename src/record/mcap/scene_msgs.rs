@@ -141,7 +141,8 @@ pub fn sphere(s: &Sphere, rgba: [f64; 4]) -> SpherePrimitive {
 }
 
 /// An indexed triangle list of scene primitives, built up by [`SceneMesh::add`]: each scene
-/// vertex the primitives use appears once in `points`, and the triangles index it. Adding
+/// vertex the primitives use appears once in `points`, and the triangles index it (unless the
+/// index is the identity). Adding
 /// keeps what is there, so nested sets (the leaves of successive levels) are built once.
 #[derive(Debug)]
 pub struct SceneMesh<'s> {
@@ -185,14 +186,36 @@ impl<'s> SceneMesh<'s> {
         }
     }
 
-    /// The mesh so far as one primitive in colour `rgba`.
+    /// The mesh so far as one primitive in colour `rgba` (see [`SceneMesh::into_primitive`]).
     pub fn primitive(&self, rgba: [f64; 4]) -> TriangleListPrimitive {
+        Self::list(self.points.clone(), self.index_list(), rgba)
+    }
+
+    /// The mesh as one primitive in colour `rgba`, its points moved rather than copied. The
+    /// indices are left out when they would be 0, 1, 2, … (no vertex shared, as in a triangle
+    /// soup), which readers take as the default.
+    pub fn into_primitive(self, rgba: [f64; 4]) -> TriangleListPrimitive {
+        let indices = self.index_list();
+        Self::list(self.points, indices, rgba)
+    }
+
+    fn index_list(&self) -> Vec<u32> {
+        let identity = self.indices.len() == self.points.len()
+            && self.indices.iter().enumerate().all(|(i, &v)| v == i as u32);
+        if identity {
+            Vec::new()
+        } else {
+            self.indices.clone()
+        }
+    }
+
+    fn list(points: Vec<Point3>, indices: Vec<u32>, rgba: [f64; 4]) -> TriangleListPrimitive {
         TriangleListPrimitive {
             pose: pose_at(&P3::origin()),
-            points: self.points.clone(),
+            points,
             color: color(rgba),
             colors: Vec::new(),
-            indices: self.indices.clone(),
+            indices,
         }
     }
 }
@@ -271,4 +294,29 @@ pub fn cover_update(wrappers: &[WrapperRecord], t_ns: u64) -> SceneUpdate {
             .filter(used)
             .collect(),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::generate;
+
+    #[test]
+    fn a_soup_is_drawn_without_indices_and_a_shared_mesh_with_them() {
+        let soup = generate::soup(50, 1);
+        let mut mesh = SceneMesh::new(&soup);
+        mesh.add(0..soup.len());
+        let list = mesh.into_primitive(SCENE_COLOR);
+        assert_eq!(list.points.len(), 150);
+        assert!(list.indices.is_empty());
+        // The lamp's primitives share vertices: three indices per triangle, fewer points.
+        let lamp = generate::lamp();
+        let mut mesh = SceneMesh::new(&lamp);
+        mesh.add(0..lamp.len());
+        let kept = mesh.primitive(SCENE_COLOR);
+        let moved = mesh.into_primitive(SCENE_COLOR);
+        assert_eq!(kept, moved);
+        assert_eq!(moved.indices.len(), 3 * lamp.tris.len());
+        assert!(moved.points.len() < moved.indices.len());
+    }
 }

@@ -82,8 +82,13 @@ impl RrdRecorder {
         }
         send_static(rec, "/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
         let primitives = rerun::Mesh3D::new(mesh.positions.iter().copied())
-            .with_vertex_normals(mesh.normals.iter().copied())
-            .with_triangle_indices(mesh.all_tris().iter().copied());
+            .with_vertex_normals(mesh.normals.iter().copied());
+        // Without indices the viewer reads each three positions as a triangle.
+        let primitives = if mesh.sequential() {
+            primitives
+        } else {
+            primitives.with_triangle_indices(mesh.all_tris().iter().copied())
+        };
         // With pre-grouping, each component in its own colour.
         let primitives = match info.params.mode.pregroup {
             Pregroup::None => primitives.with_albedo_factor(SCENE_GREY),

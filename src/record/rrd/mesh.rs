@@ -112,6 +112,16 @@ impl PrimMesh {
         &self.tris
     }
 
+    /// Whether the triangles are 0 1 2, 3 4 5, … (every vertex in one triangle, in order, as in
+    /// a triangle soup): the default a `Mesh3D` without indices stands for.
+    pub(super) fn sequential(&self) -> bool {
+        self.tris.len() * 3 == self.positions.len()
+            && (0u32..)
+                .step_by(3)
+                .zip(&self.tris)
+                .all(|(i, t)| *t == [i, i + 1, i + 2])
+    }
+
     /// Triangles of primitive `i`.
     pub(super) fn prim_tris(&self, i: u32) -> &[[u32; 3]] {
         &self.tris[self.tri_start[i as usize] as usize..self.tri_start[i as usize + 1] as usize]
@@ -132,4 +142,23 @@ fn hue_color(k: u32) -> [u8; 4] {
     };
     let v = |c: f64| (90.0 + 150.0 * c) as u8;
     [v(r), v(g), v(b), 255]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::generate;
+
+    #[test]
+    fn only_a_soup_has_sequential_triangles() {
+        let soup = generate::soup(40, 2);
+        let m = PrimMesh::new(&soup, &P3::origin());
+        assert!(m.sequential());
+        assert_eq!(m.positions.len(), 120);
+        // A polygon of more than three vertices shares them between its triangles.
+        let lamp = generate::lamp();
+        let m = PrimMesh::new(&lamp, &P3::origin());
+        assert!(!m.sequential());
+        assert!(m.positions.len() < 3 * m.all_tris().len());
+    }
 }
