@@ -20,7 +20,7 @@
 //! positions are merged; everything is deterministic, so loading the same bytes twice gives
 //! the same scene.
 
-use std::fmt::{self, Write as _};
+use std::fmt;
 use std::path::Path;
 
 use sha2::{Digest, Sha256};
@@ -282,7 +282,10 @@ fn collect_groups(
     points: &mut Vec<P3>,
 ) -> Result<Vec<Group>, String> {
     let malformed = |what: &str| format!("not a valid OBJ file ({what})");
-    let mut ids = std::collections::HashMap::<[u64; 3], u32>::new();
+    let mut ids = foldhash::HashMap::<[u64; 3], u32>::with_capacity_and_hasher(
+        coords.len(),
+        foldhash::fast::RandomState::default(),
+    );
     let mut of_file = vec![u32::MAX; coords.len()];
     let mut groups = Vec::with_capacity(models.len());
     for model in models {
@@ -388,12 +391,22 @@ fn scan(text: &str) -> Result<Scanned, (LoadErrorKind, String)> {
         let mut words = raw.split_whitespace();
         match words.next() {
             Some("v") => {
-                let toks: Vec<&str> = words.collect();
-                let c = parse_vertex(&toks, s.coords.len() + 1).map_err(|p| p.at(line))?;
+                // Up to 7 tokens kept: more is an error either way.
+                let mut toks = [""; 7];
+                let mut n = 0;
+                for (slot, t) in toks.iter_mut().zip(words) {
+                    *slot = t;
+                    n += 1;
+                }
+                let c = parse_vertex(&toks[..n], s.coords.len() + 1).map_err(|p| p.at(line))?;
                 let k = s.coords.len() as u64;
                 s.coords.push(c);
-                // Writing to a `String` cannot fail.
-                let _ = writeln!(s.text, "v {} {} 0", k % INDEX_SPLIT, k / INDEX_SPLIT);
+                let mut digits = itoa::Buffer::new();
+                s.text.push_str("v ");
+                s.text.push_str(digits.format(k % INDEX_SPLIT));
+                s.text.push(' ');
+                s.text.push_str(digits.format(k / INDEX_SPLIT));
+                s.text.push_str(" 0\n");
                 continue;
             }
             Some("f") => {
