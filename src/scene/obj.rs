@@ -25,11 +25,14 @@ use std::path::Path;
 
 use sha2::{Digest, Sha256};
 
+use self::groups::{INDEX_SPLIT, collect_groups};
+use self::pipe::Cleaned;
 use self::polygon::PolygonStats;
 use self::polyhedron::PolyhedronStats;
 use super::Scene;
-use crate::geom::P3;
 
+mod groups;
+mod pipe;
 pub mod polygon;
 pub mod polyhedron;
 
@@ -135,6 +138,16 @@ pub fn load_bytes(
     bytes: Vec<u8>,
     opts: &LoadOptions,
 ) -> Result<Loaded, LoadError> {
+    load_piped_from(file_name, bytes, opts, pipe::PIPELINE_FROM)
+}
+
+/// [`load_bytes`], with the pre-pass and `tobj` at once from `pipeline_from` bytes up.
+fn load_piped_from(
+    file_name: &str,
+    bytes: Vec<u8>,
+    opts: &LoadOptions,
+    pipeline_from: usize,
+) -> Result<Loaded, LoadError> {
     let err = |kind, problem: String| LoadError {
         file: file_name.to_string(),
         kind,
@@ -151,7 +164,19 @@ pub fn load_bytes(
             format!("not a valid OBJ file (line {line}: not UTF-8 text)"),
         )
     })?;
-    let scanned = scan(text).map_err(|(kind, problem)| err(kind, problem))?;
+    let tobj_opts = tobj::LoadOptions {
+        single_index: true,
+        triangulate: false,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    // tobj reads the pre-pass's cleaned text as it is written (a large file) or after it.
+    let (scanned, parsed) = pipe::scan_then(text, pipeline_from, scan, |cleaned| {
+        tobj::load_obj_buf(cleaned, &tobj_opts, |_| {
+            Err(tobj::LoadError::OpenFileFailed)
+        })
+    })
+    .map_err(|(kind, problem)| err(kind, problem))?;
     if scanned.faces == 0 {
         let why = match scanned.short_faces {
             0 => String::new(),
@@ -159,16 +184,7 @@ pub fn load_bytes(
         };
         return Err(err(LoadErrorKind::NoFaces, format!("no faces{why}")));
     }
-    let tobj_opts = tobj::LoadOptions {
-        single_index: true,
-        triangulate: false,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let (models, _materials) = tobj::load_obj_buf(&mut scanned.text.as_bytes(), &tobj_opts, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
-    })
-    .map_err(|e| {
+    let (models, _materials) = parsed.map_err(|e| {
         err(
             LoadErrorKind::Malformed,
             format!("not a valid OBJ file ({e})"),
@@ -253,98 +269,9 @@ pub fn load_bytes(
     })
 }
 
-/// One OBJ object/group: its name and its faces as indices into the scene's points.
-struct Group {
-    name: String,
-    /// All faces' vertex indices, concatenated.
-    verts: Vec<u32>,
-    /// Offsets into `verts`, one more than the faces.
-    starts: Vec<usize>,
-}
-
-impl Group {
-    /// The faces, in file order.
-    fn faces(&self) -> impl Iterator<Item = &[u32]> {
-        self.starts.windows(2).map(|w| &self.verts[w[0]..w[1]])
-    }
-}
-
-/// Splits a vertex index into two parts that `f32` holds exactly (`tobj` parses `f32`).
-const INDEX_SPLIT: u64 = 1 << 20;
-
-/// Moves `tobj`'s models into `points` (merging bit-identical positions) and returns the groups.
-///
-/// `coords` are the file's vertices as parsed by [`scan`]; `tobj`'s positions only carry the
-/// vertex indices (see [`scan`]).
-fn collect_groups(
-    models: &[tobj::Model],
-    coords: &[[f64; 3]],
-    points: &mut Vec<P3>,
-) -> Result<Vec<Group>, String> {
-    let malformed = |what: &str| format!("not a valid OBJ file ({what})");
-    let mut ids = foldhash::HashMap::<[u64; 3], u32>::with_capacity_and_hasher(
-        coords.len(),
-        foldhash::fast::RandomState::default(),
-    );
-    let mut of_file = vec![u32::MAX; coords.len()];
-    let mut groups = Vec::with_capacity(models.len());
-    for model in models {
-        let mesh = &model.mesh;
-        let mut local = Vec::with_capacity(mesh.positions.len() / 3);
-        for c in mesh.positions.chunks_exact(3) {
-            let file = (f64::from(c[1]) as u64 * INDEX_SPLIT + f64::from(c[0]) as u64) as usize;
-            let slot = of_file
-                .get_mut(file)
-                .ok_or_else(|| malformed("vertex index"))?;
-            if *slot == u32::MAX {
-                // `+ 0.0` turns -0.0 into 0.0 so both spellings merge.
-                let p = coords[file].map(|x| x + 0.0);
-                *slot = *ids.entry(p.map(f64::to_bits)).or_insert_with(|| {
-                    points.push(P3::from(p));
-                    (points.len() - 1) as u32
-                });
-            }
-            local.push(*slot);
-        }
-        let arities: Box<dyn Iterator<Item = usize>> = if mesh.face_arities.is_empty() {
-            Box::new(std::iter::repeat_n(3, mesh.indices.len() / 3))
-        } else {
-            Box::new(mesh.face_arities.iter().map(|&a| a as usize))
-        };
-        let mut g = Group {
-            name: model.name.clone(),
-            verts: Vec::with_capacity(mesh.indices.len()),
-            starts: vec![0],
-        };
-        let mut at = 0usize;
-        for n in arities {
-            let idx = mesh
-                .indices
-                .get(at..at + n)
-                .ok_or_else(|| malformed("face list"))?;
-            at += n;
-            if n >= 3 {
-                for &i in idx {
-                    g.verts.push(
-                        *local
-                            .get(i as usize)
-                            .ok_or_else(|| malformed("face index"))?,
-                    );
-                }
-                g.starts.push(g.verts.len());
-            }
-        }
-        if g.starts.len() > 1 {
-            groups.push(g);
-        }
-    }
-    Ok(groups)
-}
-
-/// Result of [`scan`]: the cleaned text for `tobj`, the `f64` vertices and the face counts.
+/// Result of [`scan`]: the `f64` vertices and the face counts.
 #[derive(Default)]
 struct Scanned {
-    text: String,
     coords: Vec<[f64; 3]>,
     faces: usize,
     short_faces: usize,
@@ -375,12 +302,11 @@ fn shown(tok: &str) -> String {
     format!("{t:?}{more}")
 }
 
-/// Validates `text` line by line and builds the cleaned copy handed to `tobj`.
-fn scan(text: &str) -> Result<Scanned, (LoadErrorKind, String)> {
-    let mut s = Scanned {
-        text: String::with_capacity(text.len()),
-        ..Scanned::default()
-    };
+/// Validates `text` line by line and writes to `out` the cleaned copy handed to `tobj`.
+fn scan(text: &str, out: &mut dyn Cleaned) -> Result<Scanned, (LoadErrorKind, String)> {
+    let mut s = Scanned::default();
+    // A vertex's rewritten line, written out whole.
+    let mut vline = String::with_capacity(32);
     let mut face_no = 0;
     // Positive indices may point forward: the largest (with its face and line) is checked
     // once all vertices are known.
@@ -402,11 +328,13 @@ fn scan(text: &str) -> Result<Scanned, (LoadErrorKind, String)> {
                 let k = s.coords.len() as u64;
                 s.coords.push(c);
                 let mut digits = itoa::Buffer::new();
-                s.text.push_str("v ");
-                s.text.push_str(digits.format(k % INDEX_SPLIT));
-                s.text.push(' ');
-                s.text.push_str(digits.format(k / INDEX_SPLIT));
-                s.text.push_str(" 0\n");
+                vline.clear();
+                vline.push_str("v ");
+                vline.push_str(digits.format(k % INDEX_SPLIT));
+                vline.push(' ');
+                vline.push_str(digits.format(k / INDEX_SPLIT));
+                vline.push_str(" 0\n");
+                out.push_str(&vline);
                 continue;
             }
             Some("f") => {
@@ -422,15 +350,15 @@ fn scan(text: &str) -> Result<Scanned, (LoadErrorKind, String)> {
                 }
                 if n >= 3 {
                     s.faces += 1;
-                    s.text.push_str(raw);
+                    out.push_str(raw);
                 } else {
                     s.short_faces += 1;
                 }
             }
-            Some("o" | "g") => s.text.push_str(raw),
+            Some("o" | "g") => out.push_str(raw),
             _ => {}
         }
-        s.text.push('\n');
+        out.push_str("\n");
     }
     if let Some((idx, face, line)) = forward.filter(|f| f.0 > s.coords.len() as i64) {
         let n = s.coords.len();

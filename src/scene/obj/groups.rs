@@ -1,0 +1,92 @@
+//! `tobj`'s models as groups of faces over the scene's points, the coordinates taken from the
+//! pre-pass ([`scan`](super::scan)).
+
+use crate::geom::P3;
+
+/// One OBJ object/group: its name and its faces as indices into the scene's points.
+pub(super) struct Group {
+    pub(super) name: String,
+    /// All faces' vertex indices, concatenated.
+    verts: Vec<u32>,
+    /// Offsets into `verts`, one more than the faces.
+    starts: Vec<usize>,
+}
+
+impl Group {
+    /// The faces, in file order.
+    pub(super) fn faces(&self) -> impl Iterator<Item = &[u32]> {
+        self.starts.windows(2).map(|w| &self.verts[w[0]..w[1]])
+    }
+}
+
+/// Splits a vertex index into two parts that `f32` holds exactly (`tobj` parses `f32`).
+pub(super) const INDEX_SPLIT: u64 = 1 << 20;
+
+/// Moves `tobj`'s models into `points` (merging bit-identical positions) and returns the groups.
+///
+/// `coords` are the file's vertices as parsed by [`scan`](super::scan); `tobj`'s positions only carry the
+/// vertex indices (see [`scan`](super::scan)).
+pub(super) fn collect_groups(
+    models: &[tobj::Model],
+    coords: &[[f64; 3]],
+    points: &mut Vec<P3>,
+) -> Result<Vec<Group>, String> {
+    let malformed = |what: &str| format!("not a valid OBJ file ({what})");
+    let mut ids = foldhash::HashMap::<[u64; 3], u32>::with_capacity_and_hasher(
+        coords.len(),
+        foldhash::fast::RandomState::default(),
+    );
+    let mut of_file = vec![u32::MAX; coords.len()];
+    let mut groups = Vec::with_capacity(models.len());
+    for model in models {
+        let mesh = &model.mesh;
+        let mut local = Vec::with_capacity(mesh.positions.len() / 3);
+        for c in mesh.positions.chunks_exact(3) {
+            let file = (f64::from(c[1]) as u64 * INDEX_SPLIT + f64::from(c[0]) as u64) as usize;
+            let slot = of_file
+                .get_mut(file)
+                .ok_or_else(|| malformed("vertex index"))?;
+            if *slot == u32::MAX {
+                // `+ 0.0` turns -0.0 into 0.0 so both spellings merge.
+                let p = coords[file].map(|x| x + 0.0);
+                *slot = *ids.entry(p.map(f64::to_bits)).or_insert_with(|| {
+                    points.push(P3::from(p));
+                    (points.len() - 1) as u32
+                });
+            }
+            local.push(*slot);
+        }
+        let arities: Box<dyn Iterator<Item = usize>> = if mesh.face_arities.is_empty() {
+            Box::new(std::iter::repeat_n(3, mesh.indices.len() / 3))
+        } else {
+            Box::new(mesh.face_arities.iter().map(|&a| a as usize))
+        };
+        let mut g = Group {
+            name: model.name.clone(),
+            verts: Vec::with_capacity(mesh.indices.len()),
+            starts: vec![0],
+        };
+        let mut at = 0usize;
+        for n in arities {
+            let idx = mesh
+                .indices
+                .get(at..at + n)
+                .ok_or_else(|| malformed("face list"))?;
+            at += n;
+            if n >= 3 {
+                for &i in idx {
+                    g.verts.push(
+                        *local
+                            .get(i as usize)
+                            .ok_or_else(|| malformed("face index"))?,
+                    );
+                }
+                g.starts.push(g.verts.len());
+            }
+        }
+        if g.starts.len() > 1 {
+            groups.push(g);
+        }
+    }
+    Ok(groups)
+}
