@@ -12,6 +12,9 @@
 //! 2. `tobj::load_obj_buf` parses the cleaned copy into groups and faces (materials refused);
 //!    the vertex indices in its positions lead back to the `f64` coordinates.
 //!
+//! From 1 MB up the two run at once, tobj reading the cleaned copy in blocks as `scan` writes
+//! it (`pipe`), with the same results.
+//!
 //! Then, in polygon mode (default) every face becomes one `PrimitiveKind::Polygon` by the
 //! rules of [`polygon`]; with [`LoadOptions::polyhedra`] every OBJ object/group becomes one
 //! `PrimitiveKind::Polyhedron` by the rules of [`polyhedron`]. Every primitive records the
