@@ -1,6 +1,8 @@
 //! `tobj`'s models as groups of faces over the scene's points, the coordinates taken from the
 //! pre-pass ([`scan`](super::scan)).
 
+use std::hash::BuildHasher;
+
 use crate::geom::P3;
 
 /// One OBJ object/group: its name and its faces as indices into the scene's points.
@@ -24,18 +26,21 @@ pub(super) const INDEX_SPLIT: u64 = 1 << 20;
 
 /// Moves `tobj`'s models into `points` (merging bit-identical positions) and returns the groups.
 ///
-/// `coords` are the file's vertices as parsed by [`scan`](super::scan); `tobj`'s positions only carry the
-/// vertex indices (see [`scan`](super::scan)).
+/// `coords` are the file's vertices as parsed by [`scan`](super::scan); `tobj`'s positions
+/// only carry the vertex indices (see [`scan`](super::scan)).
 pub(super) fn collect_groups(
     models: &[tobj::Model],
     coords: &[[f64; 3]],
     points: &mut Vec<P3>,
 ) -> Result<Vec<Group>, String> {
     let malformed = |what: &str| format!("not a valid OBJ file ({what})");
-    let mut ids = foldhash::HashMap::<[u64; 3], u32>::with_capacity_and_hasher(
-        coords.len(),
-        foldhash::fast::RandomState::default(),
-    );
+    // The distinct coordinates as a table of point ids (4 bytes a slot, not a key's 28: at 3×10^6
+    // vertices the table stays in 16 MB), compared through `points`.
+    let hasher = foldhash::fast::FixedState::with_seed(0);
+    let bits = |p: &P3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+    let mut ids = hashbrown::HashTable::<u32>::with_capacity(coords.len());
+    // At most one point per vertex line.
+    points.reserve(coords.len());
     let mut of_file = vec![u32::MAX; coords.len()];
     let mut groups = Vec::with_capacity(models.len());
     for model in models {
@@ -49,10 +54,18 @@ pub(super) fn collect_groups(
             if *slot == u32::MAX {
                 // `+ 0.0` turns -0.0 into 0.0 so both spellings merge.
                 let p = coords[file].map(|x| x + 0.0);
-                *slot = *ids.entry(p.map(f64::to_bits)).or_insert_with(|| {
-                    points.push(P3::from(p));
-                    (points.len() - 1) as u32
-                });
+                let key = p.map(f64::to_bits);
+                let hash = |k: &[u64; 3]| hasher.hash_one(k);
+                let found = |&id: &u32| bits(&points[id as usize]) == key;
+                *slot = match ids.find(hash(&key), found) {
+                    Some(&id) => id,
+                    None => {
+                        let id = points.len() as u32;
+                        points.push(P3::from(p));
+                        ids.insert_unique(hash(&key), id, |&i| hash(&bits(&points[i as usize])));
+                        id
+                    }
+                };
             }
             local.push(*slot);
         }
@@ -89,4 +102,35 @@ pub(super) fn collect_groups(
         }
     }
     Ok(groups)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{LoadOptions, load_bytes};
+    use crate::geom::P3;
+
+    #[test]
+    fn bit_identical_positions_become_one_point_in_order_of_first_use() {
+        // Vertex 4 repeats 2 (with −0), 5 repeats 3, 6 is unused; the first face uses 4, 5, 7.
+        let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 -0\nv 0 1 0\nv 5 5 5\nv 0 0 1\n\
+                   o a\nf 4 5 7\no b\nf 1 2 3\n";
+        let l = load_bytes("dup.obj", obj.as_bytes().to_vec(), &LoadOptions::default()).unwrap();
+        let want = [
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, 0.0],
+        ];
+        let want: Vec<P3> = want.iter().map(|&c| P3::from(c)).collect();
+        assert_eq!(l.scene.points, want);
+        assert!(
+            l.scene
+                .points
+                .iter()
+                .all(|p| p.x.to_bits() != (-0.0f64).to_bits())
+        );
+        assert_eq!(l.scene.prim(0), [0, 1, 2]);
+        assert_eq!(l.scene.prim(1), [3, 0, 1]);
+        assert_eq!(l.scene.objects, [0, 1]);
+    }
 }
