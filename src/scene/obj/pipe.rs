@@ -103,12 +103,13 @@ impl BufRead for BlockReader {
 }
 
 /// Scans `text` with `scan` and has `parse` read the cleaned text: at once on two threads for a
-/// text of `pipeline_from` bytes or more ([`PIPELINE_FROM`]), one after the other below. Returns
-/// the scan's result (an error of the scan is returned as such) with `parse`'s.
+/// text of `pipeline_from` bytes or more ([`PIPELINE_FROM`]), one after the other below (and
+/// when no thread can be started). Returns the scan's result (an error of the scan is returned
+/// as such) with `parse`'s.
 pub(super) fn scan_then<S, E, T>(
     text: &str,
     pipeline_from: usize,
-    scan: impl FnOnce(&str, &mut dyn Cleaned) -> Result<S, E> + Send,
+    scan: impl Fn(&str, &mut dyn Cleaned) -> Result<S, E> + Sync,
     parse: impl FnOnce(&mut BlockReader) -> T,
 ) -> Result<(S, T), E>
 where
@@ -116,24 +117,23 @@ where
     E: Send,
 {
     if text.len() < pipeline_from {
-        let mut cleaned = String::with_capacity(text.len());
-        let scanned = scan(text, &mut cleaned)?;
-        let mut reader = BlockReader {
-            cur: cleaned.into_bytes(),
-            pos: 0,
-            rx: None,
-        };
-        return Ok((scanned, parse(&mut reader)));
+        return in_turn(text, &scan, parse);
     }
+    let scan = &scan;
+    let (tx, rx) = sync_channel(IN_FLIGHT);
     std::thread::scope(|s| {
-        let (tx, rx) = sync_channel(IN_FLIGHT);
-        let scanner = s.spawn(move || {
-            let mut blocks = Blocks {
-                buf: Vec::with_capacity(BLOCK + 256),
-                tx: Some(tx),
-            };
-            scan(text, &mut blocks)
-        });
+        let started = std::thread::Builder::new()
+            .name("obj-prepass".into())
+            .spawn_scoped(s, move || {
+                let mut blocks = Blocks {
+                    buf: Vec::with_capacity(BLOCK + 256),
+                    tx: Some(tx),
+                };
+                scan(text, &mut blocks)
+            });
+        let Ok(scanner) = started else {
+            return in_turn(text, scan, parse);
+        };
         let mut reader = BlockReader {
             cur: Vec::new(),
             pos: 0,
@@ -149,12 +149,28 @@ where
     })
 }
 
+/// [`scan_then`] one after the other: the whole cleaned text, then the parse.
+fn in_turn<S, E, T>(
+    text: &str,
+    scan: &impl Fn(&str, &mut dyn Cleaned) -> Result<S, E>,
+    parse: impl FnOnce(&mut BlockReader) -> T,
+) -> Result<(S, T), E> {
+    let mut cleaned = String::with_capacity(text.len());
+    let scanned = scan(text, &mut cleaned)?;
+    let mut reader = BlockReader {
+        cur: cleaned.into_bytes(),
+        pos: 0,
+        rx: None,
+    };
+    Ok((scanned, parse(&mut reader)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     /// Copies `text` to the cleaned text in pieces of `piece` bytes.
-    fn copy(piece: usize) -> impl FnOnce(&str, &mut dyn Cleaned) -> Result<usize, String> + Send {
+    fn copy(piece: usize) -> impl Fn(&str, &mut dyn Cleaned) -> Result<usize, String> + Sync {
         move |text: &str, out: &mut dyn Cleaned| {
             for chunk in text.as_bytes().chunks(piece) {
                 out.push_str(std::str::from_utf8(chunk).map_err(|e| e.to_string())?);
