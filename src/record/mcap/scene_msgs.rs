@@ -142,8 +142,8 @@ pub fn sphere(s: &Sphere, rgba: [f64; 4]) -> SpherePrimitive {
 
 /// An indexed triangle list of scene primitives, built up by [`SceneMesh::add`]: each scene
 /// vertex the primitives use appears once in `points`, and the triangles index it (unless the
-/// index is the identity). Adding
-/// keeps what is there, so nested sets (the leaves of successive levels) are built once.
+/// index is the identity). Adding keeps what is there, so nested sets (the leaves of successive
+/// levels) are built once.
 #[derive(Debug)]
 pub struct SceneMesh<'s> {
     scene: &'s Scene,

@@ -37,6 +37,7 @@ pub(super) fn collect_groups(
     // The distinct coordinates as a table of point ids (4 bytes a slot, not a key's 28: at 3×10^6
     // vertices the table stays in 16 MB), compared through `points`.
     let hasher = foldhash::fast::FixedState::with_seed(0);
+    let hash = |k: &[u64; 3]| hasher.hash_one(k);
     let bits = |p: &P3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
     let mut ids = hashbrown::HashTable::<u32>::with_capacity(coords.len());
     // At most one point per vertex line.
@@ -55,7 +56,6 @@ pub(super) fn collect_groups(
                 // `+ 0.0` turns -0.0 into 0.0 so both spellings merge.
                 let p = coords[file].map(|x| x + 0.0);
                 let key = p.map(f64::to_bits);
-                let hash = |k: &[u64; 3]| hasher.hash_one(k);
                 let found = |&id: &u32| bits(&points[id as usize]) == key;
                 *slot = match ids.find(hash(&key), found) {
                     Some(&id) => id,
