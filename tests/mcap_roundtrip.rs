@@ -518,3 +518,47 @@ fn record_cli_cover_level_passes_the_python_checker() {
     assert!((1.0..276.0).contains(&num("cover_size")), "{m:?}");
     assert!(!m.contains_key("cover_budget"));
 }
+
+/// The chunks are compressed as asked, `auto` picks by scene size, and every kind reads back
+/// to the same run.
+#[test]
+fn chunks_are_compressed_as_asked_and_read_back_alike() {
+    use wraptree::record::mcap::{AUTO_UNCOMPRESSED_FROM, Compression};
+    assert_eq!(Compression::Auto.for_scene(3), Compression::Lz4);
+    assert_eq!(
+        Compression::Auto.for_scene(AUTO_UNCOMPRESSED_FROM),
+        Compression::None
+    );
+    assert_eq!(Compression::Zstd.for_scene(10_000_000), Compression::Zstd);
+    let loaded = load_grid();
+    let params = Params::default();
+    let resolved = params.resolve(&loaded.scene);
+    let info = RunInfo {
+        scene: &loaded.scene,
+        source: &loaded.source,
+        params: &resolved,
+        detail: Detail::Full,
+    };
+    let mut merges = Vec::new();
+    for (kind, name) in [
+        (Compression::None, ""),
+        (Compression::Auto, "lz4"),
+        (Compression::Lz4, "lz4"),
+        (Compression::Zstd, "zstd"),
+    ] {
+        let mut rec = McapRecorder::start(Cursor::new(Vec::new()), &info, kind).unwrap();
+        rec.write_scene();
+        let g = group(&loaded.scene, &params, &mut rec);
+        let bytes = rec.finish(&Outcome::finished(&g)).unwrap().into_inner();
+        let summary = mcap::Summary::read(&bytes).unwrap().expect("a summary");
+        assert!(!summary.chunk_indexes.is_empty());
+        for c in &summary.chunk_indexes {
+            assert_eq!(c.compression, name, "{kind:?}");
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("c.mcap");
+        std::fs::write(&path, &bytes).unwrap();
+        merges.push(read_recording(&path).unwrap().merges);
+    }
+    assert!(merges.iter().all(|m| *m == merges[0] && !m.is_empty()));
+}

@@ -9,6 +9,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use wraptree::record::mcap::Compression;
 use wraptree::record::output::output_prefix;
 use wraptree::record::{Detail, RecordOptions, Written, record};
 use wraptree::refine::RefineParams;
@@ -51,6 +52,10 @@ pub struct RecordCmd {
     /// Wrapper kinds the cover chooses from, comma-separated: sphere, box (or aabb), obb, hull.
     #[arg(long, default_value = "sphere,box,hull", value_delimiter = ',', value_parser = WrapperKind::parse)]
     cover_kinds: Vec<WrapperKind>,
+    /// Compress the .mcap's chunks: auto (lz4 below 500,000 primitives, none from there on),
+    /// none (fastest to write and read), lz4, or zstd (smallest).
+    #[arg(long, value_enum, default_value_t = Compression::Auto)]
+    mcap_compression: Compression,
     /// Write every level to the .mcap (default: from the root down to the last level whose cut
     /// is less than half leaves; the .rrd always has every level).
     #[arg(long)]
@@ -121,6 +126,7 @@ impl RecordCmd {
             wrappers: self.wrapper,
             cover: limit.map(|l| (l, self.cover_kinds)),
             all_levels: self.all_levels,
+            mcap_compression: self.mcap_compression,
             refine: self.refine.then_some(RefineParams {
                 passes: self.refine_passes,
                 batch: self.refine_batch,

@@ -5,6 +5,7 @@
 //! runs a grouping with both recorders listening, and [`Written`] says what it wrote.
 
 pub mod background;
+pub mod direct;
 pub mod mcap;
 mod options;
 pub mod output;

@@ -12,7 +12,8 @@
 //! # Ok::<(), anyhow::Error>(())
 //! ```
 
-use super::mcap::McapRecorder;
+use super::direct::DirectWriter;
+use super::mcap::{Compression, McapRecorder};
 use super::output::{Pending, with_ext};
 use super::rrd::RrdRecorder;
 use super::{CoverLevel, Detail, Outcome, RunInfo, background};
@@ -53,10 +54,13 @@ pub struct RecordOptions {
     /// Refine the finished tree with these parameters ([`crate::refine`]), recording each
     /// move; the levels are then the refined tree's.
     pub refine: Option<crate::refine::RefineParams>,
+    /// How the `.mcap`'s chunks are compressed.
+    pub mcap_compression: Compression,
 }
 
 impl Default for RecordOptions {
-    /// Full detail, sphere Wrapper Trees, no cover, no limits, existing files kept.
+    /// Full detail, sphere Wrapper Trees, no cover, no limits, existing files kept,
+    /// `.mcap` chunks compressed as [`Compression::Auto`] decides.
     fn default() -> Self {
         RecordOptions {
             detail: Detail::Full,
@@ -68,6 +72,7 @@ impl Default for RecordOptions {
             cover: None,
             all_levels: false,
             refine: None,
+            mcap_compression: Compression::Auto,
         }
     }
 }
@@ -107,7 +112,7 @@ pub fn record<O: Observer>(
 ) -> Result<Written> {
     let (scene, source, detail) = (&loaded.scene, &loaded.source, opts.detail);
     let (force, reproducible, limits) = (opts.force, opts.reproducible, opts.limits);
-    let all_levels = opts.all_levels;
+    let (all_levels, compression) = (opts.all_levels, opts.mcap_compression);
     if opts.cover.is_some() && !detail.levels() {
         bail!(
             "--cover-tolerance/--cover-budget need --detail levels or full (the cover is a level)"
@@ -122,7 +127,8 @@ pub fn record<O: Observer>(
         params,
         detail,
     };
-    let mcap_out = mcap_file.file()?;
+    let mcap_out = DirectWriter::open(mcap_file.path())
+        .with_context(|| format!("{}: cannot open for writing", mcap_path.display()))?;
     let never = AtomicBool::new(false);
     let stop = opts.stop.as_deref().unwrap_or(&never);
     let start = Instant::now();
@@ -148,8 +154,7 @@ pub fn record<O: Observer>(
         let mcap_thread = std::thread::Builder::new()
             .name("mcap-recorder".into())
             .spawn_scoped(s, move || {
-                let writer = std::io::BufWriter::new(mcap_out);
-                let mut mcap = McapRecorder::start(writer, info)?;
+                let mut mcap = McapRecorder::start(mcap_out, info, compression)?;
                 mcap.set_reproducible(reproducible);
                 mcap.set_all_levels(all_levels);
                 mcap.write_scene();

@@ -1,8 +1,10 @@
 //! Foxglove `.mcap` recordings of a grouping run ([`McapRecorder`]) and their reader
 //! ([`read_recording`], used by `wraptree replay`).
 //!
-//! The file is chunked, LZ4-compressed (fast mode, single-threaded, so the same run gives the
-//! same bytes on every machine) with chunk, data-section, summary and attachment CRCs. Geometry
+//! The file is chunked, LZ4-compressed below [`AUTO_UNCOMPRESSED_FROM`] primitives and
+//! uncompressed from there on unless asked otherwise ([`Compression`]; LZ4 and Zstandard run
+//! single-threaded, so the same run gives the same bytes on every machine), with chunk,
+//! data-section, summary and attachment CRCs. Geometry
 //! uses the well-known `foxglove.SceneUpdate` schema; grouping events use small typed protobuf
 //! messages derived with `foxglove::Encode` ([`messages`]). Message encoding is `protobuf`
 //! everywhere; every entity is in frame `world`.
@@ -51,9 +53,42 @@ use scene_msgs::SceneMesh;
 use std::collections::BTreeMap;
 use std::io::{Seek, Write};
 
-/// LZ4 level of every chunk: 0, the fast (not high-compression) mode. On the 10^6-triangle
-/// recording it compresses 3× faster than zstd level 2, for chunks 16 % larger (README).
+/// LZ4 level of every chunk with [`Compression::Lz4`]: 0, the fast (not high-compression)
+/// mode. On the 10^6-triangle recording it compresses 3× faster than zstd level 2, for chunks
+/// 16 % larger (README).
 pub const LZ4_LEVEL: u32 = 0;
+/// Zstandard level of every chunk with [`Compression::Zstd`].
+pub const ZSTD_LEVEL: u32 = 2;
+
+/// Scenes of at least this many primitives get uncompressed chunks under
+/// [`Compression::Auto`]: at 10^6 triangles LZ4 costs about 0.4 s of CPU, nearly as much as the
+/// grouping, for a file 14 % smaller (README, Recordings at scale).
+pub const AUTO_UNCOMPRESSED_FROM: usize = 500_000;
+
+/// How the `.mcap`'s chunks are compressed (`record --mcap-compression`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Compression {
+    /// LZ4 below [`AUTO_UNCOMPRESSED_FROM`] primitives, none from there on.
+    #[default]
+    Auto,
+    /// Not at all: the fastest to write and to read, 25–30 % larger than LZ4 on real scenes.
+    None,
+    /// LZ4 frames, fast mode ([`LZ4_LEVEL`]), single-threaded.
+    Lz4,
+    /// Zstandard, level [`ZSTD_LEVEL`], single-threaded: the smallest, the slowest.
+    Zstd,
+}
+
+impl Compression {
+    /// The compression used for a scene of `n` primitives ([`Compression::Auto`] decided).
+    pub fn for_scene(self, n: usize) -> Compression {
+        match self {
+            Compression::Auto if n >= AUTO_UNCOMPRESSED_FROM => Compression::None,
+            Compression::Auto => Compression::Lz4,
+            c => c,
+        }
+    }
+}
 /// Target uncompressed chunk size.
 pub const CHUNK_SIZE: u64 = 1 << 20;
 /// Media type of the embedded scene.
@@ -146,10 +181,11 @@ fn emit<T: Encode, W: Write + Seek>(
 }
 
 impl<'a, W: Write + Seek> McapRecorder<'a, W> {
-    /// Starts a recording: writes the header, schemas, channels, the `/scene` message and the
-    /// scene attachment ([`McapRecorder::start`] then [`McapRecorder::write_scene`]).
+    /// Starts a recording with [`Compression::Auto`]: writes the header, schemas, channels, the
+    /// `/scene` message and the scene attachment ([`McapRecorder::start`] then
+    /// [`McapRecorder::write_scene`]).
     pub fn new(writer: W, info: &RunInfo<'a>) -> Result<Self> {
-        let mut rec = Self::start(writer, info)?;
+        let mut rec = Self::start(writer, info, Compression::Auto)?;
         rec.write_scene();
         match rec.error.take() {
             Some(e) => Err(e),
@@ -157,14 +193,22 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
         }
     }
 
-    /// Starts a recording: writes the header, schemas and channels (small; a buffered writer
-    /// holds them), but not yet the scene.
-    pub fn start(writer: W, info: &RunInfo<'a>) -> Result<Self> {
+    /// Starts a recording whose chunks are compressed with `compression`: writes the header,
+    /// schemas and channels (small; a buffered writer holds them), but not yet the scene.
+    pub fn start(writer: W, info: &RunInfo<'a>, compression: Compression) -> Result<Self> {
+        let (compression, level) = match compression.for_scene(info.scene.len()) {
+            Compression::None | Compression::Auto => (None, 0),
+            Compression::Lz4 => (Some(mcap::Compression::Lz4), LZ4_LEVEL),
+            Compression::Zstd => (Some(mcap::Compression::Zstd), ZSTD_LEVEL),
+        };
         let options = mcap::WriteOptions::new()
-            .compression(Some(mcap::Compression::Lz4))
-            .compression_level(LZ4_LEVEL)
+            .compression(compression)
+            .compression_level(level)
             .chunk_size(Some(CHUNK_SIZE))
             .use_chunks(true)
+            // Each chunk is built in memory and then appended: the file is written front to
+            // back, never rewound (so it can bypass the page cache, `record::direct`).
+            .disable_seeking(true)
             .profile(PROFILE)
             .library(LIBRARY)
             .calculate_chunk_crcs(true)

@@ -1,8 +1,8 @@
 //! The Rerun `.rrd` recorder: the grouping run as a file for the Rerun viewer (SDK 0.36.3).
 //!
-//! [`RrdRecorder`] is an [`Observer`]; it saves with the SDK's file sink
-//! (`RecordingStreamBuilder::save`, no viewer is spawned), checks at the end that the file is
-//! complete (`sink.rs`), writes what precedes the events in `header.rs`, and embeds a
+//! [`RrdRecorder`] is an [`Observer`]; it saves through a sink of its own (the SDK's encoder
+//! on a writer thread that bypasses the page cache, no viewer is spawned), checks at the end
+//! that the file is complete (`sink.rs`), writes what precedes the events in `header.rs`, and embeds a
 //! blueprint (`blueprint.rs`) so the file opens on a useful layout.
 //!
 //! # Timelines
@@ -104,6 +104,8 @@ const ACTIVE_BLUE: u32 = 0x3C78D8A0;
 /// Records a grouping run to a Rerun `.rrd` file; see the [module docs](self) for its layout.
 pub struct RrdRecorder {
     rec: Option<RecordingStream>,
+    /// How the file's writer ended.
+    status: sink::Status,
     /// The file written.
     path: PathBuf,
     /// The path named in errors.
@@ -208,7 +210,7 @@ impl RrdRecorder {
         let scene = info.scene;
         let builder =
             rerun::RecordingStreamBuilder::new("wraptree").recording_id(header::recording_id(info));
-        let rec = sink::save(builder, path)
+        let (rec, status) = sink::save(builder, path)
             .map_err(|e| file_error(name, "cannot create the Rerun recording", e))?;
         // The SDK builds a blueprint through a stream of its own (two threads, one chunk per
         // view); a thread of ours does it while this one writes the header and the events.
@@ -238,6 +240,7 @@ impl RrdRecorder {
         };
         let mut recorder = RrdRecorder {
             rec: Some(rec),
+            status,
             path: path.to_path_buf(),
             name: name.to_path_buf(),
             detail: info.detail,
@@ -408,7 +411,7 @@ impl RrdRecorder {
             }
         }
         let rec = self.rec.take().ok_or_else(closed).map_err(fail)?;
-        sink::close(rec, &path).map_err(fail)
+        sink::close(rec, &self.status, &path).map_err(fail)
     }
 
     fn write_tail(&mut self, outcome: &Outcome<'_>) -> anyhow::Result<()> {

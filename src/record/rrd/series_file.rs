@@ -1,5 +1,4 @@
-//! A plain `.rrd` for benchmark and sweep results: a [`RecordingStream`] saved with the SDK's
-//! file sink and checked like the grouping recorder's, without wall-clock time, written to a
+//! A plain `.rrd` for benchmark and sweep results: a [`RecordingStream`] saved and checked like the grouping recorder's, without wall-clock time, written to a
 //! temporary file and moved into place by [`SeriesFile::commit`].
 
 use super::sink;
@@ -10,6 +9,7 @@ use std::path::{Path, PathBuf};
 /// An `.rrd` being written.
 pub struct SeriesFile {
     rec: RecordingStream,
+    status: sink::Status,
     pending: Pending,
 }
 
@@ -28,9 +28,13 @@ impl SeriesFile {
         if let Some(b) = blueprint {
             builder = builder.with_blueprint(b);
         }
-        let rec = sink::save(builder, pending.path())
+        let (rec, status) = sink::save(builder, pending.path())
             .map_err(|e| anyhow::anyhow!("{}: {}", dest.display(), e.root_cause()))?;
-        Ok(SeriesFile { rec, pending })
+        Ok(SeriesFile {
+            rec,
+            status,
+            pending,
+        })
     }
 
     /// The stream to log to.
@@ -41,7 +45,7 @@ impl SeriesFile {
     /// Flushes and closes the file and moves it into place; returns its path.
     pub fn commit(self) -> anyhow::Result<PathBuf> {
         let dest = self.pending.dest().to_path_buf();
-        sink::close(self.rec, self.pending.path())
+        sink::close(self.rec, &self.status, self.pending.path())
             .map_err(|e| anyhow::anyhow!("{}: {e}", dest.display()))?;
         self.pending.commit()
     }
