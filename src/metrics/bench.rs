@@ -270,7 +270,7 @@ pub fn record_costs(repeat: u32, mut on_row: impl FnMut(&RecordCostRow)) -> Resu
     let mut fixed = [0.0; 3];
     for (f, &detail) in fixed.iter_mut().zip(&RECORD_DETAILS) {
         let prefix = dir.path().join(format!("fixed-{detail:?}"));
-        *f = record_cost(&tiny, detail, &prefix, repeat)?.record_seconds;
+        *f = record_cost(&tiny, &Params::default(), detail, &prefix, repeat)?.record_seconds;
     }
     for scene in &record_scenes() {
         let loaded = as_loaded(scene)?;
@@ -280,7 +280,7 @@ pub fn record_costs(repeat: u32, mut on_row: impl FnMut(&RecordCostRow)) -> Resu
                 scene: scene.name.clone(),
                 n: scene.len(),
                 detail,
-                cost: record_cost(&loaded, detail, &prefix, repeat)?,
+                cost: record_cost(&loaded, &Params::default(), detail, &prefix, repeat)?,
                 fixed_seconds,
             });
         }
@@ -288,17 +288,18 @@ pub fn record_costs(repeat: u32, mut on_row: impl FnMut(&RecordCostRow)) -> Resu
     Ok(fixed)
 }
 
-/// `repeat` pairs of (grouping alone, grouping recorded) wall times for `loaded`, each
-/// recorded run just after its grouping-only run so that a slow spell of the machine weighs
-/// on both sides of a pair; and where the last recording went (`PREFIX.rrd`/`.mcap`, replaced,
-/// reproducible, sphere Wrapper Trees).
+/// `repeat` pairs of (grouping alone, grouping recorded) wall times for `loaded` with
+/// `params`, each recorded run just after its grouping-only run so that a slow spell of the
+/// machine weighs on both sides of a pair; and where the last recording went
+/// (`PREFIX.rrd`/`.mcap`, replaced, reproducible, sphere Wrapper Trees).
 pub fn record_pairs(
     loaded: &Loaded,
+    params: &Params,
     detail: Detail,
     prefix: &Path,
     repeat: u32,
 ) -> Result<(Vec<(f64, f64)>, Written)> {
-    let params = Params::default().resolve(&loaded.scene);
+    let resolved = params.resolve(&loaded.scene);
     let opts = RecordOptions {
         detail,
         force: true,
@@ -309,10 +310,10 @@ pub fn record_pairs(
     let pairs = (0..repeat.max(1))
         .map(|_| {
             let t_group = best_of(1, || {
-                std::hint::black_box(grouping::group(&loaded.scene, &Params::default(), ()));
+                std::hint::black_box(grouping::group(&loaded.scene, params, ()));
             });
             let t_rec = best_of(1, || {
-                written = Some(record(loaded, &params, prefix, &opts, ()));
+                written = Some(record(loaded, &resolved, prefix, &opts, ()));
             });
             (t_group, t_rec)
         })
@@ -335,14 +336,16 @@ pub struct RecordCost {
     pub mcap_bytes: u64,
 }
 
-/// Measures [`record_pairs`] of `loaded` at `detail` into `prefix`, `repeat` times.
+/// Measures [`record_pairs`] of `loaded` with `params` at `detail` into `prefix`, `repeat`
+/// times.
 pub fn record_cost(
     loaded: &Loaded,
+    params: &Params,
     detail: Detail,
     prefix: &Path,
     repeat: u32,
 ) -> Result<RecordCost> {
-    let (pairs, w) = record_pairs(loaded, detail, prefix, repeat)?;
+    let (pairs, w) = record_pairs(loaded, params, detail, prefix, repeat)?;
     let mut ratios: Vec<f64> = pairs.iter().map(|(g, r)| r / g).collect();
     ratios.sort_by(f64::total_cmp);
     let size = |p: &Path| std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);

@@ -2,11 +2,14 @@
 //! each in a rayon pool of 1 and 2 threads, with the partitioned tree's quality against the
 //! exact tree's and the builds' peak memory (`wraptree bench --partitioned`).
 
-use crate::grouping::Params;
+use crate::grouping::{Params, Schedule};
+use crate::metrics::bench::{RecordCost, record_cost};
 use crate::metrics::{compare, peak_rss_bytes, sah};
 use crate::peers::{self, Method};
 use crate::query::{self, Bv, Workload};
+use crate::record::Detail;
 use crate::scene::Scene;
+use crate::scene::spec::as_loaded;
 use anyhow::{Result, anyhow};
 
 /// Thread counts of the table.
@@ -139,4 +142,23 @@ pub fn row(scene: &Scene, repeat: u32) -> Result<Row> {
         partitioned: each(Method::GroupingPartitioned, n <= EXACT_MAX_N)?,
         ploc: each(Method::ObvhsPloc, false)?,
     })
+}
+
+/// The scene size whose recording the table measures ([`record_row`]).
+pub const RECORD_N: usize = 1_000_000;
+
+/// What `wraptree record --schedule partitioned --detail merges` costs on `scene` in a
+/// 1-thread pool: `repeat` pairs (at most 2) of the grouping alone and the recorded run (both
+/// files, into a temporary directory; the scene attached as its OBJ text, as for a file).
+pub fn record_row(scene: &Scene, repeat: u32) -> Result<RecordCost> {
+    let loaded = as_loaded(scene)?;
+    let mut params = Params::default();
+    params.mode.schedule = Schedule::Partitioned;
+    let dir = tempfile::tempdir()?;
+    let prefix = dir.path().join("partitioned");
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(|e| anyhow!("building a 1-thread pool: {e}"))?;
+    pool.install(|| record_cost(&loaded, &params, Detail::Merges, &prefix, repeat.min(2)))
 }

@@ -17,7 +17,9 @@ mod targets;
 
 pub use bench::{bench_charts, bench_csv, bench_table, write_bench};
 pub use group::{group_json, group_text, pregrouping_lines};
-pub use partitioned::{partitioned_header, partitioned_line, partitioned_notes};
+pub use partitioned::{
+    partitioned_header, partitioned_line, partitioned_notes, partitioned_record_line,
+};
 pub use stress::{StressRow, stress_csv, stress_sweep_chart, stress_table};
 pub use sweep::{SweepRrd, setting_name, sweep_csv, sweep_heat_maps, sweep_table, write_sweep};
 pub use targets::{

@@ -1,6 +1,7 @@
 //! What `bench --partitioned` prints: the partitioned schedule's table
 //! ([`crate::metrics::bench::partitioned`]) with its header and notes.
 
+use crate::metrics::bench::RecordCost;
 use crate::metrics::bench::partitioned::{Case, Row};
 
 /// The partitioned table's header line (after a blank line).
@@ -60,4 +61,19 @@ pub fn partitioned_notes() -> String {
      (peak reset before each; exact left out above 10^6). Goals: p/P 1t <= 1.5, p/P 2t <= 1,\n\
      SAH and qry p/e <= 1.02.\n"
         .to_string()
+}
+
+/// The line under the partitioned table: recording `scene` (`n` primitives) with the
+/// partitioned schedule at `--detail merges` on one thread, against its grouping alone.
+pub fn partitioned_record_line(scene: &str, n: usize, c: &RecordCost) -> String {
+    format!(
+        "record {scene} ({n}, partitioned, --detail merges, 1t): group {:.0} ms, record {:.0} ms, \
+         ratio {:.2} (median {:.2}; goal <= 3); .rrd {:.1} MB, .mcap {:.1} MB\n",
+        c.group_seconds * 1e3,
+        c.record_seconds * 1e3,
+        c.record_seconds / c.group_seconds,
+        c.median_ratio,
+        c.rrd_bytes as f64 / 1e6,
+        c.mcap_bytes as f64 / 1e6,
+    )
 }
