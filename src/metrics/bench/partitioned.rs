@@ -148,8 +148,9 @@ pub fn row(scene: &Scene, repeat: u32) -> Result<Row> {
 pub const RECORD_N: usize = 1_000_000;
 
 /// What `wraptree record --schedule partitioned --detail merges` costs on `scene` in a
-/// 1-thread pool: `repeat` pairs (at most 2) of the grouping alone and the recorded run (both
-/// files, into a temporary directory; the scene attached as its OBJ text, as for a file).
+/// 1-thread pool: `repeat` pairs, at least 3 and at most 5 (so that the median means
+/// something on a noisy machine), of the grouping alone and the recorded run (both files, into
+/// a temporary directory; the scene attached as its OBJ text, as for a file).
 pub fn record_row(scene: &Scene, repeat: u32) -> Result<RecordCost> {
     let loaded = as_loaded(scene)?;
     let mut params = Params::default();
@@ -160,5 +161,5 @@ pub fn record_row(scene: &Scene, repeat: u32) -> Result<RecordCost> {
         .num_threads(1)
         .build()
         .map_err(|e| anyhow!("building a 1-thread pool: {e}"))?;
-    pool.install(|| record_cost(&loaded, &params, Detail::Merges, &prefix, repeat.min(2)))
+    pool.install(|| record_cost(&loaded, &params, Detail::Merges, &prefix, repeat.clamp(3, 5)))
 }
