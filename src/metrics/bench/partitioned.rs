@@ -161,5 +161,13 @@ pub fn record_row(scene: &Scene, repeat: u32) -> Result<RecordCost> {
         .num_threads(1)
         .build()
         .map_err(|e| anyhow!("building a 1-thread pool: {e}"))?;
-    pool.install(|| record_cost(&loaded, &params, Detail::Merges, &prefix, repeat.clamp(3, 5)))
+    pool.install(|| {
+        record_cost(
+            &loaded,
+            &params,
+            Detail::Merges,
+            &prefix,
+            repeat.clamp(3, 5),
+        )
+    })
 }

@@ -39,7 +39,7 @@
 //! | `series/queue_len` | `Scalars` (1) | `merge` | all | MPairs entries left after each pop |
 //!
 //! Each series entity carries static `SeriesLines` names and colours, one per scalar of its rows.
-//! | `log/doublings` | `TextLog` | `merge`, `round` | all | one line per round start (DLimit, GLimit, active, dormant, pairs), per doubling and at the finish |
+//! | `log/doublings` | `TextLog` | `merge`, `round` | all | one line per round start (DLimit, GLimit, active, dormant, pairs), per doubling, per part of the run (each run of consecutive chunks of at most 8 bodies as one line, `parts.rs`) and at the finish |
 //! | `levels/spheres` | `Ellipsoids3D` | `level` (and the preview level at `merge` 0, `round` 0) | levels, full | interior nodes of the cut at depth d, as translucent blue spheres (`--wrapper sphere`) |
 //! | `levels/hulls` | `Mesh3D` | `level` | levels, full | interior nodes' convex hulls, translucent green (`--wrapper hull`; every distinct hull vertex once at d = 0, then only the triangle indices of the cut's hulls) |
 //! | `levels/boxes` | `Boxes3D` | `level` | levels, full | interior nodes' axis-aligned boxes, translucent violet (`--wrapper box`) |
@@ -78,6 +78,7 @@ mod columns;
 mod header;
 mod levels;
 mod mesh;
+mod parts;
 mod refine;
 mod series_file;
 mod sink;
@@ -96,6 +97,8 @@ use crate::record::{ACTIVE_CAP, Detail, Outcome, RunInfo, boxes_drawn};
 use columns::Columns;
 use mesh::PrimMesh;
 
+/// The level of every log line but a stopped run's warning.
+const INFO: &str = rerun::TextLogLevel::INFO;
 /// Light grey of the input primitives.
 const SCENE_GREY: u32 = 0xC8C8C8FF;
 /// Blue of the active bodies' boxes.
@@ -119,6 +122,8 @@ pub struct RrdRecorder {
     columns: Columns,
     /// The refinement's rows (`record --refine`).
     refine: refine::RefineColumns,
+    /// The part lines, small chunks summarised.
+    parts: parts::PartLines,
     round: u32,
     dlimit: f64,
     glimit: f64,
@@ -249,6 +254,7 @@ impl RrdRecorder {
             boxes,
             columns: Columns::default(),
             refine: refine::RefineColumns::default(),
+            parts: parts::PartLines::default(),
             round: 0,
             dlimit: info.params.dlimit0,
             glimit: info.params.glimit0,
@@ -272,8 +278,7 @@ impl RrdRecorder {
     }
 
     fn text(&mut self, round: u32, line: std::fmt::Arguments<'_>) {
-        self.columns
-            .push_text(self.merges, round, line, rerun::TextLogLevel::INFO);
+        self.columns.push_text(self.merges, round, line, INFO);
     }
 
     fn handle(&mut self, event: &Event<'_>) -> anyhow::Result<()> {
@@ -361,7 +366,12 @@ impl RrdRecorder {
                     self.refine.flush(rec)?;
                 }
             }
-            Event::Part(p) => self.text(self.round, format_args!("{p}")),
+            Event::Part(p) => {
+                let (columns, round) = (&mut self.columns, self.round);
+                self.parts.part(&p, self.merges, |merge, line| {
+                    columns.push_text(merge, round, format_args!("{line}"), INFO)
+                });
+            }
             Event::Doubling {
                 round,
                 merges,
@@ -377,6 +387,7 @@ impl RrdRecorder {
                 rounds,
                 merges,
             } => {
+                self.end_parts();
                 let line =
                     format_args!("finished: root {root} after {rounds} rounds and {merges} merges");
                 self.text(self.round, line);
@@ -414,7 +425,15 @@ impl RrdRecorder {
         sink::close(rec, &self.status, &path).map_err(fail)
     }
 
+    /// Logs the small chunks' run not yet logged ([`parts`]).
+    fn end_parts(&mut self) {
+        let (columns, round) = (&mut self.columns, self.round);
+        self.parts
+            .end(|merge, line| columns.push_text(merge, round, format_args!("{line}"), INFO));
+    }
+
     fn write_tail(&mut self, outcome: &Outcome<'_>) -> anyhow::Result<()> {
+        self.end_parts();
         if outcome.grouping.is_none() {
             self.mark_incomplete(outcome)?;
         }
