@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use wraptree::geom::V3;
-use wraptree::grouping::{Event, EventLog, Grouping, Observer, Params, Tee, group};
+use wraptree::grouping::{Event, EventLog, Grouping, Observer, Params, ResolvedParams, Tee, group};
 use wraptree::record::mcap::{McapRecorder, metadata, read_recording};
 use wraptree::record::{Detail, Outcome, RunInfo};
 use wraptree::scene::{LoadOptions, Loaded, generate, load_bytes};
@@ -24,6 +24,16 @@ fn load_grid() -> Loaded {
         &LoadOptions::default(),
     )
     .expect("grid loads")
+}
+
+/// What the recorder is told about a run of `loaded` with `resolved` at `detail`.
+fn run_info<'a>(loaded: &'a Loaded, resolved: &'a ResolvedParams, detail: Detail) -> RunInfo<'a> {
+    RunInfo {
+        scene: &loaded.scene,
+        source: &loaded.source,
+        params: resolved,
+        detail,
+    }
 }
 
 /// Forwards only the first `left` events (an interrupted run).
@@ -52,12 +62,7 @@ fn record(
 ) -> (Grouping, EventLog) {
     let params = Params::default();
     let resolved = params.resolve(&loaded.scene);
-    let info = RunInfo {
-        scene: &loaded.scene,
-        source: &loaded.source,
-        params: &resolved,
-        detail,
-    };
+    let info = run_info(loaded, &resolved, detail);
     let file = std::fs::File::create(path).unwrap();
     let mut rec = McapRecorder::new(BufWriter::new(file), &info).unwrap();
     rec.set_reproducible(reproducible);
@@ -361,12 +366,7 @@ impl Seek for FailAfter {
 fn record_into<W: Write + Seek>(loaded: &Loaded, sink: W) -> anyhow::Result<W> {
     let params = Params::default();
     let resolved = params.resolve(&loaded.scene);
-    let info = RunInfo {
-        scene: &loaded.scene,
-        source: &loaded.source,
-        params: &resolved,
-        detail: Detail::Full,
-    };
+    let info = run_info(loaded, &resolved, Detail::Full);
     let mut rec = McapRecorder::new(sink, &info)?;
     let g = group(&loaded.scene, &params, &mut rec);
     let spheres = sphere_tree(&g.tree, &loaded.scene, SphereMethod::default());
@@ -436,12 +436,7 @@ fn paper_scene_recordings_are_small() {
 /// Records `loaded` at full detail with `wrappers` (spheres from them) to `path`.
 fn record_wrappers(loaded: &Loaded, path: &Path, g: &Grouping, wrappers: &Wrappers) {
     let resolved = Params::default().resolve(&loaded.scene);
-    let info = RunInfo {
-        scene: &loaded.scene,
-        source: &loaded.source,
-        params: &resolved,
-        detail: Detail::Levels,
-    };
+    let info = run_info(loaded, &resolved, Detail::Levels);
     let file = std::fs::File::create(path).unwrap();
     let mut rec = McapRecorder::new(BufWriter::new(file), &info).unwrap();
     let mut log = EventLog::default();
@@ -533,12 +528,7 @@ fn chunks_are_compressed_as_asked_and_read_back_alike() {
     let loaded = load_grid();
     let params = Params::default();
     let resolved = params.resolve(&loaded.scene);
-    let info = RunInfo {
-        scene: &loaded.scene,
-        source: &loaded.source,
-        params: &resolved,
-        detail: Detail::Full,
-    };
+    let info = run_info(&loaded, &resolved, Detail::Full);
     let mut merges = Vec::new();
     for (kind, name) in [
         (Compression::None, ""),

@@ -367,6 +367,14 @@ mod tests {
 
     const SIZES: [usize; 7] = [1, 4095, 4097, BLOCK - 3, 9 << 20, 17, 3 * ALIGN];
 
+    /// An empty file `name` in a new temporary directory (kept alive by the first value).
+    fn empty_file(name: &str) -> (tempfile::TempDir, std::path::PathBuf) {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(name);
+        std::fs::write(&path, b"").unwrap();
+        (dir, path)
+    }
+
     /// The test directory's file system takes `O_DIRECT` at open.
     fn takes_direct(path: &Path) -> bool {
         open(path, true).is_ok()
@@ -399,9 +407,7 @@ mod tests {
     #[cfg(target_os = "linux")]
     #[test]
     fn a_refused_direct_write_falls_back_to_the_page_cache() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("b.bin");
-        std::fs::write(&path, b"").unwrap();
+        let (_dir, path) = empty_file("b.bin");
         let Ok(file) = open(&path, true) else {
             return; // this file system refuses O_DIRECT at open: `open` already falls back
         };
@@ -424,9 +430,7 @@ mod tests {
 
     #[test]
     fn seeking_anywhere_but_here_is_refused() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("c.bin");
-        std::fs::write(&path, b"").unwrap();
+        let (_dir, path) = empty_file("c.bin");
         let mut w = DirectWriter::open(&path).unwrap();
         w.write_all(b"abc").unwrap();
         assert_eq!(w.seek(SeekFrom::Start(3)).unwrap(), 3);
@@ -439,9 +443,7 @@ mod tests {
     #[cfg(target_os = "linux")]
     #[test]
     fn a_write_error_is_returned_by_a_later_write_or_the_flush() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("d.bin");
-        std::fs::write(&path, b"").unwrap();
+        let (_dir, path) = empty_file("d.bin");
         // A read-only descriptor: every write fails with EBADF.
         let out = Out {
             file: File::open(&path).unwrap(),
