@@ -89,6 +89,7 @@ impl Compression {
         }
     }
 }
+
 /// Target uncompressed chunk size.
 pub const CHUNK_SIZE: u64 = 1 << 20;
 /// Media type of the embedded scene.
