@@ -150,6 +150,8 @@ impl DirectWriter {
     }
 }
 
+/// A new error of the same OS code, or else of the same kind and message (`io::Error` is not
+/// `Clone`, and the I/O thread's first error is returned to every later call).
 fn copy(e: &io::Error) -> io::Error {
     match e.raw_os_error() {
         Some(code) => io::Error::from_raw_os_error(code),
