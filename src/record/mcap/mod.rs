@@ -130,7 +130,8 @@ struct Topics {
 /// Writes a grouping run to an `.mcap` file; feed it events as an [`Observer`], then call
 /// [`McapRecorder::finish`].
 ///
-/// `W` is written in many small pieces: give it a `BufWriter` around a file. Write errors do
+/// `W` is written in many small pieces: give it a buffered writer (`record` uses a
+/// [`DirectWriter`](crate::record::direct::DirectWriter), tests a `BufWriter`). Write errors do
 /// not panic: the first one is kept, later events are ignored, and `finish` returns it.
 pub struct McapRecorder<'a, W: Write + Seek> {
     writer: mcap::Writer<W>,
