@@ -2,8 +2,8 @@
 //!
 //! [`RrdRecorder`] is an [`Observer`]; it saves through a sink of its own (the SDK's encoder
 //! on a writer thread that bypasses the page cache, no viewer is spawned), checks at the end
-//! that the file is complete (`sink.rs`), writes what precedes the events in `header.rs`, and embeds a
-//! blueprint (`blueprint.rs`) so the file opens on a useful layout.
+//! that the file is complete (`sink.rs`), writes what precedes the events in `header.rs`, and
+//! embeds a blueprint (`blueprint.rs`) so the file opens on a useful layout.
 //!
 //! # Timelines
 //!
@@ -367,10 +367,8 @@ impl RrdRecorder {
                 }
             }
             Event::Part(p) => {
-                let (columns, round) = (&mut self.columns, self.round);
-                self.parts.part(&p, self.merges, |merge, line| {
-                    columns.push_text(merge, round, format_args!("{line}"), INFO)
-                });
+                let lines = part_lines(&mut self.columns, self.round);
+                self.parts.part(&p, self.merges, lines);
             }
             Event::Doubling {
                 round,
@@ -427,9 +425,8 @@ impl RrdRecorder {
 
     /// Logs the small chunks' run not yet logged ([`parts`]).
     fn end_parts(&mut self) {
-        let (columns, round) = (&mut self.columns, self.round);
-        self.parts
-            .end(|merge, line| columns.push_text(merge, round, format_args!("{line}"), INFO));
+        let lines = part_lines(&mut self.columns, self.round);
+        self.parts.end(lines);
     }
 
     fn write_tail(&mut self, outcome: &Outcome<'_>) -> anyhow::Result<()> {
@@ -461,6 +458,11 @@ impl Observer for RrdRecorder {
             self.error = Some(err);
         }
     }
+}
+
+/// Where [`parts::PartLines`] writes: each line into `columns` at its merge tick and `round`.
+fn part_lines(columns: &mut Columns, round: u32) -> impl FnMut(u32, &str) + '_ {
+    move |merge, line| columns.push_text(merge, round, format_args!("{line}"), INFO)
 }
 
 fn closed() -> anyhow::Error {

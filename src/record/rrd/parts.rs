@@ -28,8 +28,7 @@ pub(super) struct PartLines {
 impl PartLines {
     /// Logs part `p` through `line(merge tick, text)`: a small chunk joins the current run; any
     /// other part first ends the run, then gets its own line (at the current merge, `merge`).
-    pub(super) fn part(&mut self, p: &Part, merge: u32, line: impl FnMut(u32, &str)) {
-        let mut line = line;
+    pub(super) fn part(&mut self, p: &Part, merge: u32, mut line: impl FnMut(u32, &str)) {
         if let PartKind::Chunk { keep, .. } = p.kind
             && p.bodies <= SMALL_CHUNK
         {

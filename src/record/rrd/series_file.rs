@@ -1,5 +1,6 @@
-//! A plain `.rrd` for benchmark and sweep results: a [`RecordingStream`] saved and checked like the grouping recorder's, without wall-clock time, written to a
-//! temporary file and moved into place by [`SeriesFile::commit`].
+//! A plain `.rrd` for benchmark and sweep results: a [`RecordingStream`] saved and checked like
+//! the grouping recorder's, without wall-clock time, written to a temporary file and moved into
+//! place by [`SeriesFile::commit`].
 
 use super::sink;
 use crate::record::output::Pending;
