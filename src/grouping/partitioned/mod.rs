@@ -53,6 +53,7 @@
 //! boxes); with it the partitioned schedule runs the exact schedule.
 
 mod big;
+mod pages;
 mod plan;
 mod small;
 mod split;
@@ -295,28 +296,27 @@ pub fn group_boxes<O: Observer>(
     assert!(!aabb.is_empty(), "grouping needs at least one primitive");
     let n = aabb.len();
     aabb.reserve_exact(n - 1);
-    let mut diameter: Vec<f64> = Vec::with_capacity(2 * n - 1);
+    pages::advise_spare(&mut aabb);
+    let mut diameter: Vec<f64> = pages::vec_with_capacity(2 * n - 1);
     diameter.par_extend(aabb.par_iter().map(Aabb::diameter));
     let mut codes = morton_order(&aabb);
     // The leaves as bodies in Morton order: one gather (its loads overlap) instead of one per
     // chunk, of the box alone (the diameter is recomputed, the same value, rather than read at
     // random from a second array); `rd` is set by their chunk.
-    let mut leaves: Vec<Body> = (0..n)
-        .into_par_iter()
-        .map(|i| {
-            if let Some(&(_, ahead)) = codes.get(i + GATHER_AHEAD) {
-                prefetch(&aabb[ahead as usize]);
-            }
-            let id = codes[i].1;
-            let aabb = aabb[id as usize];
-            Body {
-                id,
-                rd: 0,
-                aabb,
-                d: aabb.diameter(),
-            }
-        })
-        .collect();
+    let mut leaves: Vec<Body> = pages::vec_with_capacity(n);
+    leaves.par_extend((0..n).into_par_iter().map(|i| {
+        if let Some(&(_, ahead)) = codes.get(i + GATHER_AHEAD) {
+            prefetch(&aabb[ahead as usize]);
+        }
+        let id = codes[i].1;
+        let aabb = aabb[id as usize];
+        Body {
+            id,
+            rd: 0,
+            aabb,
+            d: aabb.diameter(),
+        }
+    }));
     // Planned on the leaves themselves: the SAH cuts read their boxes in order, and reorder
     // them with their codes.
     let nodes = plan(&mut codes, &mut leaves, chunking);
@@ -331,17 +331,18 @@ pub fn group_boxes<O: Observer>(
         reason: Mutex::new(None),
     };
     let merges = n - 1;
-    let mut children = vec![[0u32; 2]; merges];
+    let mut children: Vec<[u32; 2]> = pages::vec_with_capacity(merges);
+    children.par_extend(rayon::iter::repeat_n([0u32; 2], merges));
     // The merges' slots, filled on every thread (fresh pages are written, and faulted in, in
     // parallel).
     aabb.par_extend(rayon::iter::repeat_n(Aabb::EMPTY, n - 1));
     diameter.par_extend(rayon::iter::repeat_n(0.0, n - 1));
     let listens = !observer.is_silent();
-    let mut info = if listens {
-        vec![Info::default(); merges]
-    } else {
-        Vec::new()
-    };
+    let mut info = Vec::new();
+    if listens {
+        info = pages::vec_with_capacity(merges);
+        info.par_extend(rayon::iter::repeat_n(Info::default(), merges));
+    }
     let done: Vec<AtomicBool> = nodes.iter().map(|_| AtomicBool::new(false)).collect();
     let exec = Exec {
         ctx: &ctx,

@@ -54,19 +54,16 @@ pub(super) fn morton_order(boxes: &[Aabb]) -> Vec<(u64, u32)> {
         0.0
     };
     let scale = [s; 3];
-    let mut codes: Vec<(u64, u32)> = boxes
-        .par_iter()
-        .enumerate()
-        .map(|(i, b)| {
-            let c = b.center();
-            let mut key = 0u64;
-            for k in 0..3 {
-                let t = ((c[k] - cb.min[k]) * scale[k]).clamp(0.0, 2_097_151.0) as u64;
-                key |= spread_bits(t) << k;
-            }
-            (key, i as u32)
-        })
-        .collect();
+    let mut codes: Vec<(u64, u32)> = super::pages::vec_with_capacity(boxes.len());
+    codes.par_extend(boxes.par_iter().enumerate().map(|(i, b)| {
+        let c = b.center();
+        let mut key = 0u64;
+        for k in 0..3 {
+            let t = ((c[k] - cb.min[k]) * scale[k]).clamp(0.0, 2_097_151.0) as u64;
+            key |= spread_bits(t) << k;
+        }
+        (key, i as u32)
+    }));
     codes.par_sort_unstable();
     codes
 }
