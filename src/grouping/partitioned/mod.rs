@@ -15,11 +15,11 @@
 //! 3. Bottom-up, each chunk groups its primitives until at most f(δ) bodies remain, and each
 //!    inner node of the split groups the bodies its two halves left until at most f(n) remain,
 //!    n its number of primitives, with AAC's reduction function f(n) = ⌈c·n^(1/2 − ε)⌉,
-//!    c = δ^(1/2 + ε)/2 (so f(δ) = δ/2) — but never fewer than its share of the root's
-//!    [`Chunking::top`] bodies, ⌊top·hi/N⌋ − ⌊top·lo/N⌋ for primitives `lo..hi` of N, so that
-//!    the root, which groups what is left into one body, starts from about `top` bodies. The
-//!    shares of two halves add up to their parent's, so the nodes above that size pass their
-//!    halves' bodies up unmerged.
+//!    c = δ^(1/2 + ε)/2 (so f(δ) = δ/2) — but never fewer than ⌈top·n/N⌉ bodies
+//!    ([`Chunking::top`]), so that the root, which groups what is left into one body, starts
+//!    from about `top` bodies (nodes above that size pass their halves' bodies up unmerged,
+//!    but for the one merge that the halves' rounded-up shares leave now and then to a node of
+//!    at most `SMALL` bodies; larger nodes leave those merges to the root).
 //! 4. Each of those subproblems is the paper's step: Cost = diameter^A × (B·Fill + C·Balance),
 //!    the AABB p-set, DLimit/GLimit eligibility from DLimit0/GLimit0 with doubling, the
 //!    cheapest eligible pair first, ties by the pair's tie tags of the run's (global) ids. Up to
