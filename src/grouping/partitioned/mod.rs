@@ -53,7 +53,6 @@
 //! boxes); with it the partitioned schedule runs the exact schedule.
 
 mod big;
-mod pages;
 mod plan;
 mod small;
 mod sort;
@@ -279,7 +278,7 @@ pub fn group_with<O: Observer>(
     }
     let n = scene.len();
     // Room for the merged bodies from the start (no copy when they are added).
-    let mut aabb: Vec<Aabb> = pages::vec_with_capacity(2 * n - 1);
+    let mut aabb: Vec<Aabb> = Vec::with_capacity(2 * n - 1);
     aabb.par_extend((0..n).into_par_iter().map(|i| scene.prim_aabb(i)));
     group_boxes(aabb, params, chunking, observer, budget)
 }
@@ -297,14 +296,13 @@ pub fn group_boxes<O: Observer>(
     assert!(!aabb.is_empty(), "grouping needs at least one primitive");
     let n = aabb.len();
     aabb.reserve_exact(n - 1);
-    pages::advise_spare(&mut aabb);
-    let mut diameter: Vec<f64> = pages::vec_with_capacity(2 * n - 1);
+    let mut diameter: Vec<f64> = Vec::with_capacity(2 * n - 1);
     diameter.par_extend(aabb.par_iter().map(Aabb::diameter));
     let mut codes = morton_order(&aabb);
     // The leaves as bodies in Morton order: one gather (its loads overlap) instead of one per
     // chunk, of the box alone (the diameter is recomputed, the same value, rather than read at
     // random from a second array); `rd` is set by their chunk.
-    let mut leaves: Vec<Body> = pages::vec_with_capacity(n);
+    let mut leaves: Vec<Body> = Vec::with_capacity(n);
     leaves.par_extend((0..n).into_par_iter().map(|i| {
         if let Some(&(_, ahead)) = codes.get(i + GATHER_AHEAD) {
             prefetch(&aabb[ahead as usize]);
@@ -332,7 +330,7 @@ pub fn group_boxes<O: Observer>(
         reason: Mutex::new(None),
     };
     let merges = n - 1;
-    let mut children: Vec<[u32; 2]> = pages::vec_with_capacity(merges);
+    let mut children: Vec<[u32; 2]> = Vec::with_capacity(merges);
     children.par_extend(rayon::iter::repeat_n([0u32; 2], merges));
     // The merges' slots, filled on every thread (fresh pages are written, and faulted in, in
     // parallel).
@@ -341,7 +339,7 @@ pub fn group_boxes<O: Observer>(
     let listens = !observer.is_silent();
     let mut info = Vec::new();
     if listens {
-        info = pages::vec_with_capacity(merges);
+        info = Vec::with_capacity(merges);
         info.par_extend(rayon::iter::repeat_n(Info::default(), merges));
     }
     let done: Vec<AtomicBool> = nodes.iter().map(|_| AtomicBool::new(false)).collect();

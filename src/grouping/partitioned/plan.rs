@@ -212,7 +212,7 @@ pub(super) fn plan(
     let planner = Planner { keep: &keep };
     let blocks = planner.blocks(codes, leaves, 0, 0).blocks;
     let total = blocks.iter().map(Vec::len).sum();
-    let mut nodes: Vec<Node> = super::pages::vec_with_capacity(total);
+    let mut nodes: Vec<Node> = Vec::with_capacity(total);
     if rayon::current_num_threads() == 1 {
         for b in &blocks {
             nodes.extend_from_slice(b);

@@ -54,7 +54,7 @@ pub(super) fn morton_order(boxes: &[Aabb]) -> Vec<(u64, u32)> {
         0.0
     };
     let scale = [s; 3];
-    let mut codes: Vec<(u64, u32)> = super::pages::vec_with_capacity(boxes.len());
+    let mut codes: Vec<(u64, u32)> = Vec::with_capacity(boxes.len());
     codes.par_extend(boxes.par_iter().enumerate().map(|(i, b)| {
         let c = b.center();
         let mut key = 0u64;
