@@ -196,9 +196,8 @@ impl<'z> Zone<'z> {
 
     /// The SAH cut of `start..start + len`, if any (moving the left side to the front).
     fn sah(&mut self, start: usize, len: usize) -> Option<usize> {
-        let part = &self.perm[start..start + len];
         // The box of the doubled centres (min + max: the same cut, a product less).
-        let cb = centres(&self.cen, part.iter().copied());
+        let cb = centres(&self.cen, self.perm[start..start + len].iter().copied());
         let e = [
             cb.hi[0] - cb.lo[0],
             cb.hi[1] - cb.lo[1],
@@ -217,17 +216,18 @@ impl<'z> Zone<'z> {
             return None;
         }
         self.bin.clear();
-        let nl = if len <= SWEEP {
-            self.sweep(start, len, axis)
+        // Bins from `cut` on are the right side.
+        let (nl, cut) = if len <= SWEEP {
+            (self.sweep(start, len, axis)?, 1)
         } else {
-            self.binned(start, len, axis, c0, w)
-        }?;
+            self.binned(start, len, axis, c0, w)?
+        };
         // A stable partition of the positions (side 0 first), without branches.
         self.tmp.resize(len, 0);
         let part = &mut self.perm[start..start + len];
         let (mut li, mut ri) = (0, nl);
         for (i, &p) in part.iter().enumerate() {
-            let right = usize::from(self.bin[i]);
+            let right = usize::from(self.bin[i] >= cut);
             let d = if right == 0 { li } else { ri };
             self.tmp[d] = p;
             li += 1 - right;
@@ -290,8 +290,15 @@ impl<'z> Zone<'z> {
 
     /// The binned cut of a longer range: centres in [`BINS`] equal bins of `c0..c0 + w` on
     /// `axis`, the bin boundary of least SAH leaving a quarter on each side; sets `bin` to each
-    /// primitive's side.
-    fn binned(&mut self, start: usize, len: usize, axis: usize, c0: f64, w: f64) -> Option<usize> {
+    /// primitive's bin and returns the left side's length and the right side's first bin.
+    fn binned(
+        &mut self,
+        start: usize,
+        len: usize,
+        axis: usize,
+        c0: f64,
+        w: f64,
+    ) -> Option<(usize, u8)> {
         let (leaves, cen) = (&*self.leaves, &self.cen);
         let part = &self.perm[start..start + len];
         let least = (len / 4).max(1);
@@ -334,10 +341,7 @@ impl<'z> Zone<'z> {
             }
         }
         let (_, cut, nl) = best?;
-        for k in self.bin.iter_mut() {
-            *k = u8::from(*k as usize >= cut);
-        }
-        Some(nl)
+        Some((nl, cut as u8))
     }
 
     /// Reorders the codes and leaves into the planned order.
