@@ -52,7 +52,9 @@
 //! The hull p-set has no partitioned form here (its diameters and gaps are not functions of
 //! boxes); with it the partitioned schedule runs the exact schedule.
 
+mod announce;
 mod big;
+mod keep;
 mod plan;
 mod small;
 mod sort;
@@ -62,14 +64,15 @@ mod tests;
 mod tiny;
 
 use super::cluster;
-use super::events::{Event, Merge, Observer, Part, PartKind};
+use super::events::{Event, Observer};
 use super::subset_tree::SubsetTree;
 use super::voxel_hash::prefetch;
 use super::{Budget, Grouping, PSet, ResolvedParams, Stats, StopReason, Stopped};
 use crate::geom::Aabb;
 use crate::scene::Scene;
+use announce::{Made, announce};
 pub use plan::Chunking;
-use plan::{Node, plan, post_order};
+use plan::{Node, plan};
 use rayon::prelude::*;
 use small::Limits;
 use split::morton_order;
@@ -360,64 +363,18 @@ pub fn group_boxes<O: Observer>(
     };
     let (result, sub) = exec.node(0, &mut leaves, out, false);
     // Events, in post-order, up to the first unfinished subproblem.
-    let mut emitted = 0u32;
-    let mut part = 0u32;
-    let order = if listens || result.is_none() {
-        post_order(&nodes)
+    let emitted = if listens || result.is_none() {
+        let made = Made {
+            n,
+            children: &children,
+            aabb: &aabb,
+            diameter: &diameter,
+            info: &info,
+        };
+        announce(&mut observer, &nodes, &done, &made, listens)
     } else {
-        Vec::new()
+        0
     };
-    for &k in &order {
-        let node = &nodes[k as usize];
-        if !done[k as usize].load(Ordering::Relaxed) {
-            break;
-        }
-        let made = node.inputs - node.keep;
-        if listens && made > 0 {
-            let kind = if node.level == 0 {
-                PartKind::Top
-            } else {
-                PartKind::Chunk {
-                    level: node.level,
-                    keep: node.keep,
-                }
-            };
-            observer.on_event(&Event::Part(Part {
-                id: part,
-                kind,
-                bodies: node.inputs,
-                first_step: emitted,
-            }));
-            part += 1;
-            for step in emitted..emitted + made {
-                let s = step as usize;
-                let new = (n + s) as u32;
-                let i = info[s];
-                observer.on_event(&Event::Merge(Merge {
-                    step,
-                    round: i.round,
-                    a: children[s][0],
-                    b: children[s][1],
-                    new,
-                    aabb: aabb[n + s],
-                    diameter: diameter[n + s],
-                    fill: i.fill,
-                    balance: i.balance,
-                    cost: i.cost,
-                    queue_len: i.queue_len,
-                    active: i.active,
-                }));
-                if !i.active {
-                    observer.on_event(&Event::Dormant {
-                        round: i.round,
-                        body: new,
-                        diameter: diameter[n + s],
-                    });
-                }
-            }
-        }
-        emitted += made;
-    }
     if result.is_none() {
         let reason = ctx
             .reason
