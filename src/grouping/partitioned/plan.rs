@@ -352,13 +352,13 @@ const PLACEHOLDER: Node = Node {
 };
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
 
     /// `n` pairs in id order with codes from a few clustered values (many ties) and random
     /// ones.
-    fn codes(n: usize, seed: u64) -> Vec<(u64, u32)> {
+    pub(in crate::grouping::partitioned) fn codes(n: usize, seed: u64) -> Vec<(u64, u32)> {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         (0..n as u32)
             .map(|i| {

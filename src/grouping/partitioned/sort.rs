@@ -156,22 +156,11 @@ fn insertion_sort(s: &mut [(u64, u32)]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rand::{Rng, SeedableRng};
 
     #[test]
     fn the_bucket_sort_gives_the_comparison_sorts_order_on_any_thread_count() {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
         // Clustered codes (many in one bucket, ties broken by id) and spread ones.
-        let codes: Vec<(u64, u32)> = (0..3 * MIN_LEN as u32 + 5)
-            .map(|i| {
-                let code = if rng.random_bool(0.4) {
-                    rng.random_range(0..8u64) << 40
-                } else {
-                    rng.random::<u64>() >> 1
-                };
-                (code, i)
-            })
-            .collect();
+        let codes = super::super::plan::tests::codes(3 * MIN_LEN + 5, 11);
         let mut want = codes.clone();
         want.sort_unstable();
         for t in [1, 2, 3] {
