@@ -133,11 +133,17 @@ fn sort_bucket(s: &mut [(u64, u32)], shift: u32, tmp: &mut Vec<(u64, u32)>) {
     }
     s.copy_from_slice(tmp);
     for (&lo, &hi) in starts.iter().zip(&next) {
-        if hi - lo > 1 {
-            insertion_sort(&mut s[lo..hi]);
+        match hi - lo {
+            0 | 1 => {}
+            k if k <= INSERTION => insertion_sort(&mut s[lo..hi]),
+            // A dense spot of the scene (one run holding most of a bucket): no quadratic sort.
+            _ => s[lo..hi].sort_unstable(),
         }
     }
 }
+
+/// Runs of at most this many pairs are sorted by insertion.
+const INSERTION: usize = 16;
 
 /// Sorts a few pairs (a run of one bucket's second digit) in place.
 #[inline]
@@ -160,7 +166,12 @@ mod tests {
     #[test]
     fn the_bucket_sort_gives_the_comparison_sorts_order_on_any_thread_count() {
         // Clustered codes (many in one bucket, ties broken by id) and spread ones.
-        let codes = super::super::plan::tests::codes(3 * MIN_LEN + 5, 11);
+        let mut codes = super::super::plan::tests::codes(3 * MIN_LEN + 5, 11);
+        // A dense spot: a fifth of the pairs share their top 18 bits, in falling order.
+        let dense = codes.len() / 5;
+        for (k, c) in codes.iter_mut().take(dense).enumerate() {
+            c.0 = (5 << 45) | (dense - k) as u64;
+        }
         let mut want = codes.clone();
         want.sort_unstable();
         for t in [1, 2, 3] {
