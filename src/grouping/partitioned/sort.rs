@@ -95,9 +95,14 @@ pub(super) fn sorted(mut codes: Vec<(u64, u32)>, key_bits: u32) -> Vec<(u64, u32
         lo = end;
     }
     let inner = shift.saturating_sub(INNER_BITS);
-    slices
-        .into_par_iter()
-        .for_each_init(Vec::new, |tmp, s| sort_bucket(s, inner, tmp));
+    slices.into_par_iter().for_each_init(Vec::new, |tmp, s| {
+        if s.len() >= MIN_LEN {
+            // Most of a scene in one bucket (a dense spot): sorted on every thread.
+            s.par_sort_unstable();
+        } else {
+            sort_bucket(s, inner, tmp);
+        }
+    });
     out
 }
 
@@ -167,10 +172,14 @@ mod tests {
     fn the_bucket_sort_gives_the_comparison_sorts_order_on_any_thread_count() {
         // Clustered codes (many in one bucket, ties broken by id) and spread ones.
         let mut codes = super::super::plan::tests::codes(3 * MIN_LEN + 5, 11);
-        // A dense spot: a fifth of the pairs share their top 18 bits, in falling order.
+        // A dense spot: a fifth of the pairs share their top 18 bits, in falling order; and
+        // the next two fifths one bucket.
         let dense = codes.len() / 5;
         for (k, c) in codes.iter_mut().take(dense).enumerate() {
             c.0 = (5 << 45) | (dense - k) as u64;
+        }
+        for (k, c) in codes.iter_mut().skip(dense).take(2 * dense).enumerate() {
+            c.0 = (9 << 53) | ((k * 7919) as u64 % (1 << 53));
         }
         let mut want = codes.clone();
         want.sort_unstable();
