@@ -305,20 +305,22 @@ pub fn group_boxes<O: Observer>(
     // The leaves as bodies in Morton order: one gather (its loads overlap) instead of one per
     // chunk, of the box alone (the diameter is recomputed, the same value, rather than read at
     // random from a second array); `rd` is set by their chunk.
-    let mut leaves: Vec<Body> = Vec::with_capacity(n);
-    leaves.par_extend((0..n).into_par_iter().map(|i| {
-        if let Some(&(_, ahead)) = codes.get(i + GATHER_AHEAD) {
-            prefetch(&aabb[ahead as usize]);
-        }
-        let id = codes[i].1;
-        let aabb = aabb[id as usize];
-        Body {
-            id,
-            rd: 0,
-            aabb,
-            d: aabb.diameter(),
-        }
-    }));
+    let mut leaves: Vec<Body> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            if let Some(&(_, ahead)) = codes.get(i + GATHER_AHEAD) {
+                prefetch(&aabb[ahead as usize]);
+            }
+            let id = codes[i].1;
+            let aabb = aabb[id as usize];
+            Body {
+                id,
+                rd: 0,
+                aabb,
+                d: aabb.diameter(),
+            }
+        })
+        .collect();
     // Planned on the leaves themselves: the SAH cuts read their boxes in order, and reorder
     // them with their codes.
     let nodes = plan(&mut codes, &mut leaves, chunking);
@@ -333,18 +335,17 @@ pub fn group_boxes<O: Observer>(
         reason: Mutex::new(None),
     };
     let merges = n - 1;
-    let mut children: Vec<[u32; 2]> = Vec::with_capacity(merges);
-    children.par_extend(rayon::iter::repeat_n([0u32; 2], merges));
+    let mut children = vec![[0u32; 2]; merges];
     // The merges' slots, filled on every thread (fresh pages are written, and faulted in, in
     // parallel).
     aabb.par_extend(rayon::iter::repeat_n(Aabb::EMPTY, n - 1));
     diameter.par_extend(rayon::iter::repeat_n(0.0, n - 1));
     let listens = !observer.is_silent();
-    let mut info = Vec::new();
-    if listens {
-        info = Vec::with_capacity(merges);
-        info.par_extend(rayon::iter::repeat_n(Info::default(), merges));
-    }
+    let mut info = if listens {
+        vec![Info::default(); merges]
+    } else {
+        Vec::new()
+    };
     let done: Vec<AtomicBool> = nodes.iter().map(|_| AtomicBool::new(false)).collect();
     let exec = Exec {
         ctx: &ctx,

@@ -54,16 +54,19 @@ pub(super) fn morton_order(boxes: &[Aabb]) -> Vec<(u64, u32)> {
         0.0
     };
     let scale = [s; 3];
-    let mut codes: Vec<(u64, u32)> = Vec::with_capacity(boxes.len());
-    codes.par_extend(boxes.par_iter().enumerate().map(|(i, b)| {
-        let c = b.center();
-        let mut key = 0u64;
-        for k in 0..3 {
-            let t = ((c[k] - cb.min[k]) * scale[k]).clamp(0.0, 2_097_151.0) as u64;
-            key |= spread_bits(t) << k;
-        }
-        (key, i as u32)
-    }));
+    let codes: Vec<(u64, u32)> = boxes
+        .par_iter()
+        .enumerate()
+        .map(|(i, b)| {
+            let c = b.center();
+            let mut key = 0u64;
+            for k in 0..3 {
+                let t = ((c[k] - cb.min[k]) * scale[k]).clamp(0.0, 2_097_151.0) as u64;
+                key |= spread_bits(t) << k;
+            }
+            (key, i as u32)
+        })
+        .collect();
     super::sort::sorted(codes, 63)
 }
 
@@ -196,8 +199,9 @@ impl<'z> Zone<'z> {
 
     /// The SAH cut of `start..start + len`, if any (moving the left side to the front).
     fn sah(&mut self, start: usize, len: usize) -> Option<usize> {
+        let part = &self.perm[start..start + len];
         // The box of the doubled centres (min + max: the same cut, a product less).
-        let cb = centres(&self.cen, self.perm[start..start + len].iter().copied());
+        let cb = centres(&self.cen, part.iter().copied());
         let e = [
             cb.hi[0] - cb.lo[0],
             cb.hi[1] - cb.lo[1],
