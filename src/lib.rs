@@ -37,9 +37,11 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod events;
 pub mod geom;
 pub mod grouping;
 pub mod metrics;
+pub mod output;
 pub mod peers;
 pub mod query;
 pub mod record;

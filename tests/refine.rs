@@ -393,7 +393,7 @@ fn area_cost_gives_valid_trees_that_differ_from_the_diameter_cost() {
         // Fill is the merged box's area over the children's, as the events say.
         for m in &log.merges[..50] {
             let t = &ga.tree;
-            let s = |x: u32| wraptree::metrics::area(&t.aabb[x as usize]);
+            let s = |x: u32| wraptree::geom::area(&t.aabb[x as usize]);
             let fill = s(m.new) / (s(m.a) + s(m.b));
             assert!(
                 (m.fill - fill).abs() <= 1e-12 * fill,

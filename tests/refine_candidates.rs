@@ -2,9 +2,9 @@
 //! `count` non-root nodes of the documented ranking (A(p)² / min(A(x), A(s)) descending, then id
 //! ascending), ties included: a grid of copies of one triangle has many slots of equal key.
 
+use wraptree::geom::area;
 use wraptree::geom::{P3, V3};
 use wraptree::grouping::{NONE, Params, group};
-use wraptree::metrics::area;
 use wraptree::refine::reinsert;
 use wraptree::refine::work::WorkTree;
 use wraptree::scene::{PrimitiveKind, Scene, generate};

@@ -12,8 +12,8 @@ use wraptree::metrics::report::{
     bench_table, record_cost_header, record_cost_line, record_cost_notes, refine_table,
     speedup_table, target_line, targets_header, targets_notes, write_bench,
 };
+use wraptree::output::output_dir;
 use wraptree::peers::Method;
-use wraptree::record::output::output_dir;
 use wraptree::scene::generate;
 use wraptree::scene::spec::scene_spec;
 

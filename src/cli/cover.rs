@@ -6,7 +6,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use wraptree::record::output::{check_new, output_prefix, with_ext, write_atomic};
+use wraptree::output::{check_new, output_prefix, with_ext, write_atomic};
 use wraptree::wrap::WrapperKind;
 use wraptree::wrap::cover::export;
 use wraptree::wrap::cover::solve::{CoverLimit, Tolerance, cover_scene};

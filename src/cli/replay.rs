@@ -7,7 +7,7 @@ use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use wraptree::record::output::output_prefix;
+use wraptree::output::output_prefix;
 use wraptree::record::{Detail, RecordOptions};
 use wraptree::replay::{self, Replay, report};
 

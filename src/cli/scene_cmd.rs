@@ -38,7 +38,7 @@ impl SceneCmd {
             .map_err(|e| anyhow!(e))?;
         let mut bytes = Vec::new();
         scene.write_obj(&mut bytes)?;
-        wraptree::record::output::write_atomic(&self.output, &bytes, self.force)?;
+        wraptree::output::write_atomic(&self.output, &bytes, self.force)?;
         eprintln!(
             "wrote {} ({} primitives)",
             self.output.display(),

@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use std::time::Duration;
 use wraptree::metrics::report::stress_table;
 use wraptree::metrics::stress::{self, Step, StressOptions, check_outputs};
-use wraptree::record::output::output_dir;
+use wraptree::output::output_dir;
 
 /// Arguments of `wraptree stress`.
 #[derive(Args, Debug)]

@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use wraptree::grouping::{CostMeasure, PSet, Params};
 use wraptree::metrics::report::{SweepRrd, setting_name, sweep_table, write_sweep};
 use wraptree::metrics::sweep::{grid, sweep};
-use wraptree::record::output::output_dir;
+use wraptree::output::output_dir;
 
 /// Arguments of `wraptree sweep`.
 #[derive(Args, Debug)]

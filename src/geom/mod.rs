@@ -110,6 +110,22 @@ impl Aabb {
     }
 }
 
+/// Surface area of a box with extents `e`: the one area formula of the crate (SAH, the
+/// Cost's `--cost area`, the split's SAH cuts, the peers).
+#[inline(always)]
+pub fn surface_area(e: &V3) -> f64 {
+    2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+}
+
+/// Surface area of `b` (0 for an empty box).
+pub fn area(b: &Aabb) -> f64 {
+    let e = b.extents();
+    if e.iter().any(|x| x.is_nan() || *x < 0.0) {
+        return 0.0;
+    }
+    surface_area(&e)
+}
+
 /// Converts a scene point to parry's `f32` glam vector relative to `origin`.
 ///
 /// parry3d ≥ 0.26 speaks glam; subtracting a local origin first keeps `f32` precise for

@@ -4,15 +4,15 @@
 //! [`fill`], and the runs on bodies given by their boxes (pre-grouping's parts, the partitioned
 //! schedule's chunks) in [`boxes`].
 
-use super::events::{Event, Merge, Observer};
 use super::hull_pset::HullBodies;
 use super::mpairs::{Entry, MPairs, Partners, order_bits};
 use super::pset::PSetBodies;
 use super::subset_tree::{NONE, SubsetTree};
 use super::voxel_hash::VoxelHash;
 use super::{Budget, Grouping, PSet, ResolvedParams, Stats, StopReason, Stopped};
-use crate::geom::Aabb;
+use crate::events::{Event, Merge, Observer};
 use crate::geom::morton::spread_bits;
+use crate::geom::{Aabb, surface_area};
 use crate::scene::Scene;
 use std::sync::atomic::Ordering;
 
@@ -22,7 +22,7 @@ mod keys;
 mod scan;
 
 pub(crate) use boxes::{run_boxes, run_boxes_until};
-pub(in crate::grouping) use fill::{box_area, fill_balance};
+pub(in crate::grouping) use fill::fill_balance;
 pub(in crate::grouping) use keys::tie_tag;
 pub(in crate::grouping) use scan::pair_cost_any;
 
@@ -408,9 +408,9 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         let (size, sa, sb) = if self.params.mode.cost == super::CostMeasure::Area {
             let ext = |x: u32| self.aabb[x as usize].max - self.aabb[x as usize].min;
             (
-                box_area(&(merged.max - merged.min)),
-                box_area(&ext(a)),
-                box_area(&ext(b)),
+                surface_area(&(merged.max - merged.min)),
+                surface_area(&ext(a)),
+                surface_area(&ext(b)),
             )
         } else {
             (d, self.diameter[a as usize], self.diameter[b as usize])

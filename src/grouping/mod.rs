@@ -36,7 +36,7 @@
 //! unlimited run's first ones.
 
 mod cluster;
-pub mod events;
+
 mod hull_pset;
 mod limits;
 pub mod mpairs;
@@ -47,11 +47,11 @@ mod pset;
 pub mod subset_tree;
 pub mod voxel_hash;
 
-pub use events::{Event, EventLog, Merge, Observer, Part, PartKind, Tee};
+pub use crate::events::{Event, EventLog, Merge, Observer, Part, PartKind, Tee};
 pub use limits::{Budget, Limits, StopReason, Stopped};
 pub use params::{CostMeasure, Mode, PSet, Params, Pregroup, ResolvedParams, Schedule, Weights};
 pub use pregroup::Pregrouping;
-pub use subset_tree::{NONE, SubsetTree};
+pub use subset_tree::{C_PRIM, C_TRAV, NONE, SubsetTree, sah};
 
 use crate::geom::Aabb;
 use crate::scene::Scene;

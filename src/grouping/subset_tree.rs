@@ -1,7 +1,7 @@
 //! The Subset Tree: a flat arena of the N leaves (ids `0..N`, input order) and the N − 1
 //! interior nodes (ids `N..2N−1`, merge order) made by the grouping phase.
 
-use crate::geom::Aabb;
+use crate::geom::{Aabb, area};
 
 /// Marker for "no node" (the root's parent).
 pub const NONE: u32 = u32::MAX;
@@ -159,4 +159,26 @@ impl SubsetTree {
             .map(|&p| if p == NONE { -1 } else { p as i64 })
             .collect()
     }
+}
+
+/// SAH cost of visiting an interior node.
+pub const C_TRAV: f64 = 1.0;
+/// SAH cost of testing a primitive.
+pub const C_PRIM: f64 = 1.0;
+
+/// SAH cost of `tree` (MacDonald and Booth, 1990): traversal cost [`C_TRAV`] per interior node
+/// and intersection cost [`C_PRIM`] per primitive, each weighted by the probability
+/// `area(node) / area(root)` that a random ray through the root box hits the node box,
+/// `SAH = (C_TRAV · Σ_interior A(n) + C_PRIM · Σ_leaves A(l)) / A(root)`. The leaf term is the
+/// same for every hierarchy over a scene. A tree whose root box has no area (all primitives in
+/// one point) gets SAH = number of nodes.
+pub fn sah(tree: &SubsetTree) -> f64 {
+    let n = tree.leaves();
+    let root = area(&tree.aabb[tree.root() as usize]);
+    if root.is_nan() || root <= 0.0 {
+        return tree.len() as f64;
+    }
+    let leaves: f64 = tree.aabb[..n].iter().map(area).sum();
+    let interior: f64 = tree.aabb[n..].iter().map(area).sum();
+    (C_TRAV * interior + C_PRIM * leaves) / root
 }

@@ -1,11 +1,6 @@
 //! Quality of a hierarchy, whatever built it: the surface-area heuristic, depth and balance.
 //!
-//! - SAH cost (MacDonald and Booth, 1990) with traversal cost [`C_TRAV`] = 1 per interior node
-//!   and intersection cost [`C_PRIM`] = 1 per primitive, each weighted by the probability
-//!   `area(node) / area(root)` that a random ray through the root box hits the node box:
-//!   `SAH = (C_TRAV · Σ_interior A(n) + C_PRIM · Σ_leaves A(l)) / A(root)`. The leaf term is the
-//!   same for every hierarchy over a scene; differences come from the interior nodes. A scene
-//!   whose root box has no area (all primitives in one point) gets SAH = number of nodes.
+//! - SAH cost ([`sah`], defined next to the Subset Tree).
 //! - Structural balance: mean over interior nodes of `min(|L|, |R|) / max(|L|, |R|)` in leaves
 //!   (1 = perfectly balanced, → 0 = a chain).
 //! - Spatial balance: mean over interior nodes of the sibling box-volume ratio
@@ -23,22 +18,9 @@ pub mod report;
 pub mod stress;
 pub mod sweep;
 
-use crate::geom::Aabb;
+pub use crate::grouping::{C_PRIM, C_TRAV, sah};
+
 use crate::grouping::SubsetTree;
-
-/// SAH cost of visiting an interior node.
-pub const C_TRAV: f64 = 1.0;
-/// SAH cost of testing a primitive.
-pub const C_PRIM: f64 = 1.0;
-
-/// Surface area of a box (0 for an empty one).
-pub fn area(b: &Aabb) -> f64 {
-    let e = b.extents();
-    if e.iter().any(|x| x.is_nan() || *x < 0.0) {
-        return 0.0;
-    }
-    2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
-}
 
 /// Peak resident memory of this process in bytes (Linux `VmHWM`), if known.
 pub fn peak_rss_bytes() -> Option<u64> {
@@ -61,18 +43,6 @@ pub struct Quality {
     pub structural_balance: f64,
     /// Mean box-volume ratio of siblings.
     pub spatial_balance: f64,
-}
-
-/// SAH cost of `tree`.
-pub fn sah(tree: &SubsetTree) -> f64 {
-    let n = tree.leaves();
-    let root = area(&tree.aabb[tree.root() as usize]);
-    if root.is_nan() || root <= 0.0 {
-        return tree.len() as f64;
-    }
-    let leaves: f64 = tree.aabb[..n].iter().map(area).sum();
-    let interior: f64 = tree.aabb[n..].iter().map(area).sum();
-    (C_TRAV * interior + C_PRIM * leaves) / root
 }
 
 /// Volumes of the cut at depth `d` (the paper's Figure 3 shows "the 8-node level", d = 3):
@@ -130,7 +100,7 @@ pub fn quality(tree: &SubsetTree) -> Quality {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::P3;
+    use crate::geom::{Aabb, P3};
 
     fn unit(x: f64) -> Aabb {
         Aabb::from_points(&[P3::new(x, 0.0, 0.0), P3::new(x + 1.0, 1.0, 1.0)])

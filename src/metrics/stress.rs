@@ -19,8 +19,8 @@
 
 use super::report::{StressRow as Row, stress_csv, stress_sweep_chart};
 use crate::grouping::{self, Grouping, PSet, Params, SubsetTree};
+use crate::output::write_atomic;
 use crate::peers;
-use crate::record::output::write_atomic;
 use crate::scene::pathological::{self, Layout};
 use crate::scene::{Scene, split};
 use crate::wrap::{

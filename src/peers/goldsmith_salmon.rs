@@ -9,18 +9,13 @@
 //! the greedy descent in Catto's formulation ("Dynamic Bounding Volume Hierarchies", GDC 2019).
 
 use super::topology::Node;
-use crate::geom::Aabb;
+use crate::geom::{Aabb, area};
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
 use rand_chacha::ChaCha8Rng;
 
 /// Seed of the insertion order.
 pub const ORDER_SEED: u64 = 0x6753_3187;
-
-fn area(b: &Aabb) -> f64 {
-    let e = b.extents();
-    2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
-}
 
 /// Builds the tree over primitive boxes `boxes`; returns the nodes and the root index.
 pub fn build(boxes: &[Aabb]) -> (Vec<Node>, u32) {

@@ -1,5 +1,5 @@
 //! Our grouping phase beside its peers, on the same primitives, each as a [`SubsetTree`] so
-//! that quality ([`crate::metrics`]), Wrapper Trees ([`crate::wrap`]) and queries
+//! that quality measures (SAH, depth, balance), Wrapper Trees ([`crate::wrap`]) and queries
 //! ([`crate::query`]) measure every hierarchy the same way.
 //!
 //! - [`Method::Grouping`], [`Method::GroupingHull`]: the paper's grouping phase (§2.2) with AABB

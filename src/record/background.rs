@@ -4,7 +4,7 @@
 //! list is the one allocation) into a batch and sends each full batch, shared, down one
 //! bounded channel per worker.
 
-use crate::grouping::events::OwnedEvent as Owned;
+use crate::events::OwnedEvent as Owned;
 use crate::grouping::{Event, Observer};
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};

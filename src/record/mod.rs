@@ -8,7 +8,6 @@ pub mod background;
 pub mod direct;
 pub mod mcap;
 mod options;
-pub mod output;
 pub mod rrd;
 mod run;
 mod summary;

@@ -14,10 +14,10 @@
 
 use super::direct::DirectWriter;
 use super::mcap::{Compression, McapRecorder};
-use super::output::{Pending, with_ext};
 use super::rrd::RrdRecorder;
 use super::{CoverLevel, Detail, Outcome, RunInfo, background};
 use crate::grouping::{self, Grouping, Limits, Observer, ResolvedParams, Stopped, Tee};
+use crate::output::{Pending, with_ext};
 use crate::scene::{Loaded, Scene};
 use crate::wrap::cover::Cover;
 use crate::wrap::cover::export::WrapperRecord;

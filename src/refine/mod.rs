@@ -3,7 +3,7 @@
 //! the nodes of at least γ leaves (Karras and Aila's γ: 64 up to 65,536 primitives, more
 //! above, [`Tuning::gamma`]) rebuilt in their SAH-optimal
 //! shape, bottom-up; then subtrees are moved to where they lower the SAH
-//! ([`crate::metrics::sah`]) most, by insertion-based optimisation (Bittner, Hapala and Havran
+//! ([`crate::grouping::sah`]) most, by insertion-based optimisation (Bittner, Hapala and Havran
 //! 2013) in the parallel form of Meister and Bittner 2018 ([`reinsert`]).
 //!
 //! A run is a sequence of passes: `treelet_passes` treelet passes (a pass that rebuilds
@@ -22,7 +22,7 @@
 //!   that children precede parents, keeping the input's order where it still holds
 //!   ([`renumber`]); a tree no move improves is returned unchanged (every id kept);
 //! - SAH never above the input's: every kept move lowers it (and a final check against
-//!   [`crate::metrics::sah`] guards rounding);
+//!   [`crate::grouping::sah`] guards rounding);
 //! - deterministic: the same tree and parameters give the same moves, the same events and the
 //!   same result for any number of rayon threads (searches are pure functions of the frozen
 //!   tree, collected in candidate order; moves apply sequentially, ties broken by node id);
@@ -33,63 +33,17 @@
 //! which treelet was rebuilt or which subtree moved from where to where, and the SAH after it. A tree whose root box has no area (all
 //! primitives in one point, or on one line) has nothing to gain and is returned unchanged.
 
+pub use crate::events::{RefineParams, Step, StepKind};
+
 pub mod reinsert;
 pub mod renumber;
 pub mod treelet;
 pub mod work;
 
-use crate::geom::Aabb;
+use crate::geom::area;
+use crate::grouping::sah;
 use crate::grouping::{Event, Observer, SubsetTree};
-use crate::metrics::{self, area};
 use work::WorkTree;
-
-/// Parameters of a refinement run.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct RefineParams {
-    /// Most passes run (a pass that keeps no move ends the run sooner).
-    pub passes: u32,
-    /// Fraction of the non-root nodes searched in the first pass (pass k searches
-    /// batch / (2k + 1) of them); in (0, 1].
-    pub batch: f64,
-    /// Most leaves of a restructured treelet, 3..=7 ([`treelet::MAX_LEAVES`]).
-    pub treelet: u32,
-    /// Treelet restructuring passes run before the reinsertion passes (0: none).
-    pub treelet_passes: u32,
-}
-
-impl Default for RefineParams {
-    /// One treelet pass of 7 leaves (rooted at the nodes of ≥ γ leaves, [`Tuning::gamma`]),
-    /// then 3 reinsertion passes, first batch = a tenth of the nodes (see the README's
-    /// refinement section for the measurements behind it).
-    fn default() -> Self {
-        RefineParams {
-            passes: 3,
-            batch: 0.1,
-            treelet: 7,
-            treelet_passes: 1,
-        }
-    }
-}
-
-impl RefineParams {
-    /// Checks that `batch` is in (0, 1]; the error names the parameter.
-    pub fn check(&self) -> Result<(), String> {
-        if !(self.batch > 0.0 && self.batch <= 1.0) {
-            return Err(format!(
-                "refine batch must be in (0, 1], got {}",
-                self.batch
-            ));
-        }
-        if !(3..=treelet::MAX_LEAVES as u32).contains(&self.treelet) {
-            return Err(format!(
-                "refine treelet must be 3 to {} leaves, got {}",
-                treelet::MAX_LEAVES,
-                self.treelet
-            ));
-        }
-        Ok(())
-    }
-}
 
 /// Knobs of a refinement run that recordings do not name (so `record --refine` and
 /// `replay --verify` always use [`Tuning::default`]); for measuring variants
@@ -134,59 +88,6 @@ impl Tuning {
     }
 }
 
-/// What a refinement step did.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-pub enum StepKind {
-    /// A subtree moved (reinsertion, [`reinsert`]).
-    Move,
-    /// A treelet of `leaves` leaves was rebuilt in its optimal shape ([`treelet`]).
-    Treelet {
-        /// Treelet leaves (3..=7).
-        leaves: u32,
-    },
-}
-
-/// One kept step of a refinement run: a move or a rebuilt treelet.
-///
-/// Ids are the input tree's: leaves are primitives; an interior id names the input's node
-/// *slot*, which a step can hang elsewhere (the final renumbering to merge order happens after
-/// the last step, see [`renumber`]). For a rebuilt treelet, `node` is its root, `parent`,
-/// `sibling` and `target` are [`crate::grouping::NONE`], and both boxes are the root's (which
-/// a rebuild keeps).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct Step {
-    /// 0-based index of the step in the run.
-    pub step: u32,
-    /// Pass the step belongs to (treelet passes first, then reinsertion passes).
-    pub pass: u32,
-    /// Move or treelet.
-    pub kind: StepKind,
-    /// The subtree that moved (a treelet's root).
-    pub node: u32,
-    /// Its parent slot, which moved with it: before, parent of `node` and `sibling`; after,
-    /// parent of `node` and `target`.
-    pub parent: u32,
-    /// Its old sibling, which took the parent's old place.
-    pub sibling: u32,
-    /// Its new sibling.
-    pub target: u32,
-    /// Box of the moved subtree.
-    #[serde(serialize_with = "ser_aabb")]
-    pub aabb: Aabb,
-    /// Box of the parent slot after the move (`node` ∪ `target`).
-    #[serde(serialize_with = "ser_aabb")]
-    pub parent_aabb: Aabb,
-    /// SAH before the step.
-    pub sah_before: f64,
-    /// SAH after the step.
-    pub sah: f64,
-}
-
-fn ser_aabb<S: serde::Serializer>(b: &Aabb, s: S) -> Result<S::Ok, S::Error> {
-    use serde::Serialize;
-    [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z].serialize(s)
-}
-
 /// The outcome of a refinement run.
 #[derive(Clone, Debug)]
 pub struct Refined {
@@ -215,7 +116,7 @@ pub fn refine_tuned<O: Observer>(
     tuning: &Tuning,
     mut observer: O,
 ) -> Refined {
-    let sah_before = metrics::sah(tree);
+    let sah_before = sah(tree);
     observer.on_event(&Event::RefineStart {
         params: *params,
         sah: sah_before,
@@ -269,7 +170,7 @@ pub fn refine_tuned<O: Observer>(
         return unchanged(passes);
     }
     let refined = renumber::subset_tree(&w, tree).expect("moves keep one binary tree");
-    let sah_after = metrics::sah(&refined);
+    let sah_after = sah(&refined);
     if sah_after > sah_before {
         return unchanged(passes);
     }

@@ -15,9 +15,9 @@
 
 use super::work::WorkTree;
 use crate::geom::Aabb;
+use crate::geom::area;
 use crate::geom::morton::spread_bits;
 use crate::grouping::NONE;
-use crate::metrics::area;
 use rayon::prelude::*;
 
 /// The best move found for one node: put `node` next to `target`, lowering the sum of interior

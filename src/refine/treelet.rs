@@ -16,12 +16,12 @@
 
 use super::work::WorkTree;
 use crate::geom::Aabb;
+use crate::geom::area;
 use crate::grouping::NONE;
-use crate::metrics::area;
 use rayon::prelude::*;
 
 /// Most leaves of a treelet (Karras and Aila's choice; the subsets then fit in a `u8`).
-pub const MAX_LEAVES: usize = 7;
+pub const MAX_LEAVES: usize = crate::events::MAX_TREELET_LEAVES;
 
 /// Fewest treelets of one height solved in parallel.
 pub const PARALLEL_MIN: usize = 256;

@@ -6,8 +6,8 @@
 //! back into a Subset Tree's merge order at the end.
 
 use crate::geom::Aabb;
+use crate::geom::area;
 use crate::grouping::{NONE, SubsetTree};
-use crate::metrics::area;
 
 /// What [`WorkTree::reinsert`] changed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -183,9 +183,9 @@ impl WorkTree {
         }
     }
 
-    /// SAH of the current tree from the running interior sum (see [`crate::metrics::sah`]).
+    /// SAH of the current tree from the running interior sum (see [`crate::grouping::sah`]).
     pub fn sah(&self, leaves: f64, root_area: f64) -> f64 {
-        use crate::metrics::{C_PRIM, C_TRAV};
+        use crate::grouping::{C_PRIM, C_TRAV};
         (C_TRAV * self.interior + C_PRIM * leaves) / root_area
     }
 }

@@ -14,9 +14,9 @@
 
 use super::{Frame, View};
 use crate::grouping::{self, EventLog, Grouping, Merge, ResolvedParams, SubsetTree};
-use crate::record::mcap::read_recording;
-use crate::record::output::Pending;
-use crate::scene::{Scene, load_bytes};
+use crate::output::Pending;
+use crate::replay;
+use crate::scene::Scene;
 use crate::wrap::{SphereMethod, WrapperKind, Wrappers};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
@@ -68,22 +68,16 @@ impl Default for SnapshotOptions {
     }
 }
 
-/// The embedded scene and parameters of the `.mcap` recording at `path`, and its merges when
-/// it is complete and holds them.
+/// The embedded scene and parameters of the `.mcap` recording at `path` (read through
+/// [`replay::open`]), and its merges when it is complete and holds them.
 pub fn from_recording(path: &Path) -> Result<(Scene, ResolvedParams, Option<Vec<Merge>>)> {
-    let rec = read_recording(path)?;
-    let loaded = load_bytes(
-        &rec.scene_file_name,
-        rec.scene_bytes.clone(),
-        &rec.load_options,
-    )
-    .map_err(|e| anyhow::anyhow!("{}: embedded scene: {e}", path.display()))?;
+    let replay::Replay { rec, loaded } = replay::open(path)?;
     let merges = (rec.complete && rec.detail.merges()).then_some(rec.merges);
     Ok((loaded.scene, rec.params, merges))
 }
 
-/// Groups `scene` with `params`; also says whether its merges differ from `recorded`, when
-/// given.
+/// Groups `scene` with `params`; also says whether its merges make another decision than
+/// `recorded`, when given ([`replay::first_divergence`]: the MPairs length is not compared).
 pub fn regroup(
     scene: &Scene,
     params: &ResolvedParams,
@@ -93,7 +87,7 @@ pub fn regroup(
     let never = AtomicBool::new(false);
     let g = grouping::group_until(scene, params, &mut log, &never)
         .map_err(|_| anyhow::anyhow!("grouping stopped unexpectedly"))?;
-    let differs = recorded.is_some_and(|m| m != log.merges.as_slice());
+    let differs = recorded.is_some_and(|m| replay::first_divergence(m, &log.merges).is_some());
     Ok((g, differs))
 }
 

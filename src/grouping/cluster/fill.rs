@@ -1,10 +1,4 @@
-//! Fill and Balance of a would-be merge (§2.2), and the box area of `--cost area`.
-
-/// Surface area of a box with extents `e` (the size measure of `--cost area`).
-#[inline(always)]
-pub(in crate::grouping) fn box_area(e: &crate::geom::V3) -> f64 {
-    2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
-}
+//! Fill and Balance of a would-be merge (§2.2).
 
 /// Fill and Balance of a would-be parent of diameter `d` over children of diameters `dx`, `dy`.
 ///

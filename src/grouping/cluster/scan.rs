@@ -39,9 +39,10 @@
 
 mod par;
 
-use super::{Clusterer, PSetBodies, ScanLimit, box_area, fill_balance};
+use super::{Clusterer, PSetBodies, ScanLimit, fill_balance};
+use crate::events::Observer;
+use crate::geom::surface_area;
 use crate::geom::{Aabb, P3, V3};
-use crate::grouping::events::Observer;
 use crate::grouping::mpairs::{K_MAX, List, Top};
 use crate::grouping::voxel_hash::CellBounds;
 use crate::grouping::{CostMeasure, Weights};
@@ -94,7 +95,11 @@ pub(in crate::grouping) fn pair_cost_any(w: &Weights, d: f64, dx: f64, dy: f64) 
 fn measures(area: bool, e: &V3, xa: &Aabb, dx: f64, ya: &Aabb, dy: f64) -> (f64, f64, f64) {
     if area {
         let ex = |b: &Aabb| b.max - b.min;
-        (box_area(e), box_area(&ex(xa)), box_area(&ex(ya)))
+        (
+            surface_area(e),
+            surface_area(&ex(xa)),
+            surface_area(&ex(ya)),
+        )
     } else {
         (e.norm(), dx, dy)
     }

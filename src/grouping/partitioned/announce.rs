@@ -3,8 +3,8 @@
 
 use super::Info;
 use super::plan::{Node, post_order};
+use crate::events::{Event, Merge, Observer, Part, PartKind};
 use crate::geom::Aabb;
-use crate::grouping::events::{Event, Merge, Observer, Part, PartKind};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The merges of the run, by step (new body `n + step`).

@@ -2,9 +2,9 @@
 //! hash and MPairs on the subproblem's bodies, stopped at `keep` bodies.
 
 use super::{Body, Ctx, Info, Out, SubStats};
+use crate::events::{Event, Observer};
 use crate::grouping::Budget;
 use crate::grouping::cluster::run_boxes_until;
-use crate::grouping::events::{Event, Observer};
 use std::sync::atomic::Ordering;
 
 /// Collects the merges of a voxel-hash subproblem for the events.

@@ -64,10 +64,10 @@ mod tests;
 mod tiny;
 
 use super::cluster;
-use super::events::{Event, Observer};
 use super::subset_tree::SubsetTree;
 use super::voxel_hash::prefetch;
 use super::{Budget, Grouping, PSet, ResolvedParams, Stats, StopReason, Stopped};
+use crate::events::{Event, Observer};
 use crate::geom::Aabb;
 use crate::scene::Scene;
 use announce::{Made, announce};

@@ -7,7 +7,7 @@
 //! clusters (a patch of a soup, the parts of one copy) as readily as between them, and each side
 //! is then grouped down to a few bodies before the two can meet. A small range is cut instead
 //! across the longest axis of its primitives' centres, at the boundary of least
-//! `area(left)·|left| + area(right)·|right|` (area = half the surface of a side's box of
+//! `area(left)·|left| + area(right)·|right|` (area = the surface of a side's box of
 //! primitive boxes; ties to the lower boundary) among those leaving at least a quarter of the
 //! range on each side: between [`BINS`] equal bins of the centres above [`SWEEP`] primitives,
 //! between any two neighbours of the sorted centres up to it. The range is partitioned
@@ -18,8 +18,8 @@
 //! cuts").
 
 use super::Body;
-use crate::geom::Aabb;
 use crate::geom::morton::spread_bits;
+use crate::geom::{Aabb, V3, surface_area};
 use crate::grouping::mpairs::order_bits;
 use rayon::prelude::*;
 
@@ -90,11 +90,10 @@ pub(super) struct Zone<'z> {
     tmp: Vec<u32>,
 }
 
-/// Half the surface of the box `lo..hi`.
+/// Surface area of the box `lo..hi`.
 #[inline]
 fn area(lo: &[f64; 3], hi: &[f64; 3]) -> f64 {
-    let e = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
-    e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
+    surface_area(&V3::new(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]))
 }
 
 /// The lesser of `a` and `b`, `a` when `b` is NaN: one `minsd` (`f64::min` also checks `a`).

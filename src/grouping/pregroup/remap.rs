@@ -1,7 +1,7 @@
 //! Events of a part run with local ids, buffered while parts run in parallel and passed on
 //! with global ids in the documented order.
 
-use crate::grouping::events::{Event, Merge, Observer, OwnedEvent};
+use crate::events::{Event, Merge, Observer, OwnedEvent};
 
 /// An owned copy of the events of one part run (no `Part`, no `Finish`).
 #[derive(Default)]

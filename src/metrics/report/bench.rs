@@ -3,7 +3,7 @@
 
 use super::{QUERY_COLUMNS, SIZE, opt, query_fields, series_by, write_chart};
 use crate::metrics::compare::{Row, query_values};
-use crate::record::output::write_atomic;
+use crate::output::write_atomic;
 use crate::record::rrd::SeriesFile;
 use crate::render::chart::{Scatter, Series, pareto_front};
 use anyhow::{Result, anyhow};

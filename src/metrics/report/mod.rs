@@ -27,8 +27,8 @@ pub use targets::{
     target_line, targets_header, targets_notes,
 };
 
+use crate::output::write_atomic;
 use crate::query::QueryCost;
-use crate::record::output::write_atomic;
 use crate::render::chart::Series;
 use crate::render::svg_to_png;
 use anyhow::{Result, anyhow};

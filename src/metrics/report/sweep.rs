@@ -5,7 +5,7 @@ use super::{QUERY_COLUMNS, query_fields, write_chart};
 use crate::grouping::{CostMeasure, Merge};
 use crate::metrics::compare::query_values;
 use crate::metrics::sweep::{Setting, SweepRow};
-use crate::record::output::write_atomic;
+use crate::output::write_atomic;
 use crate::record::rrd::SeriesFile;
 use crate::render::chart::HeatMap;
 use anyhow::{Result, anyhow};

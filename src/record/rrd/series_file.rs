@@ -3,7 +3,7 @@
 //! place by [`SeriesFile::commit`].
 
 use super::sink;
-use crate::record::output::Pending;
+use crate::output::Pending;
 use rerun::RecordingStream;
 use std::path::{Path, PathBuf};
 

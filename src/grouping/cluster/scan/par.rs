@@ -19,9 +19,9 @@
 
 use super::reachable;
 use super::{Clusterer, PSetBodies, Quick, ScanLimit, apart, merged_extents, pair_cost, query_box};
+use crate::events::Observer;
 use crate::geom::P3;
 use crate::grouping::Budget;
-use crate::grouping::events::Observer;
 use crate::grouping::mpairs::List;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
