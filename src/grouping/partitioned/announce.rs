@@ -1,14 +1,14 @@
 //! The events of a partitioned run, announced after the grouping: each finished subproblem in
 //! the split's post-order, with its merges.
 
-use super::Info;
 use super::plan::{Node, post_order};
+use super::subproblem::MergeInfo;
 use crate::events::{Event, Merge, Observer, Part, PartKind};
 use crate::geom::Aabb;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The merges of the run, by step (new body `n + step`).
-pub(super) struct Made<'a> {
+pub(super) struct Built<'a> {
     /// Primitives.
     pub(super) n: usize,
     /// Children of each merge.
@@ -17,7 +17,7 @@ pub(super) struct Made<'a> {
     pub(super) aabb: &'a [Aabb],
     pub(super) diameter: &'a [f64],
     /// Details of each merge (empty when nobody listens).
-    pub(super) info: &'a [Info],
+    pub(super) info: &'a [MergeInfo],
 }
 
 /// Announces, in post-order up to the first unfinished subproblem, each subproblem that merges
@@ -28,10 +28,10 @@ pub(super) fn announce<O: Observer>(
     observer: &mut O,
     nodes: &[Node],
     done: &[AtomicBool],
-    made: &Made<'_>,
+    made: &Built<'_>,
     listens: bool,
 ) -> u32 {
-    let Made {
+    let Built {
         n,
         children,
         aabb,

@@ -10,13 +10,10 @@ const TABLED: usize = 4096;
 /// least ⌈top·n/N⌉ for a node of n primitives; and which nodes pass all their bodies up.
 ///
 /// Two halves' shares, rounded up, can exceed their parent's by one, so a node above the share's
-/// size would make a merge or two: at 10^6 about a hundred nodes of more than
-/// [`SMALL`](super::small::SMALL) bodies did, each a voxel-hash round over thousands of bodies
-/// for one merge (18 ms of one thread's time). Such a node passes its bodies up, and the root
-/// makes those merges (8,295 bodies at the root instead of 8,193 at 10^6). Shares taken as
-/// differences of one rounded-down prefix (⌊top·hi/N⌋ − ⌊top·lo/N⌋), which add up exactly,
-/// saved more time but moved about 2,000 merges into the smallest nodes above f, and
-/// samurai-monastery's node tests from 0.911 to 1.027 × the exact tree's.
+/// size would make a merge or two, each a voxel-hash round over thousands of bodies when it
+/// has more than [`SMALL`](super::brute_force::SMALL) of them. Such a node passes its bodies
+/// up, and the root makes those merges. (Shares that add up exactly, as differences of one
+/// rounded-down prefix, push merges into the smallest nodes above f and cost tree quality.)
 pub(super) struct Keep {
     pub(super) chunking: Chunking,
     small: Vec<u32>,
@@ -59,8 +56,8 @@ impl Keep {
     }
 
     /// Whether a node of `size` primitives and `inputs` bodies passes them all up: more than
-    /// [`SMALL`](super::small::SMALL) bodies, and a share above f(`size`).
+    /// [`SMALL`](super::brute_force::SMALL) bodies, and a share above f(`size`).
     pub(super) fn passes(&self, size: u32, inputs: u32) -> bool {
-        inputs as usize > super::small::SMALL && self.share(size) > self.f(size)
+        inputs as usize > super::brute_force::SMALL && self.share(size) > self.f(size)
     }
 }

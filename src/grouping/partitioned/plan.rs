@@ -1,9 +1,9 @@
 //! The top-down split: its parameters ([`Chunking`]), the Morton order of the primitives and the
 //! tree of chunks over it.
 
-use super::Body;
 use super::keep::Keep;
 use super::split::{Zone, morton_cut};
+use super::subproblem::Body;
 #[cfg(test)]
 use crate::geom::Aabb;
 use rayon::prelude::*;
@@ -21,21 +21,15 @@ pub struct Chunking {
     pub top: u32,
     /// Ranges of at most this many primitives are cut by binned SAH on the longest axis of
     /// their centres instead of at their highest differing Morton bit (`split`); 0 = Morton
-    /// cuts throughout (the split before session 11).
+    /// cuts throughout.
     pub sah_below: u32,
 }
 
 impl Chunking {
     /// δ = 4 and ε = 1/2, so that f(n) = δ/2 = 2: every node below the root share leaves two
-    /// bodies, and the nodes above it leave ⌈top·n/N⌉, with a root step of about 8,192 bodies.
-    /// Against AAC's fast setting ε = 0.2 (README, "How the chunking was chosen") it took 26 %
-    /// less time at 10^6 on one and two threads, for trees as close to the exact schedule's on
-    /// the bench scenes (within 2 % on all but the 10^5 soup, SAH 3.5 %), closer on three
-    /// pybullet meshes (within 2 %, against 2.3–3.6 %) and farther on large assemblies of copies
-    /// (800 robot bases: SAH 11 % over, against 7 %); scenes of at most 12,288 primitives get
-    /// the exact schedule's tree. SAH cuts of ranges up to 256 primitives (session 11, README
-    /// "Where the split cuts") brought the 10^5 soup within 2 % (SAH 1.006) and the robot bases
-    /// closer (8 %), for about 0.1 s more at 10^6 on one thread.
+    /// bodies, and the nodes above it leave ⌈top·n/N⌉, with a root step of about 8,192 bodies;
+    /// ranges of up to 256 primitives are cut by SAH. Faster than AAC's ε = 0.2 for trees as
+    /// close to the exact schedule's (the measurements: docs/benchmarks.md).
     pub const DEFAULT: Chunking = Chunking {
         delta: 4,
         epsilon: 0.5,
@@ -45,9 +39,8 @@ impl Chunking {
 
     /// Whether a scene of `n` primitives is grouped as one subproblem, the exact schedule's
     /// step: when `n` ≤ 1.5 × `top`. The root step alone on about `top` bodies costs about what
-    /// the exact schedule costs on all of them: on soups (one thread) the partitioned run took
-    /// 1.25× the exact run's time at 10,000 primitives, 1.18× on the 12,144-polygon scene, and
-    /// 0.75× at 16,384, so below this size the split only approximates the tree for no gain.
+    /// the exact schedule costs on all of them, so below this size the split would only
+    /// approximate the tree for no gain.
     pub fn whole(&self, n: usize) -> bool {
         2 * n as u64 <= 3 * u64::from(self.top)
     }
@@ -388,9 +381,9 @@ pub(super) mod tests {
                     .grow(&(c + crate::geom::V3::repeat(0.5)));
                 Body {
                     id,
-                    rd: 0,
+                    first_round: 0,
                     aabb,
-                    d: aabb.diameter(),
+                    diameter: aabb.diameter(),
                 }
             })
             .collect()
@@ -484,7 +477,7 @@ pub(super) mod tests {
         let mut passed = 0;
         for (k, node) in nodes.iter().enumerate().skip(1) {
             assert!(node.keep >= share(node).min(node.inputs), "node {k}");
-            if node.inputs as usize > super::super::small::SMALL && share(node) > 2 {
+            if node.inputs as usize > super::super::brute_force::SMALL && share(node) > 2 {
                 assert_eq!(node.keep, node.inputs, "node {k}");
                 passed += 1;
             }

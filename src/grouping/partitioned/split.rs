@@ -7,17 +7,13 @@
 //! clusters (a patch of a soup, the parts of one copy) as readily as between them, and each side
 //! is then grouped down to a few bodies before the two can meet. A small range is cut instead
 //! across the longest axis of its primitives' centres, at the boundary of least
-//! `area(left)·|left| + area(right)·|right|` (area = the surface of a side's box of
-//! primitive boxes; ties to the lower boundary) among those leaving at least a quarter of the
-//! range on each side: between [`BINS`] equal bins of the centres above [`SWEEP`] primitives,
-//! between any two neighbours of the sorted centres up to it. The range is partitioned
-//! stably, so each side stays in Morton order; a range whose centres span no length (or a
-//! NaN one), or that has no such boundary, gets the Morton cut. A zone (a range of at most
-//! `sah_below` whose parent is larger) is planned as a permutation of 4-byte positions and
-//! reordered once. Chosen on the bench scenes and 15 held-out ones (README, "Where the split
-//! cuts").
+//! `area(left)·|left| + area(right)·|right|` (ties to the lower boundary) among those leaving
+//! at least a quarter of the range on each side: between [`BINS`] equal bins of the centres
+//! above [`SWEEP`] primitives, between sorted neighbours up to it. The range is partitioned
+//! stably, so each side stays in Morton order; a range without such a boundary (centres that
+//! span no length, or NaN) gets the Morton cut.
 
-use super::Body;
+use super::subproblem::Body;
 use crate::geom::morton::spread_bits;
 use crate::geom::{Aabb, V3, surface_area};
 use crate::grouping::mpairs::order_bits;
@@ -369,9 +365,9 @@ mod tests {
         };
         Body {
             id,
-            rd: 0,
+            first_round: 0,
             aabb,
-            d: aabb.diameter(),
+            diameter: aabb.diameter(),
         }
     }
 

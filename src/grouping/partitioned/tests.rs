@@ -1,10 +1,11 @@
-//! The brute-force subproblems (`tiny`, `small`) against the voxel-hash one on the same bodies.
+//! The brute-force subproblems (`all_pairs`, `brute_force`) against the voxel-hash one on the same bodies.
 
-use super::{Body, Ctx, Info, Left, Out, SubStats, big, small};
+use super::subproblem::{Body, Counters, Leftover, MergeInfo, MergeSlots, RunInputs};
+use super::{brute_force, voxel_step};
 use crate::geom::Aabb;
 use crate::grouping::{Budget, Params, Weights};
 use crate::scene::generate;
-use small::Limits;
+use brute_force::RoundLimits;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64};
 
@@ -28,7 +29,7 @@ fn part(bodies: &[Body]) -> Half {
 
 /// Runs `combine` on `bodies` (ids from 0, new ids from `n`) and returns the merges and the
 /// bodies left.
-fn solve(ctx: &Ctx, bodies: &[Body], keep: usize, n: u32, brute: bool) -> Solved {
+fn solve(ctx: &RunInputs, bodies: &[Body], keep: usize, n: u32, brute: bool) -> Solved {
     solve_parts(
         ctx,
         [part(bodies), Half::default()],
@@ -42,7 +43,7 @@ fn solve(ctx: &Ctx, bodies: &[Body], keep: usize, n: u32, brute: bool) -> Solved
 /// Runs `combine` on `parts` (brute force with `export`, or the voxel hash for `None`); returns
 /// the merges and bodies left, and what the brute force left.
 fn solve_parts(
-    ctx: &Ctx,
+    ctx: &RunInputs,
     parts: [Half; 2],
     keep: usize,
     n: u32,
@@ -52,30 +53,30 @@ fn solve_parts(
     let mut children = vec![[0u32; 2]; m];
     let mut aabb = vec![Aabb::EMPTY; m];
     let mut diameter = vec![0.0; m];
-    let mut info = vec![Info::default(); m];
-    let mut out = Out {
+    let mut info = vec![MergeInfo::default(); m];
+    let mut out = MergeSlots {
         first_new: n,
         children: &mut children,
         aabb: &mut aabb,
         diameter: &mut diameter,
         info: Some(&mut info),
-        stats: SubStats::default(),
+        stats: Counters::default(),
     };
     let left = match export {
         Some(e) => {
             let [a, b] = parts;
             let lefts = [
-                Left {
+                Leftover {
                     n: a.bodies.len(),
                     pairs: a.pairs,
                 },
-                Left {
+                Leftover {
                     n: b.bodies.len(),
                     pairs: b.pairs,
                 },
             ];
             let mut arena = [a.bodies, b.bodies].concat();
-            let left = small::combine(ctx, &mut arena, lefts, keep, &mut out, e);
+            let left = brute_force::combine(ctx, &mut arena, lefts, keep, &mut out, e);
             Half {
                 bodies: arena[..left.n].to_vec(),
                 pairs: left.pairs,
@@ -84,7 +85,7 @@ fn solve_parts(
         None => {
             let [a, b] = parts;
             let bodies = [a.bodies, b.bodies].concat();
-            part(&big::combine(ctx, bodies, keep, &mut out).unwrap())
+            part(&voxel_step::combine(ctx, bodies, keep, &mut out).unwrap())
         }
     };
     let merges = (0..m)
@@ -98,7 +99,7 @@ fn solve_parts(
 #[test]
 fn brute_force_equals_the_voxel_hash_run() {
     let budget = Budget::default();
-    // Sizes for both brute-force solvers (`tiny` up to 8 bodies, `small` above).
+    // Sizes for both brute-force solvers (`all_pairs` up to 8 bodies, `brute_force` above).
     for (seed, n) in [
         (1u64, 64usize),
         (2, 40),
@@ -130,10 +131,10 @@ fn brute_force_equals_the_voxel_hash_run() {
                 ..Params::default()
             }
             .resolve(&scene);
-            let ctx = Ctx {
+            let ctx = RunInputs {
                 params,
-                dl: Limits::new(params.dlimit0),
-                gl: Limits::new(params.glimit0),
+                dl: RoundLimits::new(params.dlimit0),
+                gl: RoundLimits::new(params.glimit0),
                 budget: &budget,
                 pairs: AtomicU64::new(0),
                 halt: AtomicBool::new(false),
@@ -145,9 +146,9 @@ fn brute_force_equals_the_voxel_hash_run() {
                     let aabb = scene.prim_aabb(i);
                     Body {
                         id: 3 * i as u32 + 1,
-                        rd: ctx.dl.first(aabb.diameter()),
+                        first_round: ctx.dl.first(aabb.diameter()),
                         aabb,
-                        d: aabb.diameter(),
+                        diameter: aabb.diameter(),
                     }
                 })
                 .collect();
@@ -180,7 +181,7 @@ fn brute_force_equals_the_voxel_hash_run() {
 
 #[test]
 fn limits_give_the_first_round_that_admits_a_value() {
-    let l = Limits::new(0.3);
+    let l = RoundLimits::new(0.3);
     for x in [0.0, 0.3, 0.31, 0.6, 0.6000001, 1e-300, 7.5, 1e300, f64::MAX] {
         let r = l.first(x);
         assert!(x <= l.at(r), "{x} within round {r}");
@@ -191,7 +192,7 @@ fn limits_give_the_first_round_that_admits_a_value() {
     // Against a linear search, for normal and subnormal bases and values at, just above and
     // just below every limit.
     for base in [0.3, 1.0, 1.5, 1e-310, 5e-324, 1e300] {
-        let l = Limits::new(base);
+        let l = RoundLimits::new(base);
         let naive = |x: f64| (0u32..).find(|&r| x <= l.at(r)).unwrap();
         for r in 0..l.rounds() as u32 {
             let v = l.at(r);

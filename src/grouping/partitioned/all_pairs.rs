@@ -1,16 +1,16 @@
-//! The brute-force step of [`small`](super::small) for subproblems of at most [`TINY`] bodies,
+//! The brute-force step of [`brute_force`](super::brute_force) for subproblems of at most [`TINY`] bodies,
 //! most of the partitioned schedule's subproblems (AAC's chunks and the levels just above).
 //!
 //! With so few bodies, keeping each body's cheapest partner costs more than it saves: every
 //! step looks at all pairs of the bodies left. The pair merged next is the least by (its
 //! round, clamped to the current round; Cost; smaller tie tag; larger tie tag), which is the
-//! pair `small` merges: the cheapest pair eligible in the current round, or, when none is,
+//! pair `brute_force` merges: the cheapest pair eligible in the current round, or, when none is,
 //! the cheapest of those eligible first in a later round, which becomes the current one. The
 //! counters (eligible pairs at each round start, candidates, pops, rounds) and the events'
-//! queue length (bodies with an eligible partner after the merge) are those of `small`.
+//! queue length (bodies with an eligible partner after the merge) are those of `brute_force`.
 
-use super::small::{NEVER, eval, leave, merged, pairs_of, put_merge};
-use super::{Body, Ctx, Left, Out, SubStats};
+use super::brute_force::{NEVER, eval, leave, merged, pairs_of, put_merge};
+use super::subproblem::{Body, Counters, Leftover, MergeSlots, RunInputs};
 use crate::grouping::cluster::tie_tag;
 
 /// The most bodies a subproblem may have to be solved here.
@@ -83,19 +83,19 @@ impl Pairs {
     }
 }
 
-/// [`small::combine`](super::small::combine) for at most [`TINY`] bodies (more than `keep`).
+/// [`brute_force::combine`](super::brute_force::combine) for at most [`TINY`] bodies (more than `keep`).
 pub(super) fn run(
-    ctx: &Ctx,
+    ctx: &RunInputs,
     body: &mut [Body],
-    parts: [Left; 2],
+    parts: [Leftover; 2],
     keep: usize,
-    out: &mut Out<'_>,
+    out: &mut MergeSlots<'_>,
     export: bool,
-) -> Left {
+) -> Leftover {
     let m = body.len();
     debug_assert!(m <= TINY && keep >= 1 && keep < m && parts[0].n + parts[1].n == m);
     let seed = ctx.params.seed;
-    let mut st = SubStats::default();
+    let mut st = Counters::default();
     let mut p = Pairs {
         cost: [[0; TINY]; TINY],
         round: [[NEVER; TINY]; TINY],

@@ -1,19 +1,19 @@
-//! Subproblems of more than [`SMALL`](super::small::SMALL) bodies: the exact schedule's voxel
+//! Subproblems of more than [`SMALL`](super::brute_force::SMALL) bodies: the exact schedule's voxel
 //! hash and MPairs on the subproblem's bodies, stopped at `keep` bodies.
 
-use super::{Body, Ctx, Info, Out, SubStats};
+use super::subproblem::{Body, Counters, MergeInfo, MergeSlots, RunInputs};
 use crate::events::{Event, Observer};
 use crate::grouping::Budget;
 use crate::grouping::cluster::run_boxes_until;
 use std::sync::atomic::Ordering;
 
 /// Collects the merges of a voxel-hash subproblem for the events.
-struct Log(Vec<Info>);
+struct MergeLog(Vec<MergeInfo>);
 
-impl Observer for Log {
+impl Observer for MergeLog {
     fn on_event(&mut self, event: &Event<'_>) {
         if let Event::Merge(m) = event {
-            self.0.push(Info {
+            self.0.push(MergeInfo {
                 round: m.round,
                 fill: m.fill,
                 balance: m.balance,
@@ -25,13 +25,13 @@ impl Observer for Log {
     }
 }
 
-/// A subproblem of more than [`SMALL`](super::small::SMALL) bodies, with the exact schedule's voxel hash and
+/// A subproblem of more than [`SMALL`](super::brute_force::SMALL) bodies, with the exact schedule's voxel hash and
 /// MPairs (local ids mapped increasingly onto the run's ids, ties broken by the run's ids).
 pub(super) fn combine(
-    ctx: &Ctx,
+    ctx: &RunInputs,
     mut bodies: Vec<Body>,
     keep: usize,
-    out: &mut Out<'_>,
+    out: &mut MergeSlots<'_>,
 ) -> Option<Vec<Body>> {
     let m = bodies.len();
     if m <= keep {
@@ -53,7 +53,7 @@ pub(super) fn combine(
         max_pairs: ctx.budget.max_pairs.map(|p| p.saturating_sub(used)),
     };
     let boxes = bodies.iter().map(|b| b.aabb).collect();
-    let mut log = Log(Vec::new());
+    let mut log = MergeLog(Vec::new());
     let part = if out.listens() {
         log.0.reserve(m - keep);
         run_boxes_until(boxes, keep, id, &ctx.params, &mut log, &budget)
@@ -72,7 +72,7 @@ pub(super) fn combine(
         out.put(s, ch.map(id), part.aabb[s], part.diameter[s], info);
     }
     let st = &part.stats;
-    out.stats.add(&SubStats {
+    out.stats.add(&Counters {
         eligible_pairs: st.eligible_pairs,
         candidates: st.candidates,
         pops: st.pops,
@@ -85,8 +85,8 @@ pub(super) fn combine(
             .iter()
             .map(|&l| Body {
                 id: id(l),
-                rd: if (l as usize) < m {
-                    bodies[l as usize].rd
+                first_round: if (l as usize) < m {
+                    bodies[l as usize].first_round
                 } else {
                     ctx.dl.first(part.diameter[l as usize - m])
                 },
@@ -95,8 +95,8 @@ pub(super) fn combine(
                 } else {
                     part.aabb[l as usize - m]
                 },
-                d: if (l as usize) < m {
-                    bodies[l as usize].d
+                diameter: if (l as usize) < m {
+                    bodies[l as usize].diameter
                 } else {
                     part.diameter[l as usize - m]
                 },

@@ -9,10 +9,10 @@
 //! moves to the first round in which one is (the rounds in between would merge nothing). Pairs
 //! are ordered by (Cost, smaller tie tag, larger tie tag) as in MPairs, so the merges are those
 //! of the exact schedule run on the same bodies with the same limits. A half of the split that
-//! was solved here passes its bodies' pairs up with them (`Left`), so its parent evaluates only
+//! was solved here passes its bodies' pairs up with them (`Leftover`), so its parent evaluates only
 //! the pairs across the two halves (a pair's Cost and round depend on its two bodies alone).
 
-use super::{Body, Ctx, Info, Left, Out, SubStats};
+use super::subproblem::{Body, Counters, Leftover, MergeInfo, MergeSlots, RunInputs};
 use crate::grouping::cluster::{fill_balance, pair_cost_any, tie_tag};
 use crate::grouping::mpairs::order_bits;
 use std::cell::RefCell;
@@ -24,20 +24,20 @@ pub(super) const SMALL: usize = 64;
 pub(super) const NEVER: u32 = u32::MAX;
 
 /// The limits of every round: `tab[r]` = `base` doubled `r` times, up to the first infinity.
-pub(super) struct Limits {
+pub(super) struct RoundLimits {
     tab: Vec<f64>,
 }
 
-impl Limits {
+impl RoundLimits {
     /// The doubling sequence of `base` (> 0).
-    pub(super) fn new(base: f64) -> Limits {
+    pub(super) fn new(base: f64) -> RoundLimits {
         let mut tab = vec![base];
         let mut v = base;
         while v < f64::INFINITY && tab.len() < 4096 {
             v *= 2.0;
             tab.push(v);
         }
-        Limits { tab }
+        RoundLimits { tab }
     }
 
     /// The number of rounds before the limit is infinite (the last one's is).
@@ -176,10 +176,13 @@ thread_local! {
 
 /// The Cost (as [`order_bits`]) and first eligible round of the pair `a`, `b`.
 #[inline(always)]
-pub(super) fn eval(ctx: &Ctx, a: &Body, b: &Body) -> (u64, u32) {
+pub(super) fn eval(ctx: &RunInputs, a: &Body, b: &Body) -> (u64, u32) {
     let d = a.aabb.merge(&b.aabb).diameter();
-    let round = a.rd.max(b.rd).max(ctx.gl.first(a.aabb.gap_linf(&b.aabb)));
-    let cost = pair_cost_any(&ctx.params.weights, d, a.d, b.d);
+    let round = a
+        .first_round
+        .max(b.first_round)
+        .max(ctx.gl.first(a.aabb.gap_linf(&b.aabb)));
+    let cost = pair_cost_any(&ctx.params.weights, d, a.diameter, b.diameter);
     (order_bits(cost), round)
 }
 
@@ -187,10 +190,10 @@ pub(super) fn eval(ctx: &Ctx, a: &Body, b: &Body) -> (u64, u32) {
 /// part brings them, else evaluated), then the pairs across the parts; evaluations are counted.
 #[inline(always)]
 pub(super) fn pairs_of(
-    ctx: &Ctx,
+    ctx: &RunInputs,
     body: &[Body],
-    parts: &[Left; 2],
-    st: &mut SubStats,
+    parts: &[Leftover; 2],
+    st: &mut Counters,
     mut set: impl FnMut(usize, usize, (u64, u32)),
 ) {
     let (ka, m) = (parts[0].n, body.len());
@@ -220,14 +223,14 @@ pub(super) fn pairs_of(
 
 /// The body made by merging `x` and `y`, with id `new`.
 #[inline(always)]
-pub(super) fn merged(ctx: &Ctx, x: &Body, y: &Body, new: u32) -> Body {
+pub(super) fn merged(ctx: &RunInputs, x: &Body, y: &Body, new: u32) -> Body {
     let aabb = x.aabb.merge(&y.aabb);
     let d = aabb.diameter();
     Body {
         id: new,
-        rd: ctx.dl.first(d),
+        first_round: ctx.dl.first(d),
         aabb,
-        d,
+        diameter: d,
     }
 }
 
@@ -235,18 +238,18 @@ pub(super) fn merged(ctx: &Ctx, x: &Body, y: &Body, new: u32) -> Body {
 /// events read (Fill, Balance, Cost, `queue_len`) when someone listens.
 #[inline(always)]
 pub(super) fn put_merge(
-    ctx: &Ctx,
-    out: &mut Out<'_>,
+    ctx: &RunInputs,
+    out: &mut MergeSlots<'_>,
     made: usize,
     [x, y]: [&Body; 2],
     nb: &Body,
     round: u32,
     queue_len: impl FnOnce() -> u32,
 ) {
-    let d = nb.d;
+    let d = nb.diameter;
     let info = if out.listens() {
-        let (fill, balance) = fill_balance(d, x.d, y.d);
-        Info {
+        let (fill, balance) = fill_balance(d, x.diameter, y.diameter);
+        MergeInfo {
             round,
             fill,
             balance,
@@ -255,7 +258,7 @@ pub(super) fn put_merge(
             active: d <= ctx.dl.at(round),
         }
     } else {
-        Info::default()
+        MergeInfo::default()
     };
     out.put(made, [x.id.min(y.id), x.id.max(y.id)], nb.aabb, d, info);
 }
@@ -267,7 +270,7 @@ pub(super) fn leave(
     live: &[usize],
     export: bool,
     pair: impl Fn(usize, usize) -> (u64, u32),
-) -> Left {
+) -> Leftover {
     let pairs = if export {
         let mut v = Vec::with_capacity(live.len() * (live.len() - 1) / 2);
         for (x, &i) in live.iter().enumerate() {
@@ -280,7 +283,7 @@ pub(super) fn leave(
     for (k, &i) in live.iter().enumerate() {
         body[k] = body[i];
     }
-    Left {
+    Leftover {
         n: live.len(),
         pairs,
     }
@@ -293,38 +296,38 @@ pub(super) fn leave(
 /// choice is by Cost and tie tags). A part's pairs, when given, are used instead of evaluating
 /// them again.
 pub(super) fn combine(
-    ctx: &Ctx,
+    ctx: &RunInputs,
     body: &mut [Body],
-    parts: [Left; 2],
+    parts: [Leftover; 2],
     keep: usize,
-    out: &mut Out<'_>,
+    out: &mut MergeSlots<'_>,
     export: bool,
-) -> Left {
+) -> Leftover {
     if body.len() <= keep {
-        return Left {
+        return Leftover {
             n: body.len(),
             pairs: Vec::new(),
         };
     }
-    if body.len() <= super::tiny::TINY {
-        return super::tiny::run(ctx, body, parts, keep, out, export);
+    if body.len() <= super::all_pairs::TINY {
+        return super::all_pairs::run(ctx, body, parts, keep, out, export);
     }
     TABLE.with(|t| run(ctx, body, parts, keep, out, export, &mut t.borrow_mut()))
 }
 
 /// [`combine`] with the thread's table.
 fn run(
-    ctx: &Ctx,
+    ctx: &RunInputs,
     body: &mut [Body],
-    parts: [Left; 2],
+    parts: [Leftover; 2],
     keep: usize,
-    out: &mut Out<'_>,
+    out: &mut MergeSlots<'_>,
     export: bool,
     t: &mut Table,
-) -> Left {
+) -> Leftover {
     let m = body.len();
     debug_assert!(m <= SMALL && keep >= 1 && parts[0].n + parts[1].n == m);
-    let mut st = SubStats::default();
+    let mut st = Counters::default();
     let seed = ctx.params.seed;
     t.m = m;
     if t.cost.len() < m * m {

@@ -1,0 +1,198 @@
+//! The entry points of the partitioned schedule: the Morton order and the split planned, the
+//! executor run over it, the events announced and the Subset Tree assembled.
+
+use super::announce::{Built, announce};
+use super::brute_force::RoundLimits;
+use super::executor::Executor;
+use super::plan::{Chunking, plan};
+use super::split::morton_order;
+use super::subproblem::{Body, Counters, MergeInfo, MergeSlots, RunInputs};
+use crate::events::{Event, Observer};
+use crate::geom::Aabb;
+use crate::grouping::cluster;
+use crate::grouping::subset_tree::SubsetTree;
+use crate::grouping::voxel_hash::prefetch;
+use crate::grouping::{Budget, Grouping, PSet, ResolvedParams, Stats, StopReason, Stopped};
+use crate::scene::Scene;
+use rayon::prelude::*;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
+/// How many leaves ahead the gather asks for the box it will read (its reads are random).
+const GATHER_AHEAD: usize = 16;
+
+/// The default [`Chunking`] with the root share `params.mode` names.
+fn chunking_of(params: &ResolvedParams) -> Chunking {
+    Chunking {
+        top: params.mode.chunk_top,
+        epsilon: params.mode.chunk_epsilon,
+        sah_below: params.mode.chunk_sah,
+        ..Chunking::DEFAULT
+    }
+}
+
+/// Runs the partitioned schedule with the default [`Chunking`].
+pub(crate) fn run<O: Observer>(
+    scene: &Scene,
+    params: &ResolvedParams,
+    observer: O,
+    budget: &Budget<'_>,
+) -> Result<Grouping, Stopped> {
+    group_with(scene, params, &chunking_of(params), observer, budget)
+}
+
+/// Runs the partitioned schedule on primitive boxes (see [`group_boxes`]) with the default
+/// [`Chunking`].
+pub(crate) fn run_boxes<O: Observer>(
+    aabb: Vec<Aabb>,
+    params: &ResolvedParams,
+    observer: O,
+    budget: &Budget<'_>,
+) -> Result<Grouping, Stopped> {
+    group_boxes(aabb, params, &chunking_of(params), observer, budget)
+}
+
+/// Runs the partitioned schedule with `chunking` instead of [`Chunking::DEFAULT`] (see the module
+/// doc); `params.mode` is not read. Panics only if the scene is empty.
+pub fn group_with<O: Observer>(
+    scene: &Scene,
+    params: &ResolvedParams,
+    chunking: &Chunking,
+    observer: O,
+    budget: &Budget<'_>,
+) -> Result<Grouping, Stopped> {
+    assert!(!scene.is_empty(), "grouping needs at least one primitive");
+    if params.pset == PSet::Hull {
+        return cluster::run(scene, params, observer, budget);
+    }
+    let n = scene.len();
+    // Room for the merged bodies from the start (no copy when they are added).
+    let mut aabb: Vec<Aabb> = Vec::with_capacity(2 * n - 1);
+    aabb.par_extend((0..n).into_par_iter().map(|i| scene.prim_aabb(i)));
+    group_boxes(aabb, params, chunking, observer, budget)
+}
+
+/// The partitioned schedule (AABB p-set) on primitives whose boxes are `aabb`, the primitive
+/// ids being their indices (`aabb` grows to the tree's 2N − 1 boxes: give it that capacity to
+/// spare a copy). Panics only if `aabb` is empty.
+pub fn group_boxes<O: Observer>(
+    mut aabb: Vec<Aabb>,
+    params: &ResolvedParams,
+    chunking: &Chunking,
+    mut observer: O,
+    budget: &Budget<'_>,
+) -> Result<Grouping, Stopped> {
+    assert!(!aabb.is_empty(), "grouping needs at least one primitive");
+    let n = aabb.len();
+    aabb.reserve_exact(n - 1);
+    let mut diameter: Vec<f64> = Vec::with_capacity(2 * n - 1);
+    diameter.par_extend(aabb.par_iter().map(Aabb::diameter));
+    let mut codes = morton_order(&aabb);
+    // The leaves as bodies in Morton order: one gather (its loads overlap) instead of one per
+    // chunk, of the box alone (the diameter is recomputed, the same value, rather than read at
+    // random from a second array); `rd` is set by their chunk.
+    let mut leaves: Vec<Body> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            if let Some(&(_, ahead)) = codes.get(i + GATHER_AHEAD) {
+                prefetch(&aabb[ahead as usize]);
+            }
+            let id = codes[i].1;
+            let aabb = aabb[id as usize];
+            Body {
+                id,
+                first_round: 0,
+                aabb,
+                diameter: aabb.diameter(),
+            }
+        })
+        .collect();
+    // Planned on the leaves themselves: the SAH cuts read their boxes in order, and reorder
+    // them with their codes.
+    let nodes = plan(&mut codes, &mut leaves, chunking);
+    drop(codes);
+    let ctx = RunInputs {
+        params: *params,
+        dl: RoundLimits::new(params.dlimit0),
+        gl: RoundLimits::new(params.glimit0),
+        budget,
+        pairs: AtomicU64::new(0),
+        halt: AtomicBool::new(false),
+        reason: Mutex::new(None),
+    };
+    let merges = n - 1;
+    let mut children = vec![[0u32; 2]; merges];
+    // The merges' slots, filled on every thread (fresh pages are written, and faulted in, in
+    // parallel).
+    aabb.par_extend(rayon::iter::repeat_n(Aabb::EMPTY, n - 1));
+    diameter.par_extend(rayon::iter::repeat_n(0.0, n - 1));
+    let listens = !observer.is_silent();
+    let mut info = if listens {
+        vec![MergeInfo::default(); merges]
+    } else {
+        Vec::new()
+    };
+    let done: Vec<AtomicBool> = nodes.iter().map(|_| AtomicBool::new(false)).collect();
+    let exec = Executor {
+        ctx: &ctx,
+        nodes: &nodes,
+        done: &done,
+    };
+    let (_, new_aabb) = aabb.split_at_mut(n);
+    let (_, new_d) = diameter.split_at_mut(n);
+    let out = MergeSlots {
+        first_new: n as u32,
+        children: &mut children,
+        aabb: new_aabb,
+        diameter: new_d,
+        info: listens.then_some(&mut info[..]),
+        stats: Counters::default(),
+    };
+    let (result, sub) = exec.node(0, &mut leaves, out, false);
+    // Events, in post-order, up to the first unfinished subproblem.
+    let emitted = if listens || result.is_none() {
+        let made = Built {
+            n,
+            children: &children,
+            aabb: &aabb,
+            diameter: &diameter,
+            info: &info,
+        };
+        announce(&mut observer, &nodes, &done, &made, listens)
+    } else {
+        0
+    };
+    if result.is_none() {
+        let reason = ctx
+            .reason
+            .lock()
+            .expect("no panics hold it")
+            .unwrap_or(StopReason::Interrupted);
+        return Err(Stopped {
+            reason,
+            merges: emitted,
+            rounds: 0,
+            eligible_pairs: ctx.pairs.load(Ordering::Relaxed),
+        });
+    }
+    let tree = SubsetTree::new(aabb, diameter, children)
+        .expect("the partitioned schedule makes exactly N - 1 valid merges");
+    observer.on_event(&Event::Finish {
+        root: tree.root(),
+        rounds: sub.rounds,
+        merges: merges as u32,
+    });
+    Ok(Grouping {
+        tree,
+        rounds: sub.rounds,
+        params: *params,
+        stats: Stats {
+            eligible_pairs: sub.eligible_pairs,
+            candidates: sub.candidates,
+            pops: sub.pops,
+            stale_pops: sub.stale_pops,
+            peak_queue: sub.peak_queue,
+        },
+        pregrouping: None,
+    })
+}
