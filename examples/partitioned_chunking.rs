@@ -1,6 +1,7 @@
 //! The partitioned schedule's chunking against the exact schedule's tree, on the targets
 //! scenes: SAH and node tests per query (AABB BVs, standard workload) of each chunking's tree
-//! over the exact tree's, and its grouping time on one thread. How the defaults were chosen.
+//! over the exact tree's, and its grouping time on one thread. How the defaults were chosen
+//! (`docs/benchmarks.md`).
 //!
 //! `cargo run --release --example partitioned_chunking [MAX_SOUP] [DELTA:EPSILON[:TOP[:SAH]] ...]
 //! [FILE.obj ...]` — default 100000 and the default chunking and 20:0.1 (AAC's high-quality

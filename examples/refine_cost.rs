@@ -2,12 +2,13 @@
 //! over an obvhs PLOC build timed in the same process (both on the default rayon pool), and the
 //! SAH and node tests per query (AABB BVs, standard workload) of grouping + that refinement
 //! over the best peer's (the lower of parry Binned and obvhs PLOC + reinsertion, as
-//! `wraptree bench`). How the refinement's defaults were chosen.
+//! `wraptree bench`). How the refinement's defaults were chosen (`docs/benchmarks.md`).
 //!
 //! `cargo run --release --example refine_cost [MAX_SOUP] [REPEAT] [VARIANT ...]` — default
-//! 100000, 3 and the default refinement; `scene=NAME` arguments keep only those scenes. A variant is `T:K:P:B[:G[:E[:after]]]`: T
-//! treelet passes of K leaves rooted at the nodes of at least G leaves on every E-th height
-//! (defaults: [`Tuning::default`]'s; G = 0 is γ by the scene's size, [`Tuning::gamma`]), then P reinsertion passes of first batch B (`after`: the
+//! 100000, 3 and the default refinement; `scene=NAME` arguments keep only those scenes. A
+//! variant is `T:K:P:B[:G[:E[:after]]]`: T treelet passes of K leaves rooted at the nodes of at
+//! least G leaves on every E-th height (defaults: [`Tuning::default`]'s; G = 0 is γ by the
+//! scene's size, [`Tuning::gamma`]), then P reinsertion passes of first batch B (`after`: the
 //! treelet passes after them); `default` is the defaults.
 
 use std::time::Instant;

@@ -1,12 +1,9 @@
 //! wraptree: build, record and inspect bounding-volume hierarchies with the bottom-up grouping
 //! phase of Xavier, "A Generic Algorithm for Constructing Hierarchical Representations of
-//! Geometric Objects".
+//! Geometric Objects". The modules are layers, each using only those below it
+//! (`docs/architecture.md`); the algorithm is described in `docs/method.md`.
 //!
-//! Data flows [`scene`] → [`grouping`] (Subset Tree, §2.2) → [`wrap`] (Wrapper Trees, §2.4) →
-//! [`record`] (`.rrd`, `.mcap`), [`replay`], [`render`], [`metrics`] and [`query`]; [`peers`]
-//! wraps the hierarchies it is compared with, and [`geom`] is the small geometry every stage
-//! shares. Each `wraptree` command is a thin layer over one entry point here, and what it prints
-//! is built here too:
+//! Each `wraptree` command is one call here, and what it prints is built here too:
 //!
 //! | command | entry point | what it prints |
 //! |---|---|---|

@@ -10,12 +10,9 @@
 //! own steps (load the embedded scene, rebuild the Subset Tree from the merges) without panicking,
 //! or an error whose text is one line starting with the file's path.
 //!
-//! Cases: 1,536 by default (a few seconds in release); `WRAPTREE_FUZZ_CASES=200000` runs a long
-//! campaign and `WRAPTREE_FUZZ_SEED=N` changes the (otherwise fixed) random stream:
-//!
-//! ```sh
-//! WRAPTREE_FUZZ_CASES=20000 cargo test --release --test fuzz_mcap -- --nocapture
-//! ```
+//! Cases: 1,536 by default; `WRAPTREE_FUZZ_CASES=N` runs a longer campaign and
+//! `WRAPTREE_FUZZ_SEED=N` changes the (otherwise fixed) random stream (`docs/stability.md`,
+//! "Fuzzing").
 
 mod common;
 
@@ -210,7 +207,7 @@ const VALUES: &[&str] = &[
 /// A structural or byte-level edit of a recording.
 #[derive(Clone, Debug)]
 enum Edit {
-    /// Set the k-th key of the run record (among its keys and the README's) to a value.
+    /// Set the k-th key of the run record (among its keys and `metadata::KEYS`) to a value.
     MetaSet(usize, &'static str),
     /// Remove the k-th key of the run record.
     MetaDelete(usize),

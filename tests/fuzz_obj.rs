@@ -9,12 +9,9 @@
 //! within their primitive), which then groups within a budget, or it returns an error whose
 //! text is one line starting with the file name.
 //!
-//! Cases: 16,384 by default (a few seconds in release); `WRAPTREE_FUZZ_CASES=200000` runs a long
-//! campaign, and `WRAPTREE_FUZZ_SEED=N` changes the (otherwise fixed) random stream:
-//!
-//! ```sh
-//! WRAPTREE_FUZZ_CASES=200000 cargo test --release --test fuzz_obj -- --nocapture
-//! ```
+//! Cases: 16,384 by default; `WRAPTREE_FUZZ_CASES=N` runs a longer campaign and
+//! `WRAPTREE_FUZZ_SEED=N` changes the (otherwise fixed) random stream (`docs/stability.md`,
+//! "Fuzzing").
 
 mod common;
 

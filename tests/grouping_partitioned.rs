@@ -393,8 +393,8 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
     let out = wraptree(&["replay", "e.mcap", "--verify"], dir.path());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success() && text.contains("verified"), "{text}");
-    // Morton cuts throughout (the split before the SAH cuts): another run, recorded and
-    // reproduced; a recording that does not name its SAH cuts (made before them) reads as one.
+    // Morton cuts throughout (`--chunk-sah 0`): another run, recorded and reproduced; a
+    // recording without a `chunk_sah` key reads as one.
     let out = wraptree(
         &[&args[..], &["m", "--chunk-top", "256", "--chunk-sah", "0"]].concat(),
         dir.path(),

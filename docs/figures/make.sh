@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the README's figure sheets (docs/figures/*.png) like the paper's Figures 1–3:
+# Regenerates the figure sheets in docs/figures/ like the paper's Figures 1–3, and the charts:
 #   bash docs/figures/make.sh
 # Builds the release binary, renders each scene into a temporary directory with
 # `wraptree snapshot` and keeps only the sheet (figure.png). Deterministic: same bytes each run.

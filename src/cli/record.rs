@@ -60,9 +60,9 @@ pub struct RecordCmd {
     /// is less than half leaves; the .rrd always has every level).
     #[arg(long)]
     all_levels: bool,
-    /// Refine the finished tree (treelet restructuring, then reinsertion, see the README) and
-    /// record each step on the
-    /// `refine` timeline / `/refine/step` topic; the levels are then the refined tree's.
+    /// Refine the finished tree (treelet restructuring, then reinsertion, see docs/method.md)
+    /// and record each step on the `refine` timeline / `/refine/step` topic; the levels are then
+    /// the refined tree's.
     #[arg(long)]
     refine: bool,
     /// Most refinement passes (with --refine).

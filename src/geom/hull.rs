@@ -2,28 +2,10 @@
 //! the hull Wrapper Trees. Vertices are stored in `f64` and are always input points; parry
 //! (`f32`) only decides which points are on the hull.
 //!
-//! Degenerate input is normal here (one polygon is flat; duplicates; collinear points). The
-//! dimension is decided first in `f64` from the extents along the principal axes
-//! ([`Frame::principal`]): a point, a segment, a flat polygon (Andrew's monotone chain in the
-//! plane of best fit, fan-triangulated, one side), or a solid. Solids go to parry's fallible
-//! `try_convex_hull` in the principal frame with every axis scaled to [−1, 1] (the hull is
-//! affine-invariant, so thin sets are well-conditioned), guarded by `catch_unwind` (parry issue
-//! #49). Points that round to the same `f32` are given to parry once: `f32` keeps 24 bits, so
-//! a node whose sizes span many decades has distinct points closer than 6e-8 of its extent,
-//! and parry then returns a non-manifold, non-convex mesh.
-//!
-//! **Check and fallbacks**: every solid is accepted only if [`is_convex_cover`] holds in `f64`:
-//! a closed, consistently oriented mesh whose every face plane has all the node's points behind
-//! it (within the tolerance). "Every point lies on or inside the mesh" is not enough: a folded
-//! mesh through all the hull's vertices passes it. When parry's hull fails, parry is retried
-//! with uniform scaling, then an incremental hull in `f64` (`incremental`) is built; if that
-//! fails too (ill-conditioned input), the node gets its principal-axes box ([`Hull::exact`] is
-//! false): a correct but looser convex wrapper, and the parent is built from the node's points.
-//! Nothing here panics.
-//!
-//! **Tolerance**: because parry decides in `f32`, a point it drops may lie outside the `f64`
-//! hull by about 1e-7 of the node's extent; tests allow [`HULL_TOL_REL`] × the node's AABB
-//! diameter.
+//! Degenerate input is normal here (one polygon is flat; duplicates; collinear points), so the
+//! dimension is decided first in `f64`, and every solid from parry is checked in `f64`
+//! ([`is_convex_cover`]), with fallbacks when the check fails ([`hull_of`]). Nothing here
+//! panics.
 
 use super::{P3, V3};
 use crate::geom::pca::Frame;
@@ -32,7 +14,8 @@ use std::collections::HashMap;
 
 mod incremental;
 
-/// Containment tolerance of hulls, relative to the node's AABB diameter (parry is `f32`).
+/// Containment tolerance of hulls, relative to the node's AABB diameter: parry decides in
+/// `f32`, so a point it drops may lie outside the `f64` hull by about 1e-7 of the node's extent.
 pub const HULL_TOL_REL: f64 = 1e-5;
 /// Extents below this fraction of the largest extent count as zero (flat or collinear).
 pub const FLAT_REL: f64 = 1e-9;
@@ -108,6 +91,14 @@ impl Hull {
 }
 
 /// The hull of `points`, and the points themselves when the hull is only a fallback box.
+///
+/// The dimension is decided from the extents along the principal axes ([`Frame::principal`]):
+/// a point, a segment, a flat polygon (Andrew's monotone chain in the plane of best fit,
+/// fan-triangulated, one side), or a solid. A solid is parry's hull in a scaled principal frame,
+/// accepted only if [`is_convex_cover`] holds; else parry is retried with uniform scaling, then
+/// an incremental hull in `f64` (`incremental`) is built; if that fails too (ill-conditioned
+/// input), the result is the principal-axes box ([`Hull::exact`] is false): a correct but
+/// looser convex wrapper, and the caller builds the parent from the returned points.
 pub fn hull_of(mut points: Vec<P3>) -> (Hull, Option<Vec<P3>>) {
     dedup(&mut points);
     let one = |vertices: Vec<P3>, dim| Hull {
@@ -138,7 +129,7 @@ pub fn hull_of(mut points: Vec<P3>) -> (Hull, Option<Vec<P3>>) {
         return (flat_hull(&points, &frame, big, mid), None);
     }
     // Parry's f32 quickhull can return a folded mesh on near-degenerate input (12-decade
-    // scenes, the 12,144-polygon scene): see the module docs for the check and the fallbacks.
+    // scenes, the 12,144-polygon scene): check it, and fall back as the doc comment says.
     let tol = HULL_TOL_REL * ext.norm();
     let valid = |h: Hull| is_convex_cover(&h, &points, tol).then_some(h);
     let solid = solid_hull(&points, &frame, lo, hi, false)
@@ -154,6 +145,8 @@ pub fn hull_of(mut points: Vec<P3>) -> (Hull, Option<Vec<P3>>) {
 /// Whether `h` is a solid whose surface is closed (every directed edge once, its reverse once)
 /// and whose every face plane has all `points` at most `tol` in front of it: then `h` is convex
 /// and holds every point within `tol`. Zero-area faces have no plane and are not checked.
+/// "Every point lies on or inside the mesh" would not be enough: a folded mesh through all the
+/// hull's vertices passes it.
 pub fn is_convex_cover(h: &Hull, points: &[P3], tol: f64) -> bool {
     if h.dim != 3 || h.triangles.len() < 4 {
         return false;
@@ -249,6 +242,12 @@ fn flat_hull(points: &[P3], frame: &Frame, u: usize, v: usize) -> Hull {
 
 /// The solid hull by parry in the principal frame, each axis scaled to [-1, 1] (or all by the
 /// largest extent when `uniform`); `None` if parry fails or panics.
+///
+/// The hull is affine-invariant, so the scaling makes thin sets well-conditioned. parry's
+/// `try_convex_hull` is guarded by `catch_unwind` (parry issue #49). Points that round to the
+/// same `f32` are given to parry once: `f32` keeps 24 bits, so a node whose sizes span many
+/// decades has distinct points closer than 6e-8 of its extent, and parry then returns a
+/// non-manifold, non-convex mesh.
 fn solid_hull(points: &[P3], frame: &Frame, lo: V3, hi: V3, uniform: bool) -> Option<Hull> {
     let mid = (lo + hi) / 2.0;
     let half = if uniform {

@@ -1,39 +1,20 @@
 //! The grouping phase of §2.2: bottom-up greedy clustering of convex primitives into a binary
-//! Subset Tree.
+//! Subset Tree (`docs/method.md`, "The grouping phase").
 //!
-//! The paper's steps and where they live:
-//!
-//! 1. *GLimit* (largest gap between merged bodies) and *DLimit* (largest diameter of a body that
-//!    may merge) start at [`ResolvedParams::dlimit0`]/[`ResolvedParams::glimit0`]
+//! The paper's steps and where they are done:
+//! 1. DLimit and GLimit start at [`ResolvedParams::dlimit0`]/[`ResolvedParams::glimit0`]
 //!    ([`Params::resolve`]).
-//! 2. One parent-less body left → it is the root. Otherwise parent-less bodies with
-//!    diameter ≤ DLimit are active (*ABods*), the rest dormant (*DBods*) — `cluster::run`, top of
-//!    its round loop.
-//! 3. Active body centres go into a voxel hash with cell size CSize = DLimit + GLimit
-//!    ([`voxel_hash::VoxelHash`]); scanning the voxels around each body (at round start each
-//!    pair of cells once for the AABB p-set, see `cluster::scan`) and filtering by GLimit gives
-//!    the eligible pairs, queued in *MPairs* by Cost ([`mpairs::MPairs`]).
-//! 4. Until MPairs is empty: (a) pop the cheapest pair, skipping pairs that lost a member, and
-//!    merge it; (b) if the new body obeys DLimit it becomes active, enters the hash and its
-//!    eligible pairs are queued; (c) otherwise it goes dormant — `cluster::run`, inner loop.
-//! 5. Double DLimit and GLimit and go to 2 — end of the round loop.
+//! 2. One parent-less body left is the root; otherwise those with diameter ≤ DLimit are active,
+//!    the rest dormant (`cluster::run`, top of its round loop).
+//! 3. Active centres go into a voxel hash of cell size DLimit + GLimit ([`voxel_hash::VoxelHash`]);
+//!    the scans around each body (`cluster::scan`) queue the eligible pairs in MPairs
+//!    ([`mpairs::MPairs`]) by Cost ([`Weights::cost`]).
+//! 4. Pop the cheapest pair and merge it; the new body is searched and queued if it obeys
+//!    DLimit, else it goes dormant (`cluster::run`, inner loop).
+//! 5. When MPairs is empty, double DLimit and GLimit and go to 2 (end of the round loop).
 //!
-//! Cost = diameter^A × (B·Fill + C·Balance) ([`Weights::cost`]), Fill = parent diameter / sum of
-//! child diameters, Balance = greater ratio of the child diameters.
-//!
-//! MPairs keeps one entry per active body: the first live entry of its partner list (the AABB
-//! p-set's four cheapest eligible partners at the body's last search; the hull p-set's single
-//! best). When a popped entry's partner has merged away, the next live list entry replaces it;
-//! only a used-up list triggers a new search. Because pair Costs are symmetric and fixed, the
-//! pair popped at every step is the global minimum over all eligible pairs (argument in
-//! [`mpairs`]), exactly the pair the literal queue would pop, so the tree is the same; the
-//! queue is O(N) instead of O(kN). Ties break by the pair's (smaller id, larger id), or by seeded random tags with
-//! `--seed`.
-//!
-//! [`group_within`] runs under a [`Budget`] (a stop flag, a deadline, a cap on the eligible
-//! pairs of step 3), checked between merges and between the bodies of a round-start scan, and
-//! returns [`Stopped`] with the reason when one is exceeded; the merges made so far are the
-//! unlimited run's first ones.
+//! MPairs holds each active body's cheapest partners, yet pops the global minimum ([`mpairs`]).
+//! [`group_within`] stops at a [`Budget`] with [`Stopped`], after the unlimited run's first merges.
 
 mod cluster;
 

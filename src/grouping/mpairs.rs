@@ -1,17 +1,10 @@
-//! MPairs, the priority queue of eligible pairs ordered by increasing Cost (steps 3–4), and the
-//! short partner lists it is fed from.
+//! MPairs, the priority queue of eligible pairs by increasing Cost (steps 3–4), and the short
+//! partner lists it is fed from.
 //!
-//! Every active body owns a list of its cheapest eligible partners, the first few of all its
-//! partners in key order, as found when the body last searched (at round start, when it was
-//! made, or when its list ran out). The queue holds one entry per active body: the first entry
-//! of its list whose partner was alive when queued. An entry whose owner has merged is dropped
-//! when popped; one whose partner has merged is replaced by the next list entry with a live
-//! partner, and only when the list is used up does the owner search again.
-//!
-//! Ordering is total: (Cost, smaller tie tag, larger tie tag, owner), so runs are
-//! deterministic. Entries are 16 bytes (Cost, owner, partner); the tie tags are read from the
-//! caller's tag array only when two Costs are equal. The queue is a 4-ary heap, so one step
-//! down reads one cache line of children.
+//! Every active body keeps its first few partners in key order, found when it last searched.
+//! The queue holds one entry per active body: the first list entry whose partner was alive. An
+//! entry whose owner merged is dropped when popped; one whose partner merged is replaced by the
+//! next live list entry, and only a used-up list makes its owner search again.
 //!
 //! # Why the popped pair is the global minimum
 //!
@@ -65,7 +58,11 @@ pub fn order_bits(cost: f64) -> u64 {
     b ^ ((((b as i64) >> 63) as u64) | (1 << 63))
 }
 
-/// The queue: a 4-ary min-heap of [`Entry`].
+/// The queue: a 4-ary min-heap of [`Entry`], so one step down reads one cache line of children.
+///
+/// The order is total, (Cost, smaller tie tag, larger tie tag, owner), so runs are deterministic.
+/// Entries are 16 bytes; the tie tags are read from the caller's tag array only when two Costs
+/// are equal.
 #[derive(Debug, Default)]
 pub struct MPairs {
     heap: Vec<Entry>,

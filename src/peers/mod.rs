@@ -1,33 +1,18 @@
 //! Our grouping phase beside its peers, on the same primitives, each as a [`SubsetTree`] so
 //! that quality measures (SAH, depth, balance), Wrapper Trees ([`crate::wrap`]) and queries
-//! ([`crate::query`]) measure every hierarchy the same way.
+//! ([`crate::query`]) measure every hierarchy the same way (`docs/benchmarks.md`, "What is
+//! measured").
 //!
-//! - [`Method::Grouping`], [`Method::GroupingHull`]: the paper's grouping phase (§2.2) with AABB
-//!   or convex-hull p-sets; [`Method::GroupingPartitioned`]: the same step in the partitioned
-//!   schedule ([`crate::grouping::partitioned`]);
+//! - [`Method::Grouping`], [`Method::GroupingHull`], [`Method::GroupingPartitioned`]: the
+//!   paper's grouping phase (§2.2) with AABB or hull p-sets, and in the partitioned schedule;
 //! - [`Method::GroupingPregroup`], [`Method::GroupingInstanced`], [`Method::GroupingObjects`]:
-//!   the same with the paper's §1.3 speed-ups ([`crate::grouping::pregroup`]): connected
-//!   components (or the scene's objects) grouped first, in parallel on the current rayon
-//!   pool, and rigid copies copy-moved;
+//!   the same with the paper's §1.3 speed-ups ([`crate::grouping::pregroup`]);
 //! - [`parry_bvh`]: parry3d's `Bvh`, binned SAH or PLOC, as published;
 //! - [`obvhs_ploc`]: obvhs's PLOC, with or without its reinsertion optimiser, as published;
 //! - [`median_split`]: a top-down median split;
 //! - [`goldsmith_salmon`]: Goldsmith–Salmon incremental insertion;
 //! - `…+refine` ([`Method::is_refined`]): a builder's tree then [`crate::refine`] with default
 //!   parameters (grouping, parry Binned, obvhs PLOC).
-//!
-//! A peer's reported time covers its own build only, from primitive boxes (`f32` relative to the
-//! scene centre for parry and obvhs, `f64` for ours) to its native tree; reading its topology
-//! into a Subset Tree ([`topology`]) is not timed. Box computation per primitive is shared and
-//! not timed either: the grouping and partitioned grouping (AABB p-set) are timed from the
-//! boxes, DLimit0's median included ([`grouping::group_boxes`]); the hull p-set and the
-//! pre-grouped methods, which need the polygons, from the scene. The partitioned grouping, the
-//! exact grouping's round-start scans (rounds of at least 2,048 active bodies), the pre-grouped
-//! methods (whose time includes finding the components and the copies) and obvhs PLOC (built
-//! with its `parallel` feature) use the current rayon pool (run them inside
-//! `ThreadPool::install` to choose the thread count); every other builder is single-threaded.
-//! The refinement pass searches on rayon's threads and its time is added to the builder's: a
-//! refined method's time is the total, [`Built::refine_seconds`] the refinement's part.
 
 pub mod goldsmith_salmon;
 pub mod median_split;
@@ -171,7 +156,7 @@ pub struct Built {
     pub method: Method,
     /// The hierarchy as a Subset Tree (boxes recomputed in `f64`).
     pub tree: SubsetTree,
-    /// Build time in seconds (see the module doc for what is timed).
+    /// Build time in seconds (see [`build`] for what is timed).
     pub seconds: f64,
     /// Grouping work counters (grouping methods only).
     pub stats: Option<Stats>,
@@ -181,6 +166,18 @@ pub struct Built {
 
 /// Builds `method`'s hierarchy over `scene`; `params` is used by the grouping methods (the hull
 /// variant overrides the p-set). Fails only if a peer's tree is malformed (a bug).
+///
+/// The time covers the method's own build only, from primitive boxes (`f32` relative to the
+/// scene centre for parry and obvhs, `f64` for ours) to its native tree; reading its topology
+/// into a Subset Tree ([`topology`]) and the boxes per primitive are not timed. The AABB
+/// groupings are timed from the boxes, DLimit0's median included ([`grouping::group_boxes`]);
+/// the hull p-set and the pre-grouped methods (which need the polygons) from the scene,
+/// including finding the components and the copies. The partitioned grouping, the exact
+/// grouping's round-start scans (rounds of at least 2,048 active bodies), the pre-grouped
+/// methods and obvhs PLOC (its `parallel` feature) use the current rayon pool (run them inside
+/// `ThreadPool::install` to choose the thread count); the other builders are single-threaded.
+/// A refined method's time includes the refinement (which searches on rayon's threads);
+/// [`Built::refine_seconds`] is its part.
 pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, String> {
     let base = method.base();
     let mut built = build_base(base, scene, params)?;

@@ -7,30 +7,13 @@
 //! - [`scene_distance`], [`overlap`] ([`pair`]) — scene–scene distance by branch and bound on
 //!   the bounding-volume test tree (BVTT), and overlap with an early exit at the first touching
 //!   primitive pair;
-//! - [`fn@moved`] ([`mod@moved`]) — a rigidly moved copy of a tree and scene (the other object of a
-//!   scene–scene query);
-//! - [`mod@reference`] — brute force over all primitives, the exact answers the tests compare with;
+//! - [`fn@moved`] ([`mod@moved`]) — a rigidly moved copy of a tree and scene;
+//! - [`mod@reference`] — brute force over all primitives, the exact answers the tests compare
+//!   with;
 //! - [`Workload`] and [`measure`] ([`workload`]) — a seeded standard workload and its mean cost.
 //!
-//! **Primitives are their surfaces**: the triangles of [`Scene::prim_tris`]; a primitive with
-//! no triangles is the closed polygon through its vertices ([`Scene::prim`]), as in
-//! [`crate::wrap::distance::point_prim`]. The distance between two primitives is the exact `f64`
-//! minimum distance between their triangle (or edge) sets ([`prim::prim_prim`]): two triangles
-//! are 0 apart when an edge of one crosses the other, otherwise the minimum of 6 vertex–triangle
-//! and 9 edge–edge distances ([`crate::geom::distance::triangle_triangle`]); degenerate triangles
-//! and segments are measured as their edges and points. Two primitives *touch* when that
-//! distance is 0; scenes overlap when some pair touches.
-//!
-//! **What is counted.** A BV test is one node–point or node–node bound: point–AABB, point–sphere,
-//! AABB–AABB, sphere–sphere (or AABB–sphere when the two hierarchies use different [`Bv`]s), on
-//! interior nodes and leaves alike, the root included. A primitive test is one point–primitive or
-//! primitive–primitive distance.
-//!
-//! **Bounds are safe lower bounds.** Boxes hold their vertices exactly (min/max), spheres up to
-//! rounding (the Wrapper Tree tests allow 1e-9 × the scene diagonal). Each bound subtracts a
-//! slack of [`SLACK_ULPS`] ulps of the coordinates' magnitude, plus [`SPHERE_SLACK_REL`] × the
-//! root box diagonal for spheres, so rounding never prunes the true answer; the cost is a few
-//! more tests on near-ties.
+//! Primitives are their surfaces ([`prim`]); bounds are lowered by a slack ([`SLACK_ULPS`]), so
+//! rounding never prunes the true answer.
 
 pub mod moved;
 pub mod pair;
@@ -53,6 +36,11 @@ use std::cmp::Ordering;
 
 /// Slack subtracted from every bound, in ulps (`f64::EPSILON`) of the larger of the root box's
 /// largest absolute coordinate and its diagonal.
+///
+/// Boxes hold their vertices exactly (min/max), spheres up to rounding (the Wrapper Tree tests
+/// allow 1e-9 × the scene diagonal, hence [`SPHERE_SLACK_REL`]). With the slack every bound is a
+/// safe lower bound, so rounding never prunes the true answer; the cost is a few more tests on
+/// near-ties.
 pub const SLACK_ULPS: f64 = 64.0;
 
 /// Extra slack for sphere bounds, relative to the root box diagonal: the containment tolerance
@@ -82,6 +70,11 @@ pub struct Hierarchy<'a> {
 }
 
 /// Work done by queries: eq. (1)'s `N_v` and `N_p`.
+///
+/// A BV test is one node–point or node–node bound: point–AABB, point–sphere, AABB–AABB,
+/// sphere–sphere (or AABB–sphere when the two hierarchies use different [`Bv`]s), on interior
+/// nodes and leaves alike, the root included. A primitive test is one point–primitive or
+/// primitive–primitive distance.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct Counts {
     /// Bounding-volume tests (node–point or node–node bounds evaluated).
@@ -113,7 +106,7 @@ impl Counts {
 }
 
 impl Hierarchy<'_> {
-    /// The slack subtracted from this hierarchy's bounds (see the module doc).
+    /// The slack subtracted from this hierarchy's bounds (see [`SLACK_ULPS`]).
     fn slack(&self) -> f64 {
         let root = &self.tree.aabb[self.tree.root() as usize];
         let diag = root.diameter();

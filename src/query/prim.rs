@@ -1,6 +1,12 @@
-//! Primitive tests: exact `f64` distances between two primitives' surfaces (each primitive's
-//! triangles, or its polygon edges when it has none). Point–primitive distances are
-//! [`crate::wrap::distance::point_prim`].
+//! Primitive tests: exact `f64` distances between two primitives' surfaces.
+//!
+//! A primitive is its triangles ([`Scene::prim_tris`]), or when it has none the closed polygon
+//! through its vertices ([`Scene::prim`]), as in [`crate::wrap::distance::point_prim`] (the
+//! point–primitive distance). Two triangles are 0 apart when an edge of one crosses the other,
+//! otherwise the minimum of 6 vertex–triangle and 9 edge–edge distances
+//! ([`triangle_triangle`]); degenerate triangles and segments are measured as their edges and
+//! points. Two primitives *touch* when their distance is 0; scenes overlap when some pair
+//! touches.
 
 use crate::geom::P3;
 use crate::geom::distance::{segment_segment, segment_triangle, triangle_triangle};

@@ -1,22 +1,7 @@
-//! A seeded standard query workload for one scene and its mean cost per query (eq. (1)).
-//!
-//! [`Workload::standard`] draws, with a ChaCha8 RNG seeded by `seed`:
-//! - 256 query **points** uniform in the scene's AABB scaled by 1.1 about its centre (each
-//!   half-extent at least 5% of the diagonal, so flat scenes get a slab), so about a quarter
-//!   fall outside the box;
-//! - 8 **near** poses of a copy of the scene: a uniform random rotation about the box centre,
-//!   then a translation along a uniform random direction `u` until a slab of width `gap`
-//!   perpendicular to `u` separates the vertices of the copy from the original's, with `gap`
-//!   uniform in [2%, 30%] of the diagonal. The surfaces lie within their vertices' hull, so the
-//!   scene–copy distance is at least `gap` (> 0), and near it;
-//! - 8 **touching** poses: a uniform random rotation, then the translation that puts the
-//!   centroid of a random triangle of the copy on the centroid of a random triangle of the
-//!   original (a random vertex when the scene has no triangles). The two triangles then cross
-//!   there, so the copy overlaps the original partially.
-//!
-//! [`measure`] runs all 256 point queries, a scene–copy distance query per near pose, and an
-//! overlap query per near and per touching pose (8 answers false, 8 true); moving the copies is
-//! not timed.
+//! A seeded standard query workload for one scene and its mean cost per query (eq. (1)):
+//! 256 points around the scene, 8 near poses and 8 touching poses of a rotated copy
+//! ([`Workload::standard`]), run by [`measure`]. `docs/benchmarks.md` ("What is measured")
+//! describes it as the benchmarks use it.
 
 use super::{Bv, Counts, Hierarchy, moved, moved_spheres, overlap, point_distance, scene_distance};
 use crate::geom::{P3, V3};
@@ -33,7 +18,7 @@ pub const C_V: f64 = 1.0;
 /// Cost of one primitive test in eq. (1) as [`measure`] reports it.
 pub const C_P: f64 = 1.0;
 
-/// Query points and poses of a copy of the scene (see the module doc).
+/// Query points and poses of a copy of the scene (see [`Workload::standard`]).
 #[derive(Clone, Debug)]
 pub struct Workload {
     /// Points for point–scene distance queries.
@@ -59,8 +44,22 @@ fn pose_about(rot: UnitQuaternion<f64>, from: &P3, to: &P3) -> Isometry3<f64> {
 }
 
 impl Workload {
-    /// The standard workload for `scene` (see the module doc); the same seed gives the same
-    /// workload. Panics if the scene is empty.
+    /// The standard workload for `scene`; the same seed gives the same workload. Panics if the
+    /// scene is empty.
+    ///
+    /// Drawn with a ChaCha8 RNG seeded by `seed`:
+    /// - 256 query **points** uniform in the scene's AABB scaled by 1.1 about its centre (each
+    ///   half-extent at least 5% of the diagonal, so flat scenes get a slab), so about a quarter
+    ///   fall outside the box;
+    /// - 8 **near** poses of a copy of the scene: a uniform random rotation about the box centre,
+    ///   then a translation along a uniform random direction `u` until a slab of width `gap`
+    ///   perpendicular to `u` separates the vertices of the copy from the original's, with `gap`
+    ///   uniform in [2%, 30%] of the diagonal. The surfaces lie within their vertices' hull, so
+    ///   the scene–copy distance is at least `gap` (> 0), and near it;
+    /// - 8 **touching** poses: a uniform random rotation, then the translation that puts the
+    ///   centroid of a random triangle of the copy on the centroid of a random triangle of the
+    ///   original (a random vertex when the scene has no triangles). The two triangles then
+    ///   cross there, so the copy overlaps the original partially.
     pub fn standard(scene: &Scene, seed: u64) -> Workload {
         assert!(!scene.is_empty(), "the workload needs a non-empty scene");
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -153,7 +152,9 @@ pub struct QueryCost {
 }
 
 /// Runs the whole workload on `tree` over `scene` with `bv` (sphere BVs are moved with each
-/// copy by [`moved_spheres`]).
+/// copy by [`moved_spheres`]): all 256 point queries, a scene–copy distance query per near pose,
+/// and an overlap query per near and per touching pose (8 answers false, 8 true); moving the
+/// copies is not timed.
 pub fn measure(tree: &SubsetTree, scene: &Scene, bv: Bv, workload: &Workload) -> QueryCost {
     let h = Hierarchy { tree, scene, bv };
     let mut counts = Counts::default();

@@ -1,37 +1,17 @@
-//! Refinement of a finished Subset Tree (the grouping's or any peer's): first treelet
-//! restructuring (Karras and Aila 2013, [`treelet`]): the treelets of up to 7 leaves rooted at
-//! the nodes of at least γ leaves (Karras and Aila's γ: 64 up to 65,536 primitives, more
-//! above, [`Tuning::gamma`]) rebuilt in their SAH-optimal
-//! shape, bottom-up; then subtrees are moved to where they lower the SAH
-//! ([`crate::grouping::sah`]) most, by insertion-based optimisation (Bittner, Hapala and Havran
-//! 2013) in the parallel form of Meister and Bittner 2018 ([`reinsert`]).
+//! Refinement of a finished Subset Tree (the grouping's or any peer's) to a lower SAH
+//! ([`crate::grouping::sah`]): treelet restructuring (Karras and Aila 2013, [`treelet`]), then
+//! insertion-based optimisation (Bittner, Hapala and Havran 2013) in the parallel form of
+//! Meister and Bittner 2018 ([`reinsert`]). See `docs/method.md`, "Refinement after the
+//! grouping".
 //!
-//! A run is a sequence of passes: `treelet_passes` treelet passes (a pass that rebuilds
-//! nothing ends them), then up to `passes` reinsertion passes. Reinsertion pass k (0-based) ranks
-//! the non-root nodes by how badly their parent fits them ([`reinsert::candidates`]) and
-//! searches the best reinsertion of the first ⌈batch × (2N − 2) / (2k + 1)⌉ of them, in
-//! parallel on the tree as it stands; the moves found are then applied one at a time, best
-//! first, each re-checked against the current tree and kept only if it lowers the SAH by more
-//! than 10⁻¹² of the root's area (else undone). The shrinking batches (1, 1/3, 1/5, …, as obvhs
-//! does) spend the later passes on the large nodes near the top. A pass that keeps no move
-//! ends the run early. A treelet is rebuilt only when that lowers the SAH by more than the
-//! same 10⁻¹² of the root's area.
-//!
-//! What holds for every input ([`refine`]):
-//! - the result is a Subset Tree: leaves `0..N` in input order, interior nodes renumbered so
-//!   that children precede parents, keeping the input's order where it still holds
-//!   ([`renumber`]); a tree no move improves is returned unchanged (every id kept);
-//! - SAH never above the input's: every kept move lowers it (and a final check against
-//!   [`crate::grouping::sah`] guards rounding);
-//! - deterministic: the same tree and parameters give the same moves, the same events and the
-//!   same result for any number of rayon threads (searches are pure functions of the frozen
-//!   tree, collected in candidate order; moves apply sequentially, ties broken by node id);
-//! - interior nodes whose leaf set changed take their box diagonal as diameter (the AABB
-//!   p-set's measure); the others keep the input's.
-//!
-//! Each rebuilt treelet and each kept move is a [`Step`] event (`Event::Refine`) for recorders:
-//! which treelet was rebuilt or which subtree moved from where to where, and the SAH after it. A tree whose root box has no area (all
-//! primitives in one point, or on one line) has nothing to gain and is returned unchanged.
+//! A run is `treelet_passes` treelet passes (a pass that rebuilds nothing ends them), then up to
+//! `passes` reinsertion passes. Reinsertion pass k searches, in parallel on the frozen tree, new
+//! places for the first ⌈batch × (2N − 2) / (2k + 1)⌉ nodes ranked by [`reinsert::candidates`],
+//! then applies the moves best first, each re-checked on the current tree. The shrinking batches
+//! (1, 1/3, 1/5, …, as obvhs does) spend the later passes on the large nodes near the top; a pass
+//! that keeps no move ends the run. A rebuilt treelet or a move is kept only when it lowers the
+//! SAH by more than 10⁻¹² of the root's area, and each kept one is a [`Step`] event
+//! (`Event::Refine`). What holds for every input is listed at [`refine`].
 
 pub use crate::events::{RefineParams, Step, StepKind};
 
@@ -62,8 +42,8 @@ pub struct Tuning {
 }
 
 impl Default for Tuning {
-    /// γ by the tree's size, treelets on every height, before the reinsertion passes (see the
-    /// README's refinement section for the measurements behind it).
+    /// γ by the tree's size, treelets on every height, before the reinsertion passes (measured
+    /// against the other variants in `docs/benchmarks.md`, "Refinement variants").
     fn default() -> Self {
         Tuning {
             treelet_min: 0,
@@ -75,11 +55,9 @@ impl Default for Tuning {
 
 impl Tuning {
     /// γ for a tree of `n` leaves: `treelet_min` if set, else the size rule: 64 up to 65,536
-    /// leaves (about 1/32 of the interior nodes; a treelet pass over every node costs 2–3 obvhs
-    /// PLOC builds), above that `n` rounded up to a power of two, over 1,024 (128 at 10^5 and
-    /// samurai-monastery's 124,705, 1,024 at 10^6). Measured on the bench scenes (README): at
-    /// 10^5–10^6 the larger γ is faster for the same SAH, and samurai-monastery's node tests
-    /// drop from 1.148 to 1.046 × the best peer's.
+    /// leaves (about 1/32 of the interior nodes, since treelets at every node cost several PLOC
+    /// builds), above that `n` rounded up to a power of two, over 1,024 (128 at 10^5, 1,024 at
+    /// 10^6), where the larger γ gives the same SAH in less time (`docs/benchmarks.md`).
     pub fn gamma(&self, n: usize) -> u32 {
         if self.treelet_min > 0 {
             return self.treelet_min;
@@ -105,6 +83,20 @@ pub struct Refined {
 
 /// Refines `tree` (see the module doc), reporting the start ([`Event::RefineStart`]) and each
 /// kept step ([`Event::Refine`]) to `observer`.
+///
+/// What holds for every input:
+/// - the result is a Subset Tree: leaves `0..N` in input order, interior nodes renumbered so
+///   that children precede parents, keeping the input's order where it still holds
+///   ([`renumber`]); a tree no step improves is returned unchanged (every id kept);
+/// - SAH never above the input's: every kept step lowers it (and a final check against
+///   [`crate::grouping::sah`] guards rounding);
+/// - deterministic: the same tree and parameters give the same steps, the same events and the
+///   same result for any number of rayon threads (searches are pure functions of the frozen
+///   tree, collected in candidate order; moves apply sequentially, ties broken by node id);
+/// - interior nodes whose leaf set changed take their box diagonal as diameter (the AABB
+///   p-set's measure); the others keep the input's;
+/// - a tree whose root box has no area (all primitives in one point, or on one line) has
+///   nothing to gain and is returned unchanged.
 pub fn refine<O: Observer>(tree: &SubsetTree, params: &RefineParams, observer: O) -> Refined {
     refine_tuned(tree, params, &Tuning::default(), observer)
 }

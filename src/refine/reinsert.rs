@@ -162,9 +162,9 @@ pub fn still_valid(w: &WorkTree, m: &Move) -> bool {
 /// The `count` most promising candidates of a pass (ties by id): the non-root nodes `x` ranked
 /// by A(p)² / min(A(x), A(s)) for parent `p` and sibling `s` — the parent's area times
 /// its inefficiency over its smaller child, after Bittner 2013's m_min × m_area measure, which
-/// that paper found best; here it ranks the children of inefficient, large parents. Measured
-/// against ranking by A(x) (obvhs, madmann91/bvh), A(p) and A(p)² / (A(x) + A(s)) on the bench
-/// scenes at the same batch: the lowest SAH and node tests for the same time (README).
+/// that paper found best; here it ranks the children of inefficient, large parents. Of the
+/// rankings tried (A(x) as obvhs and madmann91/bvh, A(p), A(p)² / (A(x) + A(s))) it gave the
+/// lowest SAH and node tests for the same time (`docs/benchmarks.md`, "Refinement variants").
 ///
 /// The set is what matters ([`find_all`]'s moves are sorted by gain afterwards), so it is
 /// selected, not sorted: returned in id order. Keys are computed on rayon's threads for large

@@ -102,7 +102,29 @@ impl Default for Scratch {
 /// The best restructuring of the treelet of up to `k` leaves rooted at `root`, if it lowers
 /// Σ interior area by more than `min_gain`.
 pub fn solve(w: &WorkTree, root: u32, k: usize, min_gain: f64, buf: &mut Scratch) -> Option<Plan> {
-    let k = k.clamp(3, MAX_LEAVES);
+    let (leaves, inner, n) = form(w, root, k.clamp(3, MAX_LEAVES));
+    if n < 3 {
+        return None;
+    }
+    let (leaves, inner) = (&leaves[..n], &inner[..n - 1]);
+    best_subtrees(w, leaves, buf);
+    let before: f64 = inner.iter().map(|&x| w.area[x as usize]).sum();
+    let gain = before - buf.cost[(1usize << n) - 1];
+    if gain <= min_gain {
+        return None;
+    }
+    Some(Plan {
+        root,
+        leaves: n as u32,
+        gain,
+        nodes: new_nodes(w, leaves, inner, buf),
+    })
+}
+
+/// The treelet of up to `k` leaves under `root`: its leaves, its interior nodes (root first)
+/// and how many leaves it has.
+#[inline]
+fn form(w: &WorkTree, root: u32, k: usize) -> ([u32; MAX_LEAVES], [u32; MAX_LEAVES - 1], usize) {
     // Formation: open the largest-area interior treelet leaf (ties: smaller id) until k leaves.
     let mut leaves = [NONE; MAX_LEAVES];
     let mut inner = [NONE; MAX_LEAVES - 1];
@@ -132,12 +154,14 @@ pub fn solve(w: &WorkTree, root: u32, k: usize, min_gain: f64, buf: &mut Scratch
         [leaves[i], leaves[n]] = w.kids(x);
         n += 1;
     }
-    if n < 3 {
-        return None;
-    }
-    let (leaves, inner) = (&leaves[..n], &inner[..n - 1]);
+    (leaves, inner, n)
+}
+
+/// Fills `buf` with the box, the best cost and the best split of every subset of `leaves`.
+#[inline]
+fn best_subtrees(w: &WorkTree, leaves: &[u32], buf: &mut Scratch) {
     let Scratch { boxes, cost, split } = buf;
-    let full = (1usize << n) - 1;
+    let full = (1usize << leaves.len()) - 1;
     // Boxes and best costs of every subset (cost = Σ interior area of its best subtree, 0 for
     // one leaf); a proper subset is always numerically smaller than its set.
     for s in 1..=full {
@@ -168,11 +192,18 @@ pub fn solve(w: &WorkTree, root: u32, k: usize, min_gain: f64, buf: &mut Scratch
         cost[s] = best + area(&boxes[s]);
         split[s] = best_p as u8;
     }
-    let before: f64 = inner.iter().map(|&x| w.area[x as usize]).sum();
-    let gain = before - cost[full];
-    if gain <= min_gain {
-        return None;
-    }
+}
+
+/// The restructured treelet's interior nodes, root first: each keeps the slot of an old node
+/// with the same leaf set where there is one, the other old slots are reused in order.
+fn new_nodes(
+    w: &WorkTree,
+    leaves: &[u32],
+    inner: &[u32],
+    buf: &Scratch,
+) -> Vec<(u32, [u32; 2], Aabb, bool)> {
+    let Scratch { boxes, split, .. } = buf;
+    let (n, full) = (leaves.len(), (1usize << leaves.len()) - 1);
     // The old interior slots by leaf set, to keep a slot where its set survives.
     let mask_of = |x: u32| -> usize {
         let mut m = 0;
@@ -225,7 +256,7 @@ pub fn solve(w: &WorkTree, root: u32, k: usize, min_gain: f64, buf: &mut Scratch
                 .expect("every set has a slot")]
         }
     };
-    let nodes = sets
+    sets
         .iter()
         .zip(&slot)
         .map(|(&s, &x)| {
@@ -237,13 +268,7 @@ pub fn solve(w: &WorkTree, root: u32, k: usize, min_gain: f64, buf: &mut Scratch
             let changed = old.iter().all(|&(y, m)| y != x || m != s);
             (x, kids, boxes[s], changed)
         })
-        .collect();
-    Some(Plan {
-        root,
-        leaves: n as u32,
-        gain,
-        nodes,
-    })
+        .collect()
 }
 
 /// The plans of `roots` (treelets of one height, disjoint) on the frozen tree, in root order.

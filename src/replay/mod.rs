@@ -164,8 +164,8 @@ pub fn rerun(
     }
 }
 
-/// A merge without `queue_len`, which depends on how MPairs stores pairs (it changed between
-/// versions), not on which pair merges.
+/// A merge without `queue_len`, which depends on how MPairs stores pairs (recordings made by
+/// other versions may differ), not on which pair merges.
 fn decision(m: &Merge) -> Merge {
     Merge { queue_len: 0, ..*m }
 }
@@ -188,7 +188,7 @@ pub enum Verified {
     Identical {
         /// Merges compared.
         merges: usize,
-        /// Whether MPairs queue lengths differ (the queue's storage changed between versions).
+        /// Whether MPairs queue lengths differ (the queue's storage can differ between versions).
         queue_lengths_differ: bool,
     },
     /// The recording is incomplete and its merges are the re-run's first ones.

@@ -1,27 +1,14 @@
 //! Wavefront OBJ loading (via `tobj`) into a [`Scene`] of convex primitives, with validation.
 //!
-//! Each file goes through two passes:
-//! 1. `scan` reads the text once and reports the first problem with its line: not UTF-8,
-//!    malformed `v`/`f` statements, non-finite or out-of-range coordinates, face indices out
-//!    of range (including relative ones reaching before the first vertex). It parses the
-//!    coordinates in `f64` and produces a cleaned copy for `tobj` in which each `v` line holds
-//!    its vertex index instead (`tobj` parses `f32` unless its `use_f64` feature is on, and
-//!    `f32` would lose detail; small integers it holds exactly), faces with fewer than 3
-//!    vertices and every statement we ignore (`vt`, `vn`, `l`, `p`, `mtllib`, `usemtl`, `s`, …)
-//!    are blanked, and `f`, `o` and `g` lines are kept verbatim;
-//! 2. `tobj::load_obj_buf` parses the cleaned copy into groups and faces (materials refused);
-//!    the vertex indices in its positions lead back to the `f64` coordinates.
-//!
-//! From 1 MB up the two run at once, tobj reading the cleaned copy in blocks as `scan` writes
-//! it (`pipe`), with the same results.
-//!
-//! Then, in polygon mode (default) every face becomes one `PrimitiveKind::Polygon` by the
-//! rules of [`polygon`]; with [`LoadOptions::polyhedra`] every OBJ object/group becomes one
-//! `PrimitiveKind::Polyhedron` by the rules of [`polyhedron`]. Every primitive records the
-//! object id of its group ([`Scene::objects`]; groups of the same name share one id, in order
-//! of first appearance). Vertices with bit-identical
-//! positions are merged; everything is deterministic, so loading the same bytes twice gives
-//! the same scene.
+//! Each file goes through two passes: `scan` validates the text, reporting the first problem
+//! with its line, and writes a cleaned copy for `tobj` with the coordinates kept in `f64`; then
+//! `tobj::load_obj_buf` parses that copy into groups and faces, materials refused (from 1 MB up
+//! the two run at once, `pipe`). In polygon mode (default) every face becomes one
+//! `PrimitiveKind::Polygon` by the rules of [`polygon`]; with [`LoadOptions::polyhedra`] every
+//! OBJ object/group becomes one `PrimitiveKind::Polyhedron` by the rules of [`polyhedron`].
+//! Every primitive records the object id of its group ([`Scene::objects`]; groups of the same
+//! name share one id, in order of first appearance). Vertices with bit-identical positions are
+//! merged; loading the same bytes twice gives the same scene.
 
 use std::fmt;
 use std::path::Path;
@@ -306,6 +293,15 @@ fn shown(tok: &str) -> String {
 }
 
 /// Validates `text` line by line and writes to `out` the cleaned copy handed to `tobj`.
+///
+/// Reports the first problem with its line: not UTF-8, malformed `v`/`f` statements,
+/// non-finite or out-of-range coordinates, face indices out of range (including relative ones
+/// reaching before the first vertex). Coordinates are parsed in `f64`, and each `v` line of the
+/// copy holds its vertex index instead (`tobj` parses `f32` unless its `use_f64` feature is on,
+/// and `f32` would lose detail; small integers it holds exactly), so the vertex indices in
+/// `tobj`'s positions lead back to the `f64` coordinates. Faces with fewer than 3 vertices and
+/// every statement we ignore (`vt`, `vn`, `l`, `p`, `mtllib`, `usemtl`, `s`, …) are blanked;
+/// `f`, `o` and `g` lines are kept verbatim.
 fn scan(text: &str, out: &mut dyn Cleaned) -> Result<Scanned, (LoadErrorKind, String)> {
     let mut s = Scanned::default();
     // A vertex's rewritten line, written out whole.

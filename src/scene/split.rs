@@ -1,27 +1,11 @@
 //! Aspect-limited splitting, the mitigation the paper proposes in §4 for long thin primitives:
 //! "preprocess the input to obtain polygons or polyhedra with limited aspect
-//! (primary-axis:secondary-axis) ratios".
+//! (primary-axis:secondary-axis) ratios" (`--split-aspect`, `docs/stability.md`).
 //!
-//! **Aspect** ([`aspect`]): the vertices' extent along their principal axis (largest variance,
-//! [`Frame::principal`]) over their extent along the second principal axis. For a planar
-//! polygon the third extent (its 3D thickness) is zero, so the second axis is the in-plane width;
-//! extents are max − min of vertex coordinates, which no interior vertex can perturb, and the
-//! principal axis of a long shape is its long axis whatever its vertex count.
-//!
-//! **Split** ([`split_aspect`]): a polygon of aspect A > R is cut by k − 1 planes perpendicular
-//! to its long axis, k = ⌈A / R⌉ (up to 1e-12 relative), into k slabs of equal length
-//! (Sutherland–Hodgman against one plane at a time). Each cut point is computed once from the edge's endpoints in a fixed order
-//! and shared by the two pieces, so the pieces are convex, lie in the polygon's plane (up to
-//! rounding of the interpolation), and tile it exactly: their areas sum to the original's.
-//! A piece whose width is the polygon's full width (rectangles, the middle of any blunt shape)
-//! has aspect ≤ R for R ≥ 2. A piece containing a corner sharper than about 1 / R keeps that
-//! corner's sliver shape: any convex piece containing a corner of angle θ has aspect ≥ ~1 / θ,
-//! so no partition could do better; such pieces are still at most R × the original width long.
-//!
-//! **Fallbacks** (never a panic): a zero-area primitive (collinear or coincident vertices,
-//! second extent ≤ 1e-12 × the first) and every polyhedron are kept unchanged; R below 2 is
-//! taken as 2 (for 1 ≤ R < 2 slabs of a rectangle could come out too wide for their length);
-//! R = ∞ or NaN keeps the scene as it is.
+//! [`aspect`] measures a primitive's aspect from its principal axes; [`split_aspect`] cuts each
+//! polygon of aspect above R into convex slabs across its long axis that tile it exactly. Never
+//! a panic: a zero-area primitive and every polyhedron are kept unchanged; R below 2 is taken as
+//! 2 and R = ∞ or NaN keeps the scene as it is.
 
 use super::{LoadError, Loaded, PrimitiveKind, Scene, load_bytes};
 use crate::geom::pca::Frame;
@@ -61,19 +45,37 @@ fn measure(points: &[P3]) -> (f64, Frame, V3, V3) {
     (a, frame, lo, hi)
 }
 
-/// The aspect of `points` (see the module documentation): principal extent over second
-/// principal extent; ∞ for collinear points, 1 for a single point.
+/// The aspect of `points`: principal extent over second principal extent; ∞ for collinear
+/// points, 1 for a single point.
+///
+/// The extents are those along the principal axis (largest variance, [`Frame::principal`]) and
+/// the second principal axis. For a planar polygon the third extent (its 3D thickness) is zero,
+/// so the second axis is the in-plane width; extents are max − min of vertex coordinates, which
+/// no interior vertex can perturb, and the principal axis of a long shape is its long axis
+/// whatever its vertex count.
 pub fn aspect(points: &[P3]) -> f64 {
     measure(points).0
 }
 
 /// Splits every polygon of `scene` whose [`aspect`] exceeds `r` into convex pieces of aspect at
-/// most `r` (up to the sharp-corner limit in the module documentation), returning the new scene
-/// and, for each of its primitives, the id of the original primitive it came from.
+/// most `r` (up to the sharp-corner limit below), returning the new scene and, for each of its
+/// primitives, the id of the original primitive it came from.
 ///
-/// Primitives below the limit, degenerate primitives and polyhedra are copied unchanged; the
-/// order is kept (pieces of primitive i follow each other where i was). `r` below 2 is taken as
-/// 2; `r` = ∞ (or NaN) returns a copy of the scene with the identity map.
+/// Primitives below the limit, degenerate primitives (second extent ≤ [`DEGENERATE_REL`] × the
+/// first) and polyhedra are copied unchanged; the order is kept (pieces of primitive i follow
+/// each other where i was). `r` below 2 is taken as 2 (for 1 ≤ R < 2 slabs of a rectangle could
+/// come out too wide for their length); `r` = ∞ (or NaN) returns a copy of the scene with the
+/// identity map.
+///
+/// A polygon of aspect A > R is cut by k − 1 planes perpendicular to its long axis,
+/// k = ⌈A / R⌉ (up to 1e-12 relative), into k slabs of equal length (Sutherland–Hodgman against
+/// one plane at a time). Each cut point is computed once and shared by the two pieces, so the
+/// pieces are convex, lie in the polygon's plane (up to rounding of the interpolation), and tile
+/// it exactly: their areas sum to the original's. A piece whose width is the polygon's full
+/// width (rectangles, the middle of any blunt shape) has aspect ≤ R for R ≥ 2. A piece
+/// containing a corner sharper than about 1 / R keeps that corner's sliver shape: any convex
+/// piece containing a corner of angle θ has aspect ≥ ~1 / θ, so no partition could do better;
+/// such pieces are still at most R × the original width long.
 pub fn split_aspect(scene: &Scene, r: f64) -> (Scene, Vec<u32>) {
     let (s, map, _) = split_aspect_stats(scene, r);
     (s, map)

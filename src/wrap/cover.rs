@@ -1,32 +1,15 @@
 //! Covers: the fewest wrappers that model a scene within an error (§4 of the paper: "a
-//! near-optimal collection of wrappers that cover the input, given a limit on the size").
+//! near-optimal collection of wrappers that cover the input, given a limit on the size");
+//! `docs/method.md`, "Covers".
 //!
 //! A **cover** is a cut of the Subset Tree — a set of nodes such that every leaf has exactly one
-//! ancestor-or-self in the set — with one wrapper kind per chosen node. A node's error is the
-//! sphere-tree toolkit's measure from [`node_tightness`]: the largest sampled distance from the
-//! wrapper's surface to the geometry below the node. A leaf may also be drawn as its own
-//! primitive ([`CoverKind::Primitive`]), error 0, so every leaf always qualifies.
-//!
-//! **Kind per node** ([`Fits::choose`]): the smallest error wins; kinds within 10 % of it
-//! ([`TIE_REL`], plus [`TIE_ABS_REL`] × the scene diagonal for rounding) count as tied and the
-//! cheapest query wins ([`query_cost`]: sphere 1, box 2, obb 3, hull and primitive
-//! 4 + vertices / 16), never one above the cover's tolerance.
-//!
-//! **Tolerance T** ([`min_cut`]): the smallest cut whose every node's best error is ≤ T is found
-//! exactly by one bottom-up pass, `size(x) = 1` if `err(x) ≤ T` (always for leaves), else
-//! `size(a) + size(b)`. Proof: any cut of a subtree has at least one node, so when the subtree's
-//! root qualifies, `{x}` is optimal; when it does not, every cut of the subtree is a cut of the
-//! left subtree joined with one of the right, chosen independently, so the sum of the two
-//! optimal sizes is optimal. Error need not be monotone along the tree (it is sampled, and a
-//! parent's sphere can fit better than a child's box).
-//!
-//! **Budget K** ([`budget_tolerance`]): the cut of at most K nodes minimising the largest error.
-//! `size(T)` above is non-increasing in T and the optimal largest error is one of the nodes'
-//! errors, so a binary search over the sorted distinct errors for the smallest T with
-//! `size(T) ≤ K` is exact, in O(N log N); the cut returned is then the smallest one with that
-//! error.
-//!
-//! [`export`] writes a cover as JSON and OBJ; [`solve`] computes one end to end.
+//! ancestor-or-self in the set — with one wrapper kind per chosen node ([`Fits::choose`]). A
+//! node's error is the sphere-tree toolkit's measure from [`node_tightness`]: the largest
+//! sampled distance from the wrapper's surface to the geometry below the node. A leaf may also
+//! be drawn as its own primitive ([`CoverKind::Primitive`]), error 0, so every leaf qualifies.
+//! [`min_cut`] finds the smallest cover within a tolerance and [`budget_tolerance`] the smallest
+//! error for a budget of wrappers, both exactly. [`export`] writes a cover as JSON and OBJ;
+//! [`solve`] computes one end to end.
 
 pub mod export;
 pub mod solve;
@@ -286,7 +269,14 @@ pub fn min_cut_sizes(tree: &SubsetTree, err: &[f64], t: f64) -> Vec<usize> {
 }
 
 /// The smallest cut with each node's `err ≤ t` (leaves always qualify), sorted by id: a node is
-/// taken when it qualifies, else its children are searched; optimal (see the [module docs](self)).
+/// taken when it qualifies, else its children are searched.
+///
+/// Optimal, by one bottom-up pass ([`min_cut_sizes`]), `size(x) = 1` if `err(x) ≤ t` (always
+/// for leaves), else `size(a) + size(b)`. Any cut of a subtree has at least one node, so when
+/// the subtree's root qualifies, `{x}` is optimal; when it does not, every cut of the subtree is
+/// a cut of the left subtree joined with one of the right, chosen independently, so the sum of
+/// the two optimal sizes is optimal. Error need not be monotone along the tree (it is sampled,
+/// and a parent's sphere can fit better than a child's box).
 pub fn min_cut(tree: &SubsetTree, err: &[f64], t: f64) -> Vec<u32> {
     let mut out = Vec::new();
     let mut stack = vec![tree.root()];
@@ -302,6 +292,10 @@ pub fn min_cut(tree: &SubsetTree, err: &[f64], t: f64) -> Vec<u32> {
 
 /// The smallest largest error achievable by a cut of at most `k` nodes (leaves count as
 /// error 0), by binary search over the distinct interior errors; `None` for `k = 0`.
+///
+/// Exact, in O(N log N): the smallest cut's size under tolerance T is non-increasing in T and
+/// the optimal largest error is one of the nodes' errors, so the smallest such error with a cut
+/// of at most `k` nodes is the answer; the cut for it is then the smallest one with that error.
 pub fn budget_tolerance(tree: &SubsetTree, err: &[f64], k: usize) -> Option<f64> {
     if k == 0 {
         return None;

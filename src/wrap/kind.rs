@@ -83,6 +83,19 @@ impl WrapperKind {
 
 /// Wrapper Trees of several kinds for one Subset Tree; each vector has one wrapper per node
 /// (index = node id). A kind not asked for is `None`.
+///
+/// ```no_run
+/// # fn demo(tree: &wraptree::grouping::SubsetTree, scene: &wraptree::scene::Scene) {
+/// use wraptree::wrap::{SphereMethod, WrapperKind, Wrappers, hull_tree, level_tightness};
+/// let kinds = WrapperKind::parse_list("sphere,hull").unwrap();
+/// let w = Wrappers::build(tree, scene, &kinds, SphereMethod::Minimum);
+/// let hulls = w.hulls.as_deref().unwrap();
+/// for t in w.trees() {
+///     let stats = level_tightness(tree, scene, t, hulls, wraptree::wrap::DEFAULT_SAMPLES);
+///     println!("{}: {:?}", t.kind().name(), stats.last());
+/// }
+/// # }
+/// ```
 #[derive(Clone, Debug, Default)]
 pub struct Wrappers {
     /// Bounding spheres.

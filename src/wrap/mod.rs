@@ -1,33 +1,17 @@
-//! Wrapper Trees (§2.4): a covering shape for every node of a Subset Tree, index = node id.
+//! Wrapper Trees (§2.4): a covering shape for every node of a Subset Tree, index = node id
+//! (`docs/method.md`, "Wrapper Trees").
 //!
-//! - [`sphere`] — bounding spheres: merged from the children's (O(N)), or from the leaves'
-//!   vertices around the AABB centre (the paper's choice), by Ritter's approximation, or the
-//!   exact minimum enclosing sphere ([`welzl`]);
-//! - [`hull`] — convex hulls, built from the children's hull vertices, robust to flat,
-//!   collinear and duplicate points (never panics);
-//! - axis-aligned boxes are the Subset Tree's own [`SubsetTree::aabb`](crate::grouping::SubsetTree);
+//! - [`sphere`] — bounding spheres: merged from the children's, around the AABB centre (the
+//!   paper's choice), by Ritter's approximation, or the exact minimum ([`welzl`]);
+//! - [`hull`] — convex hulls from the children's hull vertices, robust to degenerate input;
+//! - axis-aligned boxes: the Subset Tree's own [`SubsetTree::aabb`](crate::grouping::SubsetTree);
 //! - [`obb`] — oriented boxes from the principal axes ([`crate::geom::pca`]);
 //! - [`kind`] — [`WrapperKind`] (`--wrapper`) and [`Wrappers`], several trees built together;
-//! - [`tightness`] — per-level volume, volume ratio and surface-to-geometry error;
-//! - [`distance`] — exact point–primitive distances with the Subset Tree as BVH;
-//! - [`report`] — build time, containment check and tightness of several trees together.
+//! - [`tightness`], [`report`] — volume, error and containment per level; [`distance`] — exact
+//!   point–primitive distances; [`cover`] — the fewest wrappers within an error.
 //!
-//! Everything is `f64` except parry's hull decision (`f32`). Containment of every vertex below
-//! a node holds up to rounding for spheres, boxes and OBBs (tests allow 1e-9 × the scene
-//! diagonal) and up to [`HULL_TOL_REL`] × the node's AABB diameter for hulls.
-//!
-//! ```no_run
-//! # fn demo(tree: &wraptree::grouping::SubsetTree, scene: &wraptree::scene::Scene) {
-//! use wraptree::wrap::{SphereMethod, WrapperKind, Wrappers, hull_tree, level_tightness};
-//! let kinds = WrapperKind::parse_list("sphere,hull").unwrap();
-//! let w = Wrappers::build(tree, scene, &kinds, SphereMethod::Minimum);
-//! let hulls = w.hulls.as_deref().unwrap();
-//! for t in w.trees() {
-//!     let stats = level_tightness(tree, scene, t, hulls, wraptree::wrap::DEFAULT_SAMPLES);
-//!     println!("{}: {:?}", t.kind().name(), stats.last());
-//! }
-//! # }
-//! ```
+//! Everything is `f64` except parry's hull decision (`f32`): every wrapper contains the vertices
+//! below its node up to rounding, hulls up to [`HULL_TOL_REL`] × the node's AABB diameter.
 
 pub mod cover;
 pub mod distance;

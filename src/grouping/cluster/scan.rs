@@ -1,41 +1,16 @@
 //! Partner searches over the voxel hash: step 3's round-start scan and step 4(b)'s search for a
 //! new body (also run when a body's partner list is used up).
 //!
-//! A body `x`'s eligible partners have their centres within `x`'s box grown by GLimit plus the
-//! largest half-extent of the round's active bodies, so only the cells of the voxels meeting
-//! that box are visited, and among them only cells the union of whose boxes is within GLimit
-//! of `x`'s box.
+//! Only cells within reach are visited: a partner's centre lies in the body's box grown by
+//! GLimit plus the largest half-extent of the round's active bodies ([`query_box`]), and a cell
+//! counts only if the union of its boxes is within GLimit ([`reachable`]). For the AABB p-set,
+//! the round-start scan visits each pair of cells once (`pairs_once`), and a single search
+//! visits cells cheapest Cost bound first ([`cost_bound`]) and stops when no cell can improve
+//! its list, which is still exactly the first partners in key order (`scan_pruned`). Other
+//! p-sets search every candidate for the single best partner, as in the paper.
 //!
-//! For the AABB p-set (whose pair Cost is a symmetric function of the two boxes and diameters):
-//! - the round-start scan visits each pair of cells once — a body's own cell after it, and the
-//!   voxels after its own in (x, y, z) order — counting every eligible pair once and offering
-//!   it to both bodies' partner lists; as the freshly built cells are sorted by their boxes'
-//!   smallest x, a body's scan of a cell stops at the first record starting more than GLimit
-//!   beyond the body's largest x (finite scenes);
-//! - a single body's search visits the cells in increasing order of a lower bound on the Cost
-//!   of any pair with one of their bodies and stops at the first cell whose bound exceeds the
-//!   last Cost the list keeps, so the list is still exactly the first partners in key order.
-//!   The bound takes the merged diameter D to be at least that of the box spanning `x`'s box
-//!   and, per axis, the cell's smallest box maximum and largest box minimum (every body's box
-//!   reaches them), and at least the cell's smallest diameter; Fill = d / (dx + dy) with
-//!   d ≥ max(D, dy) is then at least D / (dx + min(D, the cell's largest diameter)); Balance ≥ 1.
-//!   It is evaluated with the same floating-point operations as the Cost, on operands no larger,
-//!   so it never exceeds a Cost it bounds, and is lowered by 1e-9 relative for `powf` and the
-//!   rounding of the Fill bound's sum.
-//!
-//! A search keeps one partner more than a list holds and counts the searcher as a candidate of
-//! itself, so its result, with the searcher dropped, serves every body of bit-identical box and
-//! diameter: their candidates' keys are the same, and the candidates differ only by which body
-//! is left out. The last result is kept ([`Memo`]) until the voxel hash changes, so N coincident
-//! bodies re-searching between two merges cost one scan, not N.
-//!
-//! With `--cost area` ([`CostMeasure::Area`]) the Cost's three sizes are the surface areas of
-//! the merged box and of the two bodies' boxes ([`measures`]); the diameter-based bound and the
-//! `sqrt`-free filter do not hold for areas, so those searches visit every reachable cell
-//! (README, "Cost in surface area": up to 1.4× the grouping time on the scenes measured).
-//!
-//! With C = 0 and B > 0 the pair Cost skips Balance (then weighted by zero), bit for bit the
-//! same value. Other p-sets search every candidate for the single best partner, as in the paper.
+//! With `--cost area` the bound and the `sqrt`-free filter ([`Quick`]) do not hold, so those
+//! searches visit every reachable cell (`docs/method.md`, "The Cost in surface area").
 
 mod par;
 
@@ -47,9 +22,15 @@ use crate::grouping::mpairs::{K_MAX, List, Top};
 use crate::grouping::voxel_hash::CellBounds;
 use crate::grouping::{CostMeasure, Weights};
 
-/// The last AABB search (see the module doc): the bits of its searcher's box and diameter and
-/// the voxel hash version, and the first `K_MAX + 1` partners in key order of all stored bodies,
-/// the searcher included.
+/// The last AABB search: the bits of its searcher's box and diameter and the voxel hash
+/// version, and the first `K_MAX + 1` partners in key order of all stored bodies, the searcher
+/// included.
+///
+/// With one partner more than a list holds and the searcher counted as its own candidate, the
+/// result, with the searcher dropped, serves every body of bit-identical box and diameter: their
+/// candidates' keys are the same and differ only by which body is left out. It is kept until
+/// the voxel hash changes, so N coincident bodies re-searching between two merges cost one
+/// scan, not N.
 pub(super) struct Memo {
     key: ([u64; 6], u64, u64),
     top: Top<{ K_MAX + 1 }>,
@@ -175,6 +156,13 @@ fn query_box(half_ext: &[f64; 3], xa: &Aabb, glimit: f64) -> (P3, P3) {
 
 /// A lower bound on the Cost of pairing the body with box `xa` and diameter `dx` with any body
 /// stored in a cell with bounds `cb`.
+///
+/// The merged diameter D is at least that of the box spanning `xa` and, per axis, the cell's
+/// smallest box maximum and largest box minimum (every body's box reaches them), and at least
+/// the cell's smallest diameter; Fill = d / (dx + dy) with d ≥ max(D, dy) is then at least
+/// D / (dx + min(D, the cell's largest diameter)); Balance ≥ 1. It is evaluated with the same
+/// floating-point operations as the Cost, on operands no larger, so it never exceeds a Cost it
+/// bounds, and is lowered by 1e-9 relative for `powf` and the rounding of the Fill bound's sum.
 #[inline(always)]
 fn cost_bound<const A: u8>(w: &Weights, xa: &Aabb, dx: f64, cb: &CellBounds) -> f64 {
     let span = |k: usize| xa.max[k].max(cb.min_hi[k]) - xa.min[k].min(cb.max_lo[k]);
@@ -268,6 +256,10 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
 
     /// Every eligible pair once (AABB p-set); returns their number (so far, when `limit` cuts
     /// the scan short).
+    ///
+    /// The AABB pair Cost is a symmetric function of the two boxes and diameters, so each pair
+    /// of cells is visited once (a body's own cell after it, and the voxels after its own in
+    /// (x, y, z) order) and each eligible pair is offered to both bodies' partner lists.
     fn pairs_once<const A: u8>(&mut self, glimit: f64, limit: &mut ScanLimit<'_>) -> u64 {
         let (k, w, finite) = (self.k, self.params.weights, self.finite);
         let area = self.params.mode.cost == CostMeasure::Area;
@@ -341,7 +333,8 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         pairs
     }
 
-    /// The first partners of `x` in key order (AABB p-set), visiting cells cheapest bound first.
+    /// The first partners of `x` in key order (AABB p-set), visiting cells cheapest bound first
+    /// and stopping at the first cell whose [`cost_bound`] exceeds the last Cost the list keeps.
     fn scan_pruned<const A: u8>(&mut self, x: u32, glimit: f64) {
         let (k, w) = (self.k, self.params.weights);
         let xa = self.aabb[x as usize];

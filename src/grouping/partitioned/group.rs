@@ -88,25 +88,7 @@ pub fn group_boxes<O: Observer>(
     let mut diameter: Vec<f64> = Vec::with_capacity(2 * n - 1);
     diameter.par_extend(aabb.par_iter().map(Aabb::diameter));
     let mut codes = morton_order(&aabb);
-    // The leaves as bodies in Morton order: one gather (its loads overlap) instead of one per
-    // chunk, of the box alone (the diameter is recomputed, the same value, rather than read at
-    // random from a second array); `rd` is set by their chunk.
-    let mut leaves: Vec<Body> = (0..n)
-        .into_par_iter()
-        .map(|i| {
-            if let Some(&(_, ahead)) = codes.get(i + GATHER_AHEAD) {
-                prefetch(&aabb[ahead as usize]);
-            }
-            let id = codes[i].1;
-            let aabb = aabb[id as usize];
-            Body {
-                id,
-                first_round: 0,
-                aabb,
-                diameter: aabb.diameter(),
-            }
-        })
-        .collect();
+    let mut leaves = gather_leaves(&aabb, &codes);
     // Planned on the leaves themselves: the SAH cuts read their boxes in order, and reorder
     // them with their codes.
     let nodes = plan(&mut codes, &mut leaves, chunking);
@@ -163,17 +145,7 @@ pub fn group_boxes<O: Observer>(
         0
     };
     if result.is_none() {
-        let reason = ctx
-            .reason
-            .lock()
-            .expect("no panics hold it")
-            .unwrap_or(StopReason::Interrupted);
-        return Err(Stopped {
-            reason,
-            merges: emitted,
-            rounds: 0,
-            eligible_pairs: ctx.pairs.load(Ordering::Relaxed),
-        });
+        return Err(stopped(&ctx, emitted));
     }
     let tree = SubsetTree::new(aabb, diameter, children)
         .expect("the partitioned schedule makes exactly N - 1 valid merges");
@@ -182,7 +154,49 @@ pub fn group_boxes<O: Observer>(
         rounds: sub.rounds,
         merges: merges as u32,
     });
-    Ok(Grouping {
+    Ok(finished(tree, params, &sub))
+}
+
+/// The leaves as bodies in Morton order: one gather (its loads overlap) instead of one per
+/// chunk, of the box alone (the diameter is recomputed, the same value, rather than read at
+/// random from a second array); `first_round` is set by their chunk.
+fn gather_leaves(aabb: &[Aabb], codes: &[(u64, u32)]) -> Vec<Body> {
+    (0..codes.len())
+        .into_par_iter()
+        .map(|i| {
+            if let Some(&(_, ahead)) = codes.get(i + GATHER_AHEAD) {
+                prefetch(&aabb[ahead as usize]);
+            }
+            let id = codes[i].1;
+            let aabb = aabb[id as usize];
+            Body {
+                id,
+                first_round: 0,
+                aabb,
+                diameter: aabb.diameter(),
+            }
+        })
+        .collect()
+}
+
+/// The stop of a run whose budget ended it after `emitted` announced merges.
+fn stopped(ctx: &RunInputs, emitted: u32) -> Stopped {
+    let reason = ctx
+        .reason
+        .lock()
+        .expect("no panics hold it")
+        .unwrap_or(StopReason::Interrupted);
+    Stopped {
+        reason,
+        merges: emitted,
+        rounds: 0,
+        eligible_pairs: ctx.pairs.load(Ordering::Relaxed),
+    }
+}
+
+/// The outcome of a finished run: the tree with the subproblems' summed counters.
+fn finished(tree: SubsetTree, params: &ResolvedParams, sub: &Counters) -> Grouping {
+    Grouping {
         tree,
         rounds: sub.rounds,
         params: *params,
@@ -194,5 +208,5 @@ pub fn group_boxes<O: Observer>(
             peak_queue: sub.peak_queue,
         },
         pregrouping: None,
-    })
+    }
 }

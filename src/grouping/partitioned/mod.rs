@@ -2,13 +2,13 @@
 //! bottom-up and in parallel (approximate agglomerative clustering, AAC: Gu, He, Fatahalian and
 //! Blelloch 2013, "Efficient BVH Construction via Approximate Agglomerative Clustering").
 //!
-//! The primitives are sorted by Morton code ([`split`]), the sorted range is split into chunks
-//! ([`plan`], with what each node keeps for its parent from [`keep`]), and each chunk and each
-//! node of the split groups its bodies with the paper's Cost and limits ([`executor`]): by brute
-//! force up to 64 bodies ([`brute_force`], [`all_pairs`]), with the exact run's voxel hash and
-//! MPairs above ([`voxel_step`]). Merge steps are numbered in the split's post-order before any
+//! The primitives are sorted by Morton code (`split`), the sorted range is split into chunks
+//! (`plan`, with what each node keeps for its parent from `keep`), and each chunk and each
+//! node of the split groups its bodies with the paper's Cost and limits (`executor`): by brute
+//! force up to 64 bodies (`brute_force`, `all_pairs`), with the exact run's voxel hash and
+//! MPairs above (`voxel_step`). Merge steps are numbered in the split's post-order before any
 //! grouping starts, so the tree is the same for any number of threads. After the grouping, the
-//! finished subproblems are announced as events in that order ([`announce`]). The hull p-set has
+//! finished subproblems are announced as events in that order (`announce`). The hull p-set has
 //! no partitioned form: with it the exact schedule runs. docs/method.md tells the whole story.
 
 mod all_pairs;

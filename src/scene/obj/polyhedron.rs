@@ -12,9 +12,6 @@
 //!   its hull, whose vertices are original points, and named in a warning; with `strict` it is
 //!   an error naming the group;
 //! - if the hull cannot be computed the group is kept as drawn and named in a warning.
-//!
-//! Cost: the hull plus one pass over vertices and faces per hull plane (stopping at the first
-//! point found inside).
 
 use std::collections::{HashMap, HashSet};
 
@@ -78,7 +75,9 @@ impl PolyhedronStats {
 
 /// Adds the group `name` made of `faces` (indices into `scene.points`) as one polyhedron.
 ///
-/// Errors (only with `strict`) name the group that is not in convex position.
+/// Errors (only with `strict`) name the group that is not in convex position. Cost: the hull
+/// plus one pass over vertices and faces per hull plane (stopping at the first point found
+/// inside).
 pub fn add(
     scene: &mut Scene,
     name: &str,

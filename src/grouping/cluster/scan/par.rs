@@ -1,21 +1,16 @@
 //! Step 3's round-start scan (AABB p-set) on several threads, with the same result as the
 //! sequential scan.
 //!
-//! The records of the voxel hash, taken cell by cell, are cut into contiguous ranges of equal
-//! length (a late round holds many bodies in a few cells, so ranges of cells would be uneven),
-//! scanned in parallel exactly as the sequential scan does (each pair of cells once, each
-//! eligible pair once). A range offers a pair to the partner lists of its own bodies directly —
-//! every body is one record, so no two ranges write the same list — and buffers the offers to
-//! bodies of other ranges, which are made after the parallel part. A list holds the first
-//! partners in (Cost, tie tag) order, which does not depend on the order of the offers, and the
-//! Cost filter that skips offers only skips ones that could not enter a list, so every list, the
-//! pair count and the candidate count are those of the sequential scan, for any number of
-//! threads.
+//! The voxel hash's records, cell by cell, are cut into ranges of equal length (a late round
+//! holds many bodies in a few cells, so ranges of cells would be uneven) and scanned as the
+//! sequential scan does. A range writes the lists of its own bodies directly and buffers offers
+//! to other ranges' bodies, made after the parallel part. A list holds the first partners in
+//! (Cost, tie tag) order whatever the order of the offers, and the Cost filter only skips
+//! offers that could not enter a list, so every list and count is the sequential scan's.
 //!
 //! It runs when the pool has several threads, the round has at least [`MIN_BODIES`] active
-//! bodies and the budget has no `max_pairs` (where a scan stops then depends on the order in
-//! which pairs are counted). The stop flag and the deadline are read by every range every
-//! [`Budget::CLOCK_EVERY`] bodies.
+//! bodies and the budget has no `max_pairs` (where a scan stops would depend on the order of
+//! counting). The stop flag and deadline are read every [`Budget::CLOCK_EVERY`] bodies.
 
 use super::reachable;
 use super::{Clusterer, PSetBodies, Quick, ScanLimit, apart, merged_extents, pair_cost, query_box};
