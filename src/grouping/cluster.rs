@@ -266,45 +266,11 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             );
             let dormant = (parentless.len() - active.len()) as u32;
             // Step 3: voxel hash of active centres, CSize = DLimit + GLimit; queue best pairs.
-            // Bodies are stored and searched in Morton order of their centres so consecutive
-            // searches reuse the same cells from cache; the order does not change any result.
-            morton.clear();
-            morton.extend(active.iter().map(|&x| (self.morton_key(x), x)));
-            morton.sort_unstable();
-            order.clear();
-            order.extend(morton.iter().map(|&(_, x)| x));
-            let ids = 2 * n - 1;
-            self.half_ext = [0.0; 3];
-            self.partners.reset(ids);
-            for &x in &order {
-                self.live[x as usize] = true;
-                self.grow_half_ext(x);
-                self.partners.open(x);
-            }
-            let slots = self.partners.slots();
-            self.hash.build(
-                dlimit + glimit,
-                &order,
-                &self.aabb,
-                &self.diameter,
-                slots,
-                ids,
-            );
-            let mut limit = ScanLimit {
-                budget,
-                room: max_pairs.saturating_sub(self.stats.eligible_pairs),
-                timed,
-                bodies: 0,
-                hit: None,
+            self.hash_active(&active, &mut morton, &mut order, dlimit + glimit);
+            let pairs = match self.eligible_pairs(&order, glimit, budget, max_pairs, timed) {
+                Ok(pairs) => pairs,
+                Err(reason) => return Err(self.stopped(reason, round)),
             };
-            let pairs = self.round_start_search(&order, glimit, &mut limit);
-            self.stats.eligible_pairs += pairs;
-            if self.stats.eligible_pairs > max_pairs {
-                limit.hit = Some(StopReason::MaxPairs);
-            }
-            if let Some(reason) = limit.hit {
-                return Err(self.stopped(reason, round));
-            }
             for &x in &order {
                 self.queue_current(x);
             }
@@ -326,27 +292,8 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                     continue;
                 }
                 if !self.live[e.partner as usize] {
-                    // The partner merged away: the owner's next live partner, else a new search.
                     self.stats.stale_pops += 1;
-                    let live = &self.live;
-                    let mut next = self.partners.get(e.owner).advance(|y| live[y as usize]);
-                    if next.is_none() {
-                        self.search(e.owner, glimit);
-                        next = self.partners.get(e.owner).current();
-                    }
-                    match next {
-                        Some(c) => {
-                            let again = Entry {
-                                cost: order_bits(c.cost),
-                                owner: e.owner,
-                                partner: c.partner,
-                            };
-                            self.mpairs.replace_top(again, &self.tag);
-                        }
-                        None => {
-                            self.mpairs.pop(&self.tag);
-                        }
-                    }
+                    self.requeue_owner(e, glimit);
                     continue;
                 }
                 self.mpairs.pop(&self.tag);
@@ -391,6 +338,88 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             }
         }
         Ok(round)
+    }
+
+    /// Step 3 for the round's `active` bodies: stored and searched in Morton order of their
+    /// centres (`order`), so consecutive searches reuse the same cells from cache (the order
+    /// changes no result), and put in a voxel hash of cell size `csize` = DLimit + GLimit.
+    fn hash_active(
+        &mut self,
+        active: &[u32],
+        morton: &mut Vec<(u64, u32)>,
+        order: &mut Vec<u32>,
+        csize: f64,
+    ) {
+        morton.clear();
+        morton.extend(active.iter().map(|&x| (self.morton_key(x), x)));
+        morton.sort_unstable();
+        order.clear();
+        order.extend(morton.iter().map(|&(_, x)| x));
+        let ids = 2 * self.n - 1;
+        self.half_ext = [0.0; 3];
+        self.partners.reset(ids);
+        for &x in order.iter() {
+            self.live[x as usize] = true;
+            self.grow_half_ext(x);
+            self.partners.open(x);
+        }
+        let slots = self.partners.slots();
+        self.hash
+            .build(csize, order, &self.aabb, &self.diameter, slots, ids);
+    }
+
+    /// Step 3's scan of the hashed bodies `order` for their eligible pairs (within GLimit
+    /// `glimit`), counted into the stats; Err when the budget (the stop, the deadline, or
+    /// `max_pairs` eligible pairs in all) ends the run.
+    fn eligible_pairs(
+        &mut self,
+        order: &[u32],
+        glimit: f64,
+        budget: &Budget<'_>,
+        max_pairs: u64,
+        timed: bool,
+    ) -> Result<u64, StopReason> {
+        let mut limit = ScanLimit {
+            budget,
+            room: max_pairs.saturating_sub(self.stats.eligible_pairs),
+            timed,
+            bodies: 0,
+            hit: None,
+        };
+        let pairs = self.round_start_search(order, glimit, &mut limit);
+        self.stats.eligible_pairs += pairs;
+        if self.stats.eligible_pairs > max_pairs {
+            limit.hit = Some(StopReason::MaxPairs);
+        }
+        match limit.hit {
+            Some(reason) => Err(reason),
+            None => Ok(pairs),
+        }
+    }
+
+    /// The popped entry `e`'s partner merged away: the owner's next live partner replaces the
+    /// entry, else a new search finds one, else the entry leaves MPairs.
+    #[inline]
+    fn requeue_owner(&mut self, e: Entry, glimit: f64) {
+        let live = &self.live;
+        let mut next = self.partners.get(e.owner).advance(|y| live[y as usize]);
+        if next.is_none() {
+            self.search(e.owner, glimit);
+            next = self.partners.get(e.owner).current();
+        }
+        match next {
+            Some(c) => {
+                let again = Entry {
+                    cost: order_bits(c.cost),
+                    owner: e.owner,
+                    partner: c.partner,
+                };
+                self.mpairs.replace_top(again, &self.tag);
+            }
+            None => {
+                self.mpairs.pop(&self.tag);
+            }
+        }
     }
 
     /// Step 4(a)–(c) for one popped pair.

@@ -190,65 +190,18 @@ pub fn evaluate(
     let mut rows = Vec::new();
     for &method in &opts.methods {
         progress(method);
-        let mut failed = None;
-        let (built, build_s) = best_of(opts.repeat, || {
-            match peers::build(method, scene, &opts.params) {
-                Ok(b) => {
-                    let s = b.seconds;
-                    (Some(b), s)
-                }
-                Err(e) => {
-                    failed = Some(e);
-                    (None, f64::INFINITY)
-                }
-            }
-        });
-        let built = built.ok_or_else(|| failed.unwrap_or_default())?;
+        let (built, build_s) = build_best(method, scene, opts)?;
         let tree = &built.tree;
         let q = quality(tree);
         // Reference hulls for tightness (and the hull wrapper itself).
         let need_hulls = measure_tightness || opts.wrappers.contains(&Wrapper::Hull);
-        let (hulls, hull_s) = if need_hulls {
+        let hulls = if need_hulls {
             best_of(opts.repeat, || timed(|| hull_tree(tree, scene)))
         } else {
             (Vec::new(), 0.0)
         };
         for &wrapper in &opts.wrappers {
-            let mut spheres: Vec<Sphere> = Vec::new();
-            let mut obbs = Vec::new();
-            let wrapper_s = match wrapper {
-                Wrapper::Box => 0.0,
-                Wrapper::Hull => hull_s,
-                Wrapper::Sphere(m) => {
-                    let (s, t) = best_of(opts.repeat, || timed(|| sphere_tree(tree, scene, m)));
-                    spheres = s;
-                    t
-                }
-                Wrapper::Obb => {
-                    let (o, t) = best_of(opts.repeat, || timed(|| obb_tree(tree, scene, None)));
-                    obbs = o;
-                    t
-                }
-            };
-            let view = match wrapper {
-                Wrapper::Box => WrapperTree::Boxes(&tree.aabb),
-                Wrapper::Hull => WrapperTree::Hulls(&hulls),
-                Wrapper::Sphere(_) => WrapperTree::Spheres(&spheres),
-                Wrapper::Obb => WrapperTree::Obbs(&obbs),
-            };
-            let tight =
-                measure_tightness.then(|| tightness(tree, scene, view, &hulls, opts.samples));
-            let (tight, tight_levels) = match tight {
-                Some((t, l)) => (Some(t), l),
-                None => (None, Vec::new()),
-            };
-            let query = match wrapper {
-                Wrapper::Box => Some(query::measure(tree, scene, Bv::Aabb, &workload)),
-                Wrapper::Sphere(_) => {
-                    Some(query::measure(tree, scene, Bv::Sphere(&spheres), &workload))
-                }
-                _ => None,
-            };
+            let w = measure_wrapper(scene, opts, &workload, tree, &hulls, wrapper);
             rows.push(Row {
                 scene: scene.name.clone(),
                 n: scene.len(),
@@ -256,15 +209,100 @@ pub fn evaluate(
                 wrapper: wrapper.name(),
                 build_s,
                 refine_s: built.refine_seconds,
-                wrapper_s,
+                wrapper_s: w.seconds,
                 quality: q,
-                tightness: tight,
-                tightness_levels: tight_levels,
-                query,
+                tightness: w.tightness,
+                tightness_levels: w.tightness_levels,
+                query: w.query,
             });
         }
     }
     Ok(rows)
+}
+
+/// The best of `opts.repeat` builds of `method`'s hierarchy, and its time. Err: why a build
+/// failed.
+fn build_best(
+    method: Method,
+    scene: &Scene,
+    opts: &Options,
+) -> Result<(peers::Built, f64), String> {
+    let mut failed = None;
+    let (built, build_s) = best_of(opts.repeat, || {
+        match peers::build(method, scene, &opts.params) {
+            Ok(b) => {
+                let s = b.seconds;
+                (Some(b), s)
+            }
+            Err(e) => {
+                failed = Some(e);
+                (None, f64::INFINITY)
+            }
+        }
+    });
+    let built = built.ok_or_else(|| failed.unwrap_or_default())?;
+    Ok((built, build_s))
+}
+
+/// What one wrapper on a hierarchy measured.
+struct WrapperMeasure {
+    /// Build time on top of the hierarchy (best of the repetitions).
+    seconds: f64,
+    tightness: Option<f64>,
+    tightness_levels: Vec<f64>,
+    query: Option<QueryCost>,
+}
+
+/// Builds `wrapper` on `tree` (the hull tree is `hulls`: the hulls and their time) and
+/// measures its tightness (up to [`Options::tightness_max_n`] primitives) and, for boxes and
+/// spheres, its query cost.
+fn measure_wrapper(
+    scene: &Scene,
+    opts: &Options,
+    workload: &Workload,
+    tree: &SubsetTree,
+    (hulls, hull_s): &(Vec<Hull>, f64),
+    wrapper: Wrapper,
+) -> WrapperMeasure {
+    let mut spheres: Vec<Sphere> = Vec::new();
+    let mut obbs = Vec::new();
+    let seconds = match wrapper {
+        Wrapper::Box => 0.0,
+        Wrapper::Hull => *hull_s,
+        Wrapper::Sphere(m) => {
+            let (s, t) = best_of(opts.repeat, || timed(|| sphere_tree(tree, scene, m)));
+            spheres = s;
+            t
+        }
+        Wrapper::Obb => {
+            let (o, t) = best_of(opts.repeat, || timed(|| obb_tree(tree, scene, None)));
+            obbs = o;
+            t
+        }
+    };
+    let view = match wrapper {
+        Wrapper::Box => WrapperTree::Boxes(&tree.aabb),
+        Wrapper::Hull => WrapperTree::Hulls(hulls),
+        Wrapper::Sphere(_) => WrapperTree::Spheres(&spheres),
+        Wrapper::Obb => WrapperTree::Obbs(&obbs),
+    };
+    let measure_tightness = scene.len() <= opts.tightness_max_n;
+    let tight = measure_tightness.then(|| tightness(tree, scene, view, hulls, opts.samples));
+    let (tightness, tightness_levels) = match tight {
+        Some((t, l)) => (Some(t), l),
+        None => (None, Vec::new()),
+    };
+    let query = match wrapper {
+        Wrapper::Box => Some(query::measure(tree, scene, Bv::Aabb, workload)),
+        Wrapper::Sphere(_) => Some(query::measure(tree, scene, Bv::Sphere(&spheres), workload)),
+        _ => None,
+    };
+    WrapperMeasure {
+        seconds,
+        tightness,
+        tightness_levels,
+        query,
+    }
 }
 
 /// A query cost as the CSV's query columns: BV and primitive tests per query for point,

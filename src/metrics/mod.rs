@@ -33,7 +33,7 @@ pub fn peak_rss_bytes() -> Option<u64> {
 /// Quality measures of one hierarchy.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Quality {
-    /// SAH cost (see the module doc for the constants).
+    /// SAH cost (see [`sah`] for the constants).
     pub sah: f64,
     /// Largest leaf depth.
     pub depth_max: u32,

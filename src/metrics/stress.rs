@@ -1,19 +1,15 @@
-//! Stress runs (`wraptree stress`): every builder on every pathological scene ([`pathological`]), each case
-//! under a time budget, and a sweep of the spaghetti aspect ratio with and without
-//! `--split-aspect` (the §2.3 worst case, "a box of spaghetti", and the §4 mitigation).
+//! Stress runs (`wraptree stress`, `docs/stability.md`): every builder on every pathological
+//! scene ([`pathological`]), each case under a time budget, and sweeps of parallel spaghetti
+//! (the §2.3 worst case) with and without `--split-aspect` (the §4 mitigation).
 //!
-//! Per case it records whether the build finished within the budget, whether the tree is valid
-//! (every leaf once under the root, each leaf box holding its primitive, each child box inside
-//! its parent's, depths consistent; for Wrapper Trees, every vertex below a node inside its
-//! wrapper), the time, the depth, and for the grouping phase k = eligible pairs per body
-//! (`Stats::eligible_pairs / N`, the paper's k of §2.3) and candidates examined per body.
+//! Per case: whether the build finished within the budget, whether the tree is valid (every leaf
+//! once under the root, boxes nested, depths consistent; for Wrapper Trees every vertex inside
+//! its node's wrapper), time, depth, and for groupings k = eligible pairs per body (the paper's
+//! k of §2.3) and candidates examined per body.
 //!
-//! A case runs on its own thread. Groupings get a stop flag that is set when the budget runs
-//! out (the run then returns within one merge or scan block); other builders cannot be stopped,
-//! so a case past its budget is reported as a timeout and its thread left to finish in the
-//! background (of the default cases, only the hull Wrapper Tree of 1,024-vertex polygons does).
-//!
-//! Two sweeps group parallel spaghetti with the AABB p-set as it is and split at `--split`:
+//! A case runs on its own thread. Groupings get a stop flag set when the budget runs out (they
+//! return within one merge or scan block); other builders cannot be stopped, so a case past its
+//! budget is a timeout and its thread is left to finish in the background. The sweeps run
 //! against the aspect ratio at fixed N (`spaghetti.{svg,png}`) and against N at aspect 64
 //! (`spaghetti-n.{svg,png}`); their rows are also in `stress.csv`.
 
@@ -395,7 +391,8 @@ pub fn run(opts: &StressOptions, progress: &mut dyn FnMut(Step<'_>)) -> Result<S
     };
     let mut rows = Vec::new();
     for kind in pathological::KINDS {
-        // 1,024-vertex polygons: hulling them is slow (see the module documentation).
+        // 1,024-vertex polygons: hulling them is slow (their hull Wrapper Tree can outrun the
+        // budget, the only default case that does).
         let n = if kind == "ngons" { n / 30 } else { n };
         let scene = pathological::by_name(kind, Some(n), 1).expect("a known kind");
         progress(Step::Scene(&scene));
@@ -451,10 +448,7 @@ impl StressReport {
                 ),
             ),
         ];
-        let mut files = vec![(
-            "stress.csv".to_string(),
-            stress_csv(&self.rows).into_bytes(),
-        )];
+        let mut files = vec![("stress.csv".to_string(), stress_csv(&self.rows)?)];
         for (name, chart) in charts {
             let svg = chart.to_svg(900, 600).map_err(anyhow::Error::msg)?;
             let png = crate::render::svg_to_png(&svg).map_err(anyhow::Error::msg)?;

@@ -1,19 +1,15 @@
 //! A sequential file writer that bypasses the page cache where the system allows it.
 //!
-//! A large run's recordings are hundreds of megabytes written once and not read back by this
-//! process. Through the page cache every byte is copied into a freshly allocated cache page; on
-//! the 2-core VM this project is measured on, that cost about 2 µs per KB (0.8 s of CPU for the
-//! 10^6-triangle `.mcap`), against about 0.1 µs per KB for the same bytes written with Linux's
-//! `O_DIRECT` from an aligned buffer (`dd` of 440 MB: 0.05 s of system time instead of
-//! 0.55–1.1 s). [`DirectWriter`] collects the stream in aligned 4 MiB blocks and hands each full
-//! block to an I/O thread of its own, which writes it with `O_DIRECT` while the caller fills
-//! the next; the last partial block is written through the page cache after the flag is
-//! cleared.
+//! Recordings are hundreds of megabytes written once and not read back by this process; the
+//! page cache would copy every byte into a fresh page, which costs far more CPU than Linux's
+//! `O_DIRECT` from an aligned buffer (`docs/recordings.md`, "How the files are written").
+//! [`DirectWriter`] collects the stream in aligned 4 MiB blocks and hands each full block to an
+//! I/O thread of its own, which writes it with `O_DIRECT` while the caller fills the next; the
+//! last partial block is written through the page cache after the flag is cleared.
 //!
-//! Fallback: where `O_DIRECT` is missing (other systems) or refused (tmpfs before Linux 6.6 and
-//! some network or FUSE file systems refuse it at open, some devices at the first write with
-//! `EINVAL`), the I/O thread carries on with ordinary writes to the same file; the bytes are
-//! the same either way, only the cost differs.
+//! Where `O_DIRECT` is missing (other systems) or refused (at open: tmpfs before Linux 6.6,
+//! some network or FUSE file systems; at the first write with `EINVAL`: some devices), the I/O
+//! thread carries on with ordinary writes to the same file: the same bytes, only the cost differs.
 
 use std::fs::File;
 use std::io::{self, Seek, SeekFrom, Write};

@@ -1,8 +1,8 @@
 //! Recordings of a grouping run: `.rrd` for the Rerun viewer ([`rrd`]) and `.mcap` for Foxglove
-//! ([`mcap`]). Both recorders are [`Observer`](crate::grouping::Observer)s fed the same events
-//! and share nothing else; [`output`] makes their files appear atomically, and [`background`]
-//! lets a recorder consume the events on another thread while the grouping runs; [`record()`]
-//! runs a grouping with both recorders listening, and [`Written`] says what it wrote.
+//! ([`mcap`]). Both recorders are [`Observer`](crate::grouping::Observer)s fed the same events and
+//! share nothing else; [`output`](crate::output) makes their files appear atomically, and
+//! [`background`] lets a recorder consume the events on another thread while the grouping runs;
+//! [`record()`] runs a grouping with both recorders listening, and [`Written`] says what it wrote.
 
 pub mod background;
 pub mod direct;

@@ -27,6 +27,7 @@ use anyhow::{Context, Result, anyhow, bail};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
+use std::thread::{Scope, ScopedJoinHandle};
 use std::time::Instant;
 
 /// How a recording is made and what it holds besides the scene and the grouping.
@@ -110,25 +111,22 @@ pub fn record<O: Observer>(
     opts: &RecordOptions,
     progress: O,
 ) -> Result<Written> {
-    let (scene, source, detail) = (&loaded.scene, &loaded.source, opts.detail);
-    let (force, reproducible, limits) = (opts.force, opts.reproducible, opts.limits);
-    let (all_levels, compression) = (opts.all_levels, opts.mcap_compression);
+    let (scene, detail) = (&loaded.scene, opts.detail);
     if opts.cover.is_some() && !detail.levels() {
         bail!(
             "--cover-tolerance/--cover-budget need --detail levels or full (the cover is a level)"
         );
     }
-    let (rrd_path, mcap_path) = (with_ext(prefix, ".rrd"), with_ext(prefix, ".mcap"));
-    let rrd_file = Pending::create(&rrd_path, force)?;
-    let mcap_file = Pending::create(&mcap_path, force)?;
+    let rrd_file = Pending::create(&with_ext(prefix, ".rrd"), opts.force)?;
+    let mcap_file = Pending::create(&with_ext(prefix, ".mcap"), opts.force)?;
     let info = RunInfo {
         scene,
-        source,
+        source: &loaded.source,
         params,
         detail,
     };
     let mcap_out = DirectWriter::open(mcap_file.path())
-        .with_context(|| format!("{}: cannot open for writing", mcap_path.display()))?;
+        .with_context(|| format!("{}: cannot open for writing", mcap_file.dest().display()))?;
     let never = AtomicBool::new(false);
     let stop = opts.stop.as_deref().unwrap_or(&never);
     let start = Instant::now();
@@ -140,43 +138,13 @@ pub fn record<O: Observer>(
         let [rrd_worker, mcap_worker]: [background::Worker; 2] = workers
             .try_into()
             .map_err(|_| anyhow!("two event channels"))?;
-        let info = &info;
-        let (rrd_tmp, rrd_name) = (rrd_file.path(), rrd_path.as_path());
-        let rrd_thread = std::thread::Builder::new()
-            .name("rrd-recorder".into())
-            .spawn_scoped(s, move || {
-                let refined = opts.refine.is_some();
-                let mut rrd = RrdRecorder::with_refine(rrd_tmp, rrd_name, info, refined)?;
-                rrd_worker.run(&mut rrd);
-                Ok::<_, anyhow::Error>(rrd)
-            })
-            .context("cannot start the Rerun recorder thread")?;
-        let mcap_thread = std::thread::Builder::new()
-            .name("mcap-recorder".into())
-            .spawn_scoped(s, move || {
-                let mut mcap = McapRecorder::start(mcap_out, info, compression)?;
-                mcap.set_reproducible(reproducible);
-                mcap.set_all_levels(all_levels);
-                mcap.write_scene();
-                mcap_worker.run(&mut mcap);
-                Ok::<_, anyhow::Error>(mcap)
-            })
-            .context("cannot start the MCAP recorder thread")?;
+        let rrd_thread = spawn_rrd(s, rrd_worker, &rrd_file, &info, opts.refine.is_some())?;
+        let mcap_thread = spawn_mcap(s, mcap_worker, mcap_out, &info, opts)?;
         // The grouping starts without waiting for either recorder: a recorder that fails to
         // start drops its worker (the grouping stops sending to it) and its error is reported
         // after the grouping, like a write error during the run. Missing or unwritable
         // destinations were already refused by `Pending::create`.
-        let mut result = grouping::group_within(
-            scene,
-            params,
-            Tee(&mut events, progress),
-            &limits.budget(Some(stop)),
-        );
-        // The refinement's events follow the grouping's on the same channels; the levels
-        // below are the refined tree's.
-        if let (Ok(g), Some(rp)) = (&mut result, &opts.refine) {
-            g.tree = crate::refine::refine(&g.tree, rp, &mut events).tree;
-        }
+        let result = group_and_refine(scene, params, opts, stop, &mut events, progress);
         events.close();
         let seconds = start.elapsed().as_secs_f64();
         let (grouping, stopped, merges, rounds) = match result {
@@ -189,56 +157,142 @@ pub fn record<O: Observer>(
         };
         let extras = Extras::build(scene, grouping.as_ref(), opts)?;
         let outcome = extras.outcome(grouping.as_ref(), merges, rounds, seconds, stopped);
-        let (rrd_done, mcap_done) = std::thread::scope(|t| {
-            let mcap_tail = std::thread::Builder::new()
-                .name("mcap-tail".into())
-                .spawn_scoped(t, || {
-                    let mcap = mcap_thread
-                        .join()
-                        .unwrap_or_else(|_| Err(anyhow!("the MCAP recorder failed")))
-                        .with_context(|| mcap_path.display().to_string())?;
-                    mcap.finish(&outcome)
-                        .with_context(|| mcap_path.display().to_string())?;
-                    mcap_file.sync()
-                });
-            let rrd_done = rrd_thread
-                .join()
-                .unwrap_or_else(|_| bail!("{}: the Rerun recorder failed", rrd_path.display()))
-                .and_then(|rrd| rrd.finish(&outcome))
-                .and_then(|()| rrd_file.sync());
-            let mcap_done = match mcap_tail {
-                Ok(h) => h
-                    .join()
-                    .unwrap_or_else(|_| bail!("{}: the MCAP recorder failed", mcap_path.display())),
-                Err(e) => Err(anyhow!(
-                    "{}: cannot start a thread: {e}",
-                    mcap_path.display()
-                )),
-            };
-            (rrd_done, mcap_done)
-        });
+        let (rrd_done, mcap_done) =
+            finish_both(rrd_thread, mcap_thread, &outcome, &rrd_file, &mcap_file);
         Ok((rrd_done, mcap_done, grouping, stopped))
     })?;
     rrd_done?;
     mcap_done?;
-    let (rrd_dest, mcap_dest) = if grouping.is_some() {
-        (rrd_file.commit()?, mcap_file.commit()?)
-    } else {
-        let r = with_ext(prefix, ".incomplete.rrd");
-        let m = with_ext(prefix, ".incomplete.mcap");
-        (
-            rrd_file.commit_to(Some(&r))?,
-            mcap_file.commit_to(Some(&m))?,
-        )
-    };
+    let (rrd, mcap) = commit_both(rrd_file, mcap_file, prefix, grouping.is_some())?;
     Ok(Written {
-        rrd: rrd_dest,
-        mcap: mcap_dest,
+        rrd,
+        mcap,
         grouping,
         stopped,
-        limits,
+        limits: opts.limits,
         seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// Starts the Rerun recorder on its own thread, writing `file` as `worker`'s events come.
+fn spawn_rrd<'scope, 'a: 'scope>(
+    s: &'scope Scope<'scope, '_>,
+    worker: background::Worker,
+    file: &'scope Pending,
+    info: &'scope RunInfo<'a>,
+    refined: bool,
+) -> Result<ScopedJoinHandle<'scope, Result<RrdRecorder>>> {
+    std::thread::Builder::new()
+        .name("rrd-recorder".into())
+        .spawn_scoped(s, move || {
+            let mut rrd = RrdRecorder::with_refine(file.path(), file.dest(), info, refined)?;
+            worker.run(&mut rrd);
+            Ok(rrd)
+        })
+        .context("cannot start the Rerun recorder thread")
+}
+
+/// Starts the MCAP recorder on its own thread: the scene first, then `worker`'s events.
+fn spawn_mcap<'scope, 'a: 'scope>(
+    s: &'scope Scope<'scope, '_>,
+    worker: background::Worker,
+    out: DirectWriter,
+    info: &'scope RunInfo<'a>,
+    opts: &'scope RecordOptions,
+) -> Result<ScopedJoinHandle<'scope, Result<McapRecorder<'a, DirectWriter>>>> {
+    std::thread::Builder::new()
+        .name("mcap-recorder".into())
+        .spawn_scoped(s, move || {
+            let mut mcap = McapRecorder::start(out, info, opts.mcap_compression)?;
+            mcap.set_reproducible(opts.reproducible);
+            mcap.set_all_levels(opts.all_levels);
+            mcap.write_scene();
+            worker.run(&mut mcap);
+            Ok(mcap)
+        })
+        .context("cannot start the MCAP recorder thread")
+}
+
+/// The grouping, within `opts.limits` and `stop`, then the refinement if `opts.refine` asks:
+/// its events follow the grouping's on the same channels, and the levels are the refined
+/// tree's.
+fn group_and_refine<O: Observer>(
+    scene: &Scene,
+    params: &ResolvedParams,
+    opts: &RecordOptions,
+    stop: &AtomicBool,
+    events: &mut background::Background,
+    progress: O,
+) -> Result<Grouping, Stopped> {
+    let mut result = grouping::group_within(
+        scene,
+        params,
+        Tee(&mut *events, progress),
+        &opts.limits.budget(Some(stop)),
+    );
+    if let (Ok(g), Some(rp)) = (&mut result, &opts.refine) {
+        g.tree = crate::refine::refine(&g.tree, rp, events).tree;
+    }
+    result
+}
+
+/// Waits for both recorders and writes their tails with `outcome` at the same time (the
+/// `.mcap`'s on a thread of its own), each file synced after its tail.
+fn finish_both(
+    rrd_thread: ScopedJoinHandle<'_, Result<RrdRecorder>>,
+    mcap_thread: ScopedJoinHandle<'_, Result<McapRecorder<'_, DirectWriter>>>,
+    outcome: &Outcome<'_>,
+    rrd_file: &Pending,
+    mcap_file: &Pending,
+) -> (Result<()>, Result<()>) {
+    let (rrd_path, mcap_path) = (rrd_file.dest(), mcap_file.dest());
+    std::thread::scope(|t| {
+        let mcap_tail = std::thread::Builder::new()
+            .name("mcap-tail".into())
+            .spawn_scoped(t, || {
+                let mcap = mcap_thread
+                    .join()
+                    .unwrap_or_else(|_| Err(anyhow!("the MCAP recorder failed")))
+                    .with_context(|| mcap_path.display().to_string())?;
+                mcap.finish(outcome)
+                    .with_context(|| mcap_path.display().to_string())?;
+                mcap_file.sync()
+            });
+        let rrd_done = rrd_thread
+            .join()
+            .unwrap_or_else(|_| bail!("{}: the Rerun recorder failed", rrd_path.display()))
+            .and_then(|rrd| rrd.finish(outcome))
+            .and_then(|()| rrd_file.sync());
+        let mcap_done = match mcap_tail {
+            Ok(h) => h
+                .join()
+                .unwrap_or_else(|_| bail!("{}: the MCAP recorder failed", mcap_path.display())),
+            Err(e) => Err(anyhow!(
+                "{}: cannot start a thread: {e}",
+                mcap_path.display()
+            )),
+        };
+        (rrd_done, mcap_done)
+    })
+}
+
+/// Moves both files into place when the grouping `finished`, else sets them aside as
+/// `PREFIX.incomplete.*`; returns where they went.
+fn commit_both(
+    rrd_file: Pending,
+    mcap_file: Pending,
+    prefix: &Path,
+    finished: bool,
+) -> Result<(PathBuf, PathBuf)> {
+    if finished {
+        return Ok((rrd_file.commit()?, mcap_file.commit()?));
+    }
+    let r = with_ext(prefix, ".incomplete.rrd");
+    let m = with_ext(prefix, ".incomplete.mcap");
+    Ok((
+        rrd_file.commit_to(Some(&r))?,
+        mcap_file.commit_to(Some(&m))?,
+    ))
 }
 
 /// What the levels show besides the tree, built after the grouping: the Wrapper Trees and the

@@ -2,19 +2,16 @@
 //! component groups are processed separately and then copy-moved").
 //!
 //! Part `q` is a copy of part `p` when
-//! 1. they have the same structure: the same number of primitives and, primitive by primitive
-//!    in increasing order, the same vertex-index pattern (each primitive's vertices numbered by
-//!    first appearance within the part), so their vertices correspond one to one; and
-//! 2. one proper rotation R (det R = +1) and translation t map every vertex of `p` onto the
-//!    corresponding vertex of `q` within [`COPY_TOLERANCE`] × `p`'s radius (the largest
-//!    distance of its vertices from their centroid, which a rotation does not change).
-//!    R and t are the least-squares fit (Kabsch) over the corresponding vertices; a mirror
-//!    image needs det R = −1 and is not a copy.
+//! 1. they have the same structure: as many primitives, each with the same vertex-index
+//!    pattern (vertices numbered by first appearance within the part), so their vertices
+//!    correspond one to one; and
+//! 2. one proper rotation R (det R = +1, so no mirror image) and translation t, the
+//!    least-squares fit (Kabsch), map every vertex of `p` onto its counterpart in `q` within
+//!    [`COPY_TOLERANCE`] × `p`'s radius (largest vertex distance from the centroid).
 //!
-//! Every part is compared with the representatives found before it with the same structure
-//! and a radius of gyration within reach ([`find`]), in order of that radius and then of
-//! discovery, and copies the first that fits; a part that fits none is a new representative.
-//! The search is sequential and its result does not depend on the thread count.
+//! [`find`] tries the earlier representatives of a part's structure whose radius of gyration is
+//! within reach, by that radius then by discovery, and the part copies the first that fits (none:
+//! a new representative). The search is sequential: the same for any thread count.
 
 use crate::geom::{P3, V3};
 use crate::scene::Scene;

@@ -1,43 +1,18 @@
-//! Pre-grouping and instancing: the paper's speed-ups of §1.3 — "(1) component objects are
-//! pre-grouped and processed separately first, and (2) repeated component groups are
-//! processed separately and then copy-moved" — and the "boundary connectivity analysis to
-//! pre-group the input" of the Figure 3 text.
+//! Pre-grouping and instancing, the paper's speed-ups of §1.3 (`docs/method.md`, "Pre-grouping
+//! and instancing"):
 //!
-//! 1. Components: [`components::connected`] (primitives sharing welded vertices) or
-//!    [`components::objects`] (the file's `o`/`g` objects), numbered by smallest primitive.
-//! 2. Parts: components of at least [`MIN_PART`] primitives. Smaller components (a lone
-//!    triangle, a six-face box) stay as primitives in the top level, so a soup of tiny pieces
-//!    costs what the plain run costs (plus finding the components).
-//! 3. With instancing, parts that are rigid copies of an earlier part are found
-//!    (`instancing`); they are not grouped.
-//! 4. Every other part is grouped by the grouping phase (`cluster::run_boxes`) on its own, in
-//!    parallel (rayon). Each part starts its rounds from its own bodies: DLimit0 = the median
-//!    diameter of its bodies, GLimit0 = DLimit0 × the run's GLimit0/DLimit0 (1/4 by default),
-//!    so a part of small bolts does not wait for the scene's median (the run's own limits in
-//!    every part measured within 2 % in instructions on 44 robot bases and 5 lamps). A part's
-//!    result depends only on its own primitives, so the whole run is identical for any thread
-//!    count.
-//! 5. Every copy takes its representative's Subset Tree shape over its own primitives (the
-//!    i-th primitive of the copy where the representative has its i-th), with boxes and
-//!    diameters recomputed from its own geometry, since an AABB does not rotate with its
-//!    contents.
-//! 6. The top level groups, as bodies, the primitives of the small components (increasing) and
-//!    then the parts' roots (in part order), with the same rule for its limits.
+//! 1. Components ([`components::connected`] or [`components::objects`]) of at least
+//!    [`MIN_PART`] primitives are parts; smaller ones stay loose primitives of the top level.
+//! 2. With instancing, parts that are rigid copies of an earlier part are found (`instancing`).
+//! 3. Every other part is grouped on its own, in parallel, from its own DLimit0 (median body
+//!    diameter) and GLimit0 in the run's ratio; the result is the same for any thread count.
+//! 4. A copy takes its representative's Subset Tree shape, with boxes and diameters from its own
+//!    primitives (an AABB does not rotate with its contents).
+//! 5. The top level groups the loose primitives (increasing), then the part roots.
 //!
-//! **Numbering**: leaves `0..N` in input order; interior nodes part by part in part order
-//! (component index order; a copy at its own place), each part's in its merge order, then the
-//! top level's. **Events**: each part is announced by [`Event::Part`] (`Component` for a
-//! grouped part, `Copy` with the representative's component index and the motion for a copy,
-//! `Top` for the top level) followed by its events with global ids; rounds are numbered over
-//! the whole run (a part's first round follows the previous part's last), and the run's
-//! `rounds` counts them all. A copy has only merges (no rounds of its own: round = the last
-//! round started, active flag from the representative's merge, queue length 0). Parts run in
-//! parallel buffer their events only when the observer listens ([`Observer::is_silent`]).
-//! **Limits**: a [`Budget`]'s `max_pairs` counts the pairs of every part in event order, as if
-//! the parts ran one after another: the part that crosses it is re-run alone up to the stop.
-//!
-//! Only the AABB p-set is pre-grouped: `run` in [`super`] runs the plain §2.2 grouping for the
-//! hull p-set (the CLI refuses the combination).
+//! Interior nodes are numbered part by part, then the top level's. Each part is announced by
+//! [`Event::Part`], then its events follow with global ids and rounds; a [`Budget`]'s
+//! `max_pairs` counts in that order. Only the AABB p-set is pre-grouped.
 
 mod instancing;
 mod remap;
@@ -54,11 +29,9 @@ use crate::scene::Scene;
 use crate::scene::components::{self, Components};
 use rayon::prelude::*;
 
-/// Components with fewer primitives than this stay as primitives in the top level.
-///
-/// Measured (callgrind, one thread, whole `wraptree group` process, 12,000 primitives in
-/// pieces of k; as parts / loose / plain run): k = 2: 441 / 415 / 380 M instructions; k = 3:
-/// 379 / 373 / 344 M; k = 5: 370 / 434 / 410 M; k = 8: 413 / 485 / 460 M.
+/// Components with fewer primitives than this stay as primitives in the top level: pieces of 2
+/// or 3 primitives cost fewer instructions left loose, pieces of 5 or more grouped as parts
+/// (`docs/method.md`, "Pre-grouping and instancing").
 pub const MIN_PART: usize = 4;
 
 /// What pre-grouping found and did in one run (printed by `wraptree group`, in `--json`).
@@ -122,6 +95,117 @@ fn run_part(
     (r, buf)
 }
 
+/// A part's grouping and its buffered events; `None` for a copy, which is not grouped.
+type PartRun = Option<(Result<Grouping, Stopped>, Buffer)>;
+
+/// The components of a run, which of them are parts, and which parts copy an earlier one.
+struct Plan {
+    comps: Components,
+    /// Component indices of the parts (at least [`MIN_PART`] primitives), increasing.
+    parts: Vec<u32>,
+    /// Per part, with instancing: the earlier part it copies.
+    copies: Vec<Option<CopyOf>>,
+}
+
+impl Plan {
+    /// Finds the components (as `params.mode.pregroup` says), the parts and, with
+    /// instancing, the copies.
+    fn new(scene: &Scene, params: &ResolvedParams) -> Plan {
+        let comps: Components = match params.mode.pregroup {
+            Pregroup::Objects => components::objects(scene),
+            Pregroup::Connected | Pregroup::None => components::connected(scene),
+        };
+        let parts: Vec<u32> = (0..comps.len() as u32)
+            .filter(|&c| comps.get(c as usize).len() >= MIN_PART)
+            .collect();
+        let copies: Vec<Option<CopyOf>> = if params.mode.instancing {
+            instancing::find(scene, &comps, &parts)
+        } else {
+            vec![None; parts.len()]
+        };
+        Plan {
+            comps,
+            parts,
+            copies,
+        }
+    }
+
+    /// The boxes of component `c`'s primitives, taken from `boxes`.
+    fn gather(&self, c: u32, boxes: &[Aabb]) -> Vec<Aabb> {
+        self.comps
+            .get(c as usize)
+            .iter()
+            .map(|&i| boxes[i as usize])
+            .collect()
+    }
+
+    /// Groups every part that is not a copy on its own, in parallel, buffering its events
+    /// when `listen`.
+    fn run_parts(
+        &self,
+        boxes: &[Aabb],
+        params: &ResolvedParams,
+        listen: bool,
+        budget: &Budget<'_>,
+    ) -> Vec<PartRun> {
+        self.parts
+            .par_iter()
+            .zip(self.copies.par_iter())
+            .map(|(&c, copy)| {
+                copy.is_none()
+                    .then(|| run_part(self.gather(c, boxes), params, listen, budget))
+            })
+            .collect()
+    }
+
+    /// What pre-grouping found; the top level's counts are filled in later.
+    fn report(&self, params: &ResolvedParams) -> Pregrouping {
+        let mut report = Pregrouping {
+            pregroup: params.mode.pregroup,
+            instancing: params.mode.instancing,
+            components: self.comps.len() as u32,
+            parts: self.parts.len() as u32,
+            threads: rayon::current_num_threads() as u32,
+            ..Pregrouping::default()
+        };
+        for (&c, _) in self
+            .parts
+            .iter()
+            .zip(&self.copies)
+            .filter(|(_, k)| k.is_some())
+        {
+            report.copies += 1;
+            report.primitives_saved += self.comps.get(c as usize).len() as u32;
+        }
+        let mut reps: Vec<usize> = self.copies.iter().flatten().map(|c| c.of).collect();
+        reps.sort_unstable();
+        reps.dedup();
+        report.classes = reps.len() as u32;
+        report
+    }
+
+    /// The primitives of the components too small to be parts, increasing.
+    fn loose(&self) -> Vec<u32> {
+        let mut loose: Vec<u32> = (0..self.comps.len())
+            .filter(|&c| self.comps.get(c).len() < MIN_PART)
+            .flat_map(|c| self.comps.get(c).iter().copied())
+            .collect();
+        loose.sort_unstable();
+        loose
+    }
+}
+
+/// Each representative's merges, whose active flags its copies' merge events take (none
+/// when nobody listens).
+fn rep_merges(runs: &[PartRun], listen: bool) -> Vec<Vec<Merge>> {
+    runs.iter()
+        .map(|r| match r {
+            Some((_, buf)) if listen => buf.merges().collect(),
+            _ => Vec::new(),
+        })
+        .collect()
+}
+
 /// The whole run's tree under construction and its counters.
 struct Assembly {
     n: usize,
@@ -134,6 +218,34 @@ struct Assembly {
 }
 
 impl Assembly {
+    /// The N leaves with boxes `boxes`, room for their N − 1 merges.
+    fn new(boxes: Vec<Aabb>) -> Assembly {
+        let n = boxes.len();
+        let mut asm = Assembly {
+            n,
+            diameter: boxes.iter().map(Aabb::diameter).collect(),
+            aabb: boxes,
+            children: Vec::with_capacity(n - 1),
+            stats: Stats::default(),
+            rounds: 0,
+            parts: 0,
+        };
+        asm.aabb.reserve(n - 1);
+        asm.diameter.reserve(n - 1);
+        asm
+    }
+
+    /// The id map of the next part, over global bodies `leaves`: its interior nodes and
+    /// rounds follow those so far.
+    fn next_map<'a>(&self, leaves: &'a [u32]) -> IdMap<'a> {
+        IdMap {
+            leaves,
+            base: (self.n + self.children.len()) as u32,
+            n: self.n as u32,
+            round0: self.rounds,
+        }
+    }
+
     /// Appends the interior nodes of a part's tree, mapped to global ids; returns the part's
     /// global root.
     fn append(&mut self, g: &Grouping, map: IdMap<'_>) -> u32 {
@@ -216,6 +328,135 @@ impl Assembly {
         }
         map.get(rep.tree.root())
     }
+
+    /// Appends every part in part order, announced: a grouped part by [`Assembly::add_part`], a
+    /// copy by [`Assembly::copy`] with its representative's shape. Returns their global roots.
+    fn add_parts<O: Observer>(
+        &mut self,
+        plan: &Plan,
+        runs: &[PartRun],
+        rep_merges: &[Vec<Merge>],
+        params: &ResolvedParams,
+        observer: &mut O,
+        budget: &Budget<'_>,
+    ) -> Result<Vec<u32>, Stopped> {
+        let mut roots = Vec::with_capacity(plan.parts.len());
+        for (j, &c) in plan.parts.iter().enumerate() {
+            let root = match &plan.copies[j] {
+                Some(copy) => {
+                    let map = self.next_map(plan.comps.get(c as usize));
+                    let (rep_result, _) = runs[copy.of].as_ref().expect("representatives are run");
+                    // A representative that stopped has stopped the run before its copies.
+                    let rep = rep_result
+                        .as_ref()
+                        .expect("copies follow a finished representative");
+                    let kind = PartKind::Copy {
+                        of: plan.parts[copy.of],
+                        rotation: instancing::row_major(&copy.rotation),
+                        translation: copy.translation.into(),
+                    };
+                    self.announce(observer, kind, map.leaves.len());
+                    self.copy(rep, &rep_merges[copy.of], map, params, observer)
+                }
+                None => self.add_part(plan, c, &runs[j], params, observer, budget)?,
+            };
+            roots.push(root);
+        }
+        Ok(roots)
+    }
+
+    /// Announces part `c` and appends its grouping `run`, its buffered events replayed with
+    /// global ids; a part that crosses the run's `max_pairs` is re-run alone with what is left,
+    /// up to the stop. Returns the part's global root.
+    fn add_part<O: Observer>(
+        &mut self,
+        plan: &Plan,
+        c: u32,
+        run: &PartRun,
+        params: &ResolvedParams,
+        observer: &mut O,
+        budget: &Budget<'_>,
+    ) -> Result<u32, Stopped> {
+        let map = self.next_map(plan.comps.get(c as usize));
+        self.announce(observer, PartKind::Component { index: c }, map.leaves.len());
+        let (result, buf) = run.as_ref().expect("parts that are not copies are run");
+        let max_pairs = budget.max_pairs.unwrap_or(u64::MAX);
+        let room = max_pairs.saturating_sub(self.stats.eligible_pairs);
+        let pairs = match result {
+            Ok(g) => g.stats.eligible_pairs,
+            Err(s) => s.eligible_pairs,
+        };
+        let rerun;
+        let result = if pairs > room {
+            let b = Budget {
+                max_pairs: Some(room),
+                ..*budget
+            };
+            let own = plan.gather(c, &self.aabb[..self.n]);
+            let p = part_params(params, &own);
+            rerun = cluster::run_boxes(own, &p, Remap::new(observer, map), &b);
+            &rerun
+        } else {
+            buf.replay(&mut Remap::new(observer, map));
+            result
+        };
+        match result {
+            Ok(g) => Ok(self.append(g, map)),
+            Err(s) => Err(self.stopped(*s)),
+        }
+    }
+
+    /// Announces the top level and groups its bodies `top` (loose primitives, then part roots)
+    /// within what is left of the run's `max_pairs`.
+    fn group_top<O: Observer>(
+        &mut self,
+        top: &[u32],
+        params: &ResolvedParams,
+        observer: &mut O,
+        budget: &Budget<'_>,
+    ) -> Result<(), Stopped> {
+        let top_boxes: Vec<Aabb> = top.iter().map(|&x| self.aabb[x as usize]).collect();
+        self.announce(observer, PartKind::Top, top.len());
+        let map = self.next_map(top);
+        let b = Budget {
+            max_pairs: budget
+                .max_pairs
+                .map(|m| m.saturating_sub(self.stats.eligible_pairs)),
+            ..*budget
+        };
+        let p = part_params(params, &top_boxes);
+        match cluster::run_boxes(top_boxes, &p, Remap::new(observer, map), &b) {
+            Ok(g) => {
+                self.append(&g, map);
+                Ok(())
+            }
+            Err(s) => Err(self.stopped(s)),
+        }
+    }
+
+    /// The finished run's tree of N − 1 merges, announced by `Finish`.
+    fn finish<O: Observer>(
+        self,
+        params: &ResolvedParams,
+        report: Pregrouping,
+        observer: &mut O,
+    ) -> Grouping {
+        let merges = self.children.len() as u32;
+        let tree = SubsetTree::new(self.aabb, self.diameter, self.children)
+            .expect("parts and the top level make N - 1 valid merges");
+        observer.on_event(&Event::Finish {
+            root: tree.root(),
+            rounds: self.rounds,
+            merges,
+        });
+        Grouping {
+            tree,
+            rounds: self.rounds,
+            params: *params,
+            stats: self.stats,
+            pregrouping: Some(report),
+        }
+    }
 }
 
 /// Runs the grouping phase with pre-grouping (and instancing) as `params.mode` says; see the
@@ -227,167 +468,19 @@ pub(super) fn run<O: Observer>(
     budget: &Budget<'_>,
 ) -> Result<Grouping, Stopped> {
     assert!(!scene.is_empty(), "grouping needs at least one primitive");
-    let n = scene.len();
-    let comps: Components = match params.mode.pregroup {
-        Pregroup::Objects => components::objects(scene),
-        Pregroup::Connected | Pregroup::None => components::connected(scene),
-    };
-    let boxes: Vec<Aabb> = (0..n).map(|i| scene.prim_aabb(i)).collect();
-    let parts: Vec<u32> = (0..comps.len() as u32)
-        .filter(|&c| comps.get(c as usize).len() >= MIN_PART)
-        .collect();
-    let copies: Vec<Option<CopyOf>> = if params.mode.instancing {
-        instancing::find(scene, &comps, &parts)
-    } else {
-        vec![None; parts.len()]
-    };
+    let plan = Plan::new(scene, params);
+    let boxes: Vec<Aabb> = (0..scene.len()).map(|i| scene.prim_aabb(i)).collect();
     let listen = !observer.is_silent();
-    let gather = |c: u32, boxes: &[Aabb]| -> Vec<Aabb> {
-        comps
-            .get(c as usize)
-            .iter()
-            .map(|&i| boxes[i as usize])
-            .collect()
-    };
-    let runs: Vec<Option<(Result<Grouping, Stopped>, Buffer)>> = parts
-        .par_iter()
-        .zip(copies.par_iter())
-        .map(|(&c, copy)| {
-            copy.is_none()
-                .then(|| run_part(gather(c, &boxes), params, listen, budget))
-        })
-        .collect();
-    let rep_merges: Vec<Vec<Merge>> = runs
-        .iter()
-        .map(|r| match r {
-            Some((_, buf)) if listen => buf.merges().collect(),
-            _ => Vec::new(),
-        })
-        .collect();
-
-    let mut asm = Assembly {
-        n,
-        diameter: boxes.iter().map(Aabb::diameter).collect(),
-        aabb: boxes,
-        children: Vec::with_capacity(n - 1),
-        stats: Stats::default(),
-        rounds: 0,
-        parts: 0,
-    };
-    asm.aabb.reserve(n - 1);
-    asm.diameter.reserve(n - 1);
-    let max_pairs = budget.max_pairs.unwrap_or(u64::MAX);
-    let mut roots = Vec::with_capacity(parts.len());
-    let mut report = Pregrouping {
-        pregroup: params.mode.pregroup,
-        instancing: params.mode.instancing,
-        components: comps.len() as u32,
-        parts: parts.len() as u32,
-        threads: rayon::current_num_threads() as u32,
-        ..Pregrouping::default()
-    };
-    for (j, &c) in parts.iter().enumerate() {
-        let prims = comps.get(c as usize);
-        let map = IdMap {
-            leaves: prims,
-            base: (n + asm.children.len()) as u32,
-            n: n as u32,
-            round0: asm.rounds,
-        };
-        if let Some(copy) = &copies[j] {
-            let (rep_result, _) = runs[copy.of].as_ref().expect("representatives are run");
-            // A representative that stopped has stopped the run before its copies.
-            let rep = rep_result
-                .as_ref()
-                .expect("copies follow a finished representative");
-            let kind = PartKind::Copy {
-                of: parts[copy.of],
-                rotation: instancing::row_major(&copy.rotation),
-                translation: copy.translation.into(),
-            };
-            asm.announce(&mut observer, kind, prims.len());
-            roots.push(asm.copy(rep, &rep_merges[copy.of], map, params, &mut observer));
-            report.copies += 1;
-            report.primitives_saved += prims.len() as u32;
-            continue;
-        }
-        asm.announce(&mut observer, PartKind::Component { index: c }, prims.len());
-        let (result, buf) = runs[j].as_ref().expect("parts that are not copies are run");
-        let room = max_pairs.saturating_sub(asm.stats.eligible_pairs);
-        let pairs = match result {
-            Ok(g) => g.stats.eligible_pairs,
-            Err(s) => s.eligible_pairs,
-        };
-        let rerun;
-        let result = if pairs > room {
-            // This part crosses the run's max_pairs: re-run it alone with what is left.
-            let b = Budget {
-                max_pairs: Some(room),
-                ..*budget
-            };
-            let own = gather(c, &asm.aabb[..n]);
-            let p = part_params(params, &own);
-            rerun = cluster::run_boxes(own, &p, Remap::new(&mut observer, map), &b);
-            &rerun
-        } else {
-            buf.replay(&mut Remap::new(&mut observer, map));
-            result
-        };
-        match result {
-            Ok(g) => roots.push(asm.append(g, map)),
-            Err(s) => return Err(asm.stopped(*s)),
-        }
-    }
-    report.classes = {
-        let mut reps: Vec<usize> = copies.iter().flatten().map(|c| c.of).collect();
-        reps.sort_unstable();
-        reps.dedup();
-        reps.len() as u32
-    };
-
+    let runs = plan.run_parts(&boxes, params, listen, budget);
+    let mut report = plan.report(params);
+    let mut asm = Assembly::new(boxes);
+    let rep_merges = rep_merges(&runs, listen);
+    let roots = asm.add_parts(&plan, &runs, &rep_merges, params, &mut observer, budget)?;
     // The top level: loose primitives (increasing), then the part roots (in part order).
-    let mut top: Vec<u32> = (0..comps.len())
-        .filter(|&c| comps.get(c).len() < MIN_PART)
-        .flat_map(|c| comps.get(c).iter().copied())
-        .collect();
-    top.sort_unstable();
+    let mut top = plan.loose();
     report.loose = top.len() as u32;
     top.extend(&roots);
     report.top_bodies = top.len() as u32;
-    let top_boxes: Vec<Aabb> = top.iter().map(|&x| asm.aabb[x as usize]).collect();
-    asm.announce(&mut observer, PartKind::Top, top.len());
-    let map = IdMap {
-        leaves: &top,
-        base: (n + asm.children.len()) as u32,
-        n: n as u32,
-        round0: asm.rounds,
-    };
-    let b = Budget {
-        max_pairs: budget
-            .max_pairs
-            .map(|m| m.saturating_sub(asm.stats.eligible_pairs)),
-        ..*budget
-    };
-    let p = part_params(params, &top_boxes);
-    match cluster::run_boxes(top_boxes, &p, Remap::new(&mut observer, map), &b) {
-        Ok(g) => {
-            asm.append(&g, map);
-        }
-        Err(s) => return Err(asm.stopped(s)),
-    }
-    let merges = asm.children.len() as u32;
-    let tree = SubsetTree::new(asm.aabb, asm.diameter, asm.children)
-        .expect("parts and the top level make N - 1 valid merges");
-    observer.on_event(&Event::Finish {
-        root: tree.root(),
-        rounds: asm.rounds,
-        merges,
-    });
-    Ok(Grouping {
-        tree,
-        rounds: asm.rounds,
-        params: *params,
-        stats: asm.stats,
-        pregrouping: Some(report),
-    })
+    asm.group_top(&top, params, &mut observer, budget)?;
+    Ok(asm.finish(params, report, &mut observer))
 }

@@ -1,7 +1,7 @@
 //! `bench`'s files: `results.csv`, per scene the build-time/query-cost and wrapper-time/
 //! tightness charts, and `bench.rrd` with the same charts and the results table.
 
-use super::{QUERY_COLUMNS, SIZE, opt, query_fields, series_by, write_chart};
+use super::{QUERY_COLUMNS, SIZE, csv_bytes, opt, query_fields, series_by, write_chart};
 use crate::metrics::compare::{Row, query_values};
 use crate::output::write_atomic;
 use crate::record::rrd::SeriesFile;
@@ -15,38 +15,39 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// The bench rows as CSV (one header line, one line per row).
-pub fn bench_csv(rows: &[Row]) -> String {
-    let mut s = format!(
+pub fn bench_csv(rows: &[Row]) -> Result<Vec<u8>> {
+    let header = format!(
         "scene,n,method,wrapper,build_s,refine_s,wrapper_s,sah,depth_max,depth_mean,structural_balance,\
-spatial_balance,tightness,tightness_per_level,{QUERY_COLUMNS}\n"
+spatial_balance,tightness,tightness_per_level,{QUERY_COLUMNS}"
     );
-    for r in rows {
-        let q = &r.quality;
-        let _ = writeln!(
-            s,
-            "{},{},{},{},{:.6e},{:.6e},{:.6e},{:.6e},{},{:.4},{:.4},{:.4},{},{},{}",
-            r.scene,
-            r.n,
-            r.method,
-            r.wrapper,
-            r.build_s,
-            r.refine_s,
-            r.wrapper_s,
-            q.sah,
-            q.depth_max,
-            q.depth_mean,
-            q.structural_balance,
-            q.spatial_balance,
-            opt(r.tightness),
-            r.tightness_levels
-                .iter()
-                .map(|t| format!("{t:.4}"))
-                .collect::<Vec<_>>()
-                .join(";"),
-            query_fields(r.query.as_ref()),
-        );
-    }
-    s
+    csv_bytes(&header, rows.iter().map(bench_record))
+}
+
+/// One row's fields in the order of [`bench_csv`]'s header.
+fn bench_record(r: &Row) -> Vec<String> {
+    let q = &r.quality;
+    let mut fields = vec![
+        r.scene.clone(),
+        r.n.to_string(),
+        r.method.to_string(),
+        r.wrapper.to_string(),
+        format!("{:.6e}", r.build_s),
+        format!("{:.6e}", r.refine_s),
+        format!("{:.6e}", r.wrapper_s),
+        format!("{:.6e}", q.sah),
+        q.depth_max.to_string(),
+        format!("{:.4}", q.depth_mean),
+        format!("{:.4}", q.structural_balance),
+        format!("{:.4}", q.spatial_balance),
+        opt(r.tightness),
+        r.tightness_levels
+            .iter()
+            .map(|t| format!("{t:.4}"))
+            .collect::<Vec<_>>()
+            .join(";"),
+    ];
+    fields.extend(query_fields(r.query.as_ref()));
+    fields
 }
 
 /// The two bench charts for one scene: build time against node tests per query (hierarchy +
@@ -103,7 +104,7 @@ pub fn bench_charts(scene: &str, rows: &[Row]) -> Result<Vec<(String, String)>> 
 pub fn write_bench(dir: &Path, rows: &[Row], force: bool) -> Result<Vec<PathBuf>> {
     let mut written = Vec::new();
     let csv = dir.join("results.csv");
-    write_atomic(&csv, bench_csv(rows).as_bytes(), force)?;
+    write_atomic(&csv, &bench_csv(rows)?, force)?;
     written.push(csv);
     let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
     scenes.dedup();
@@ -289,4 +290,59 @@ fn bench_rrd(path: &Path, rows: &[Row], force: bool) -> Result<PathBuf> {
         )?;
     }
     file.commit()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::metrics::Quality;
+
+    fn row(scene: &str) -> Row {
+        Row {
+            scene: scene.into(),
+            n: 3,
+            method: "grouping",
+            wrapper: "box",
+            build_s: 1.5e-3,
+            refine_s: 0.0,
+            wrapper_s: 2e-5,
+            quality: Quality {
+                sah: 12.5,
+                depth_max: 4,
+                depth_mean: 3.25,
+                structural_balance: 0.5,
+                spatial_balance: 0.75,
+            },
+            tightness: Some(0.25),
+            tightness_levels: vec![0.5, 0.25],
+            query: None,
+        }
+    }
+
+    #[test]
+    fn scene_names_with_a_comma_or_a_quote_keep_their_columns() {
+        let names = ["a,b.obj", "say \"hi\".obj", "lamp"];
+        let bytes = bench_csv(&names.map(row)).unwrap();
+        let mut reader = csv::Reader::from_reader(&bytes[..]);
+        let width = reader.headers().unwrap().len();
+        assert_eq!(width, 23);
+        let records: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+        assert_eq!(records.len(), names.len());
+        for (r, name) in records.iter().zip(names) {
+            assert_eq!(r.len(), width, "{r:?}");
+            assert_eq!(&r[0], name);
+            assert_eq!(&r[13], "0.5000;0.2500");
+        }
+    }
+
+    #[test]
+    fn an_ordinary_row_is_written_without_quotes() {
+        let text = String::from_utf8(bench_csv(&[row("lamp")]).unwrap()).unwrap();
+        assert_eq!(
+            text.lines().nth(1).unwrap(),
+            "lamp,3,grouping,box,1.500000e-3,0.000000e0,2.000000e-5,1.250000e1,4,3.2500,0.5000,\
+0.7500,2.500000e-1,0.5000;0.2500,,,,,,,,,"
+        );
+        assert!(text.ends_with(",,\n"));
+    }
 }

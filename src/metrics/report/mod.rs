@@ -46,17 +46,30 @@ pub(super) fn opt(v: Option<f64>) -> String {
 pub(super) const QUERY_COLUMNS: &str = "point_bv,point_prim,distance_bv,distance_prim,overlap_bv,overlap_prim,\
 node_tests_per_query,query_cost,query_s";
 
-pub(super) fn query_fields(q: Option<&QueryCost>) -> String {
+/// The [`QUERY_COLUMNS`] fields of a query cost, all empty without one.
+pub(super) fn query_fields(q: Option<&QueryCost>) -> Vec<String> {
     match q {
-        None => ",".repeat(QUERY_COLUMNS.matches(',').count()),
-        Some(q) => {
-            let v = crate::metrics::compare::query_values(q);
-            v.iter()
-                .map(|x| format!("{x:.6e}"))
-                .collect::<Vec<_>>()
-                .join(",")
-        }
+        None => vec![String::new(); QUERY_COLUMNS.split(',').count()],
+        Some(q) => crate::metrics::compare::query_values(q)
+            .iter()
+            .map(|x| format!("{x:.6e}"))
+            .collect(),
     }
+}
+
+/// `header` (comma-separated names) and `records` as CSV, written by the csv crate: `\n` after
+/// each line, a field quoted only where it holds a comma, a quote or a line break. Err: a
+/// record whose length differs from the header's.
+pub(super) fn csv_bytes(
+    header: &str,
+    records: impl IntoIterator<Item = Vec<String>>,
+) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(header.split(','))?;
+    for r in records {
+        w.write_record(&r)?;
+    }
+    w.into_inner().map_err(|e| anyhow!("CSV: {}", e.error()))
 }
 
 /// Writes `stem.svg` and `stem.png` in `dir`; returns both paths.

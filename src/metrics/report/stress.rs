@@ -1,6 +1,7 @@
 //! The table, CSV and charts of `wraptree stress` ([`crate::metrics::stress`]).
 
 use crate::render::chart::{Scatter, Series};
+use anyhow::Result;
 use std::fmt::Write as _;
 
 /// One measured case: a row of the table and of stress.csv.
@@ -35,29 +36,26 @@ fn opt(v: Option<f64>, prec: usize) -> String {
     v.map(|x| format!("{x:.prec$}")).unwrap_or_default()
 }
 
-/// The CSV text of `rows` (header first).
-pub fn stress_csv(rows: &[StressRow]) -> String {
-    let mut s = String::from(
-        "scene,n,method,split_r,finished,valid,depth_max,seconds,k_eligible,k_candidates,note\n",
-    );
-    for r in rows {
-        let _ = writeln!(
-            s,
-            "{},{},{},{},{},{},{},{},{},{},\"{}\"",
-            r.scene,
-            r.n,
-            r.method,
-            opt(r.split_r, 0),
-            r.finished,
-            r.valid.map(|v| v.to_string()).unwrap_or_default(),
-            r.depth.map(|d| d.to_string()).unwrap_or_default(),
-            opt(r.seconds, 6),
-            opt(r.k_eligible, 3),
-            opt(r.k_candidates, 3),
-            r.note.replace('"', "'")
-        );
-    }
-    s
+/// The CSV of `rows` (header first).
+pub fn stress_csv(rows: &[StressRow]) -> Result<Vec<u8>> {
+    super::csv_bytes(
+        "scene,n,method,split_r,finished,valid,depth_max,seconds,k_eligible,k_candidates,note",
+        rows.iter().map(|r| {
+            vec![
+                r.scene.clone(),
+                r.n.to_string(),
+                r.method.clone(),
+                opt(r.split_r, 0),
+                r.finished.to_string(),
+                r.valid.map(|v| v.to_string()).unwrap_or_default(),
+                r.depth.map(|d| d.to_string()).unwrap_or_default(),
+                opt(r.seconds, 6),
+                opt(r.k_eligible, 3),
+                opt(r.k_candidates, 3),
+                r.note.clone(),
+            ]
+        }),
+    )
 }
 
 /// `rows` as a text table (header first).
@@ -125,5 +123,44 @@ pub fn stress_sweep_chart(
             series("k".into(), false, |r| r.k_eligible),
             series(format!("k, split R = {r}"), true, |r| r.k_eligible),
         ],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_scene_or_note_with_a_comma_or_a_quote_keeps_its_columns() {
+        let rows = [
+            StressRow {
+                scene: "a,b.obj".into(),
+                n: 300,
+                method: "group-aabb".into(),
+                finished: true,
+                valid: Some(true),
+                depth: Some(11),
+                seconds: Some(0.5),
+                ..StressRow::default()
+            },
+            StressRow {
+                scene: "say \"hi\".obj".into(),
+                method: "wrap-obb".into(),
+                split_r: Some(8.0),
+                note: "over budget: stopped after 3 merges, \"quoted\"".into(),
+                ..StressRow::default()
+            },
+        ];
+        let bytes = stress_csv(&rows).unwrap();
+        let mut reader = csv::Reader::from_reader(&bytes[..]);
+        assert_eq!(reader.headers().unwrap().len(), 11);
+        let records: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+        assert_eq!(records.len(), 2);
+        assert!(records.iter().all(|r| r.len() == 11));
+        assert_eq!(&records[0][0], "a,b.obj");
+        assert_eq!(&records[0][6], "11");
+        assert_eq!(&records[1][0], "say \"hi\".obj");
+        assert_eq!(&records[1][3], "8");
+        assert_eq!(&records[1][10], rows[1].note);
     }
 }

@@ -1,7 +1,7 @@
 //! `sweep`'s files: `sweep.csv`, the heat maps and `sweep.rrd` with every setting's merge
 //! series side by side.
 
-use super::{QUERY_COLUMNS, query_fields, write_chart};
+use super::{QUERY_COLUMNS, csv_bytes, query_fields, write_chart};
 use crate::grouping::{CostMeasure, Merge};
 use crate::metrics::compare::query_values;
 use crate::metrics::sweep::{Setting, SweepRow};
@@ -19,30 +19,31 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// The sweep rows as CSV.
-pub fn sweep_csv(rows: &[SweepRow]) -> String {
-    let mut s = format!(
-        "a,b,c,cost,build_s,rounds,sah,depth_max,depth_mean,structural_balance,spatial_balance,{QUERY_COLUMNS}\n"
+pub fn sweep_csv(rows: &[SweepRow]) -> Result<Vec<u8>> {
+    let header = format!(
+        "a,b,c,cost,build_s,rounds,sah,depth_max,depth_mean,structural_balance,spatial_balance,{QUERY_COLUMNS}"
     );
-    for r in rows {
-        let (w, q) = (&r.weights, &r.quality);
-        let _ = writeln!(
-            s,
-            "{},{},{},{},{:.6e},{},{:.6e},{},{:.4},{:.4},{:.4},{}",
-            w.a,
-            w.b,
-            w.c,
-            measure_name(r.cost),
-            r.build_s,
-            r.rounds,
-            q.sah,
-            q.depth_max,
-            q.depth_mean,
-            q.structural_balance,
-            q.spatial_balance,
-            query_fields(Some(&r.query)),
-        );
-    }
-    s
+    csv_bytes(&header, rows.iter().map(sweep_record))
+}
+
+/// One row's fields in the order of [`sweep_csv`]'s header.
+fn sweep_record(r: &SweepRow) -> Vec<String> {
+    let (w, q) = (&r.weights, &r.quality);
+    let mut fields = vec![
+        w.a.to_string(),
+        w.b.to_string(),
+        w.c.to_string(),
+        measure_name(r.cost).to_string(),
+        format!("{:.6e}", r.build_s),
+        r.rounds.to_string(),
+        format!("{:.6e}", q.sah),
+        q.depth_max.to_string(),
+        format!("{:.4}", q.depth_mean),
+        format!("{:.4}", q.structural_balance),
+        format!("{:.4}", q.spatial_balance),
+    ];
+    fields.extend(query_fields(Some(&r.query)));
+    fields
 }
 
 /// A sweep measure: file stem, title and how to read it from a row.
@@ -125,7 +126,7 @@ pub fn write_sweep(
 ) -> Result<Vec<PathBuf>> {
     let mut written = Vec::new();
     let csv = dir.join("sweep.csv");
-    write_atomic(&csv, sweep_csv(rows).as_bytes(), force)?;
+    write_atomic(&csv, &sweep_csv(rows)?, force)?;
     written.push(csv);
     for (stem, map) in sweep_heat_maps(scene, rows) {
         let cols = map.x_ticks.len().clamp(1, 40) as u32;

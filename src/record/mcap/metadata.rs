@@ -17,7 +17,7 @@ pub const RUN: &str = "wraptree";
 /// Name of the metadata record holding wall-clock values (omitted by reproducible recordings).
 pub const TIMING: &str = "wraptree.timing";
 
-/// Keys of the `wraptree` record, in the order the README lists them.
+/// Keys of the `wraptree` record, in the order `docs/recordings.md` ("Metadata") lists them.
 pub const KEYS: &[&str] = &[
     "version",
     "git_commit",
@@ -306,12 +306,12 @@ fn mode(m: &BTreeMap<String, String>) -> Result<Mode> {
             true => parse(m, "chunk_top")?,
             false => d.chunk_top,
         },
-        // Recordings before ε became a setting hold the chunking they were made with.
+        // A recording without `chunk_epsilon` was made with the default ε.
         chunk_epsilon: match m.contains_key("chunk_epsilon") {
             true => parse(m, "chunk_epsilon")?,
             false => d.chunk_epsilon,
         },
-        // Partitioned recordings from before the SAH cuts (session 11) were split at Morton
+        // A partitioned recording without `chunk_sah` (it has `chunk_top`) was cut at Morton
         // bits throughout; other schedules do not write the chunking.
         chunk_sah: match (m.contains_key("chunk_sah"), m.contains_key("chunk_top")) {
             (true, _) => parse(m, "chunk_sah")?,

@@ -1,38 +1,17 @@
 //! Foxglove `.mcap` recordings of a grouping run ([`McapRecorder`]) and their reader
-//! ([`read_recording`], used by `wraptree replay`).
+//! ([`read_recording`], used by `wraptree replay`). Topics, compression, log times and metadata
+//! are listed in `docs/recordings.md`, "`.mcap` (Foxglove)" and "Metadata".
 //!
-//! The file is chunked, LZ4-compressed below [`AUTO_UNCOMPRESSED_FROM`] primitives and
-//! uncompressed from there on unless asked otherwise ([`Compression`]; LZ4 and Zstandard run
-//! single-threaded, so the same run gives the same bytes on every machine), with chunk,
-//! data-section, summary and attachment CRCs. Geometry
-//! uses the well-known `foxglove.SceneUpdate` schema; grouping events use small typed protobuf
-//! messages derived with `foxglove::Encode` ([`messages`]). Message encoding is `protobuf`
-//! everywhere; every entity is in frame `world`.
+//! The file is chunked with every CRC on and written front to back; chunks are compressed as
+//! [`Compression`] says, single-threaded, so the same run gives the same bytes on every machine.
+//! Geometry uses `foxglove.SceneUpdate`, grouping events small protobuf messages derived with
+//! `foxglove::Encode` ([`messages`]); every entity is in frame `world`. The scene file is
+//! attached, and two metadata records describe the run ([`metadata`]); `wraptree.timing`, the
+//! only wall-clock value, is left out by [`McapRecorder::set_reproducible`].
 //!
-//! | topic | schema | what | written when |
-//! |---|---|---|---|
-//! | `/scene` | `foxglove.SceneUpdate` | entity `scene`: every input primitive in one indexed `TriangleListPrimitive` (no indices when no vertex is shared, as in a soup), light grey | always, once |
-//! | `/grouping/round` | `roundevent.RoundEvent` | each round start (DLimit, GLimit, active, dormant, eligible pairs) and each DLimit doubling (`doubling = true`, merges of the ended round, new limits) | always |
-//! | `/grouping/merge` | `mergeevent.MergeEvent` | every merge: step, round, a, b, new, AABB, diameter, Fill, Balance, Cost, queue length, active | always |
-//! | `/grouping/part` | `partevent.PartEvent` | each part of the run (partitioned schedule's chunks and top, pre-grouping's components and copies): id, kind (0 chunk, 1 component, 2 copy, 3 top), bodies, first step, chunk level and keep, component index (or the copied one), copy rotation and translation (written for copies only; absent, read as 0, in other parts); the merges up to the next part belong to it | runs with parts, from the first part on |
-//! | `/grouping/finish` | `finishevent.FinishEvent` | root, rounds, merges | always, once |
-//! | `/refine/step` | `refinestepevent.RefineStepEvent` | every kept step of the refinement: step, pass, kind (0 move, 1 treelet) and treelet leaves, moved node (treelet root), its parent slot, old and new sibling, the moved subtree's and new parent's boxes, SAH before and after | `record --refine` |
-//! | `/grouping/active` | `foxglove.SceneUpdate` | entity `active`: one translucent green box per active body at each round start (none above [`ACTIVE_CAP`] active bodies) | `--detail merges` or `full` |
-//! | `/grouping/bodies` | `foxglove.SceneUpdate` | entity `merge`: the merged pair (red) and the new body (yellow) as boxes, per merge of the last [`BODIES_CAP`] | `--detail full` (it repeats boxes the merge events already carry, and is the largest per-merge topic) |
-//! | `/grouping/dormant` | `dormantevent.DormantEvent` | round, body, diameter of each body going dormant | `--detail merges` or `full` |
-//! | `/levels/<d>` | `foxglove.SceneUpdate` | one snapshot of the cut at depth d of the finished tree (the refined one with `record --refine`) (d = 0 down to the last cut of less than half leaves, `LEVEL_LEAF_SHARE`; every depth with `set_all_levels`), one entity per wrapper kind chosen with `--wrapper` for the cut's interior nodes: `spheres` (`SpherePrimitive`s, size = diameter), `hulls` (one indexed `TriangleListPrimitive` per hull; a segment hull is one degenerate triangle `[a, b, b]`, a point hull `[a, a, a]`), `boxes` (axis-aligned `CubePrimitive`s), `obbs` (`CubePrimitive`s with orientation); and entity `leaves` (the cut's leaves as one orange `TriangleListPrimitive`) | `--detail levels` or `full`, finished runs |
-//! | `/cover` | `foxglove.SceneUpdate` | the cover (`--cover-tolerance` or `--cover-budget`) as one more level: entities `spheres`, `boxes` (oriented ones with orientation), `hulls` (one indexed `TriangleListPrimitive` per hull) and `leaves` (one `TriangleListPrimitive` per leaf drawn as itself), only those used | with a cover, `--detail levels` or `full`, finished runs |
-//!
-//! The input scene file is attached (name = its file name, media type `model/obj`, log time 0),
-//! and two metadata records describe the run ([`metadata`]): `wraptree` (version, git commit,
-//! every parameter, scene name/file/sha256, load options, N, rounds, merges, depth, complete) and
-//! `wraptree.timing` (`seconds`, the only wall-clock value; left out by
-//! [`McapRecorder::set_reproducible`]).
-//!
-//! **Log times** are synthetic and monotonic, never wall-clock: the scene at 0; the k-th grouping
-//! event (k = 1, 2, …, counting every event, written at this detail or not: round starts,
-//! merges, dormant bodies, doublings, the finish, then the refinement's start and steps) at k ms; the level snapshots after the last event at consecutive milliseconds,
-//! `/levels/<d>` at (events + 1 + d) ms, then `/cover` at (events + 2 + depth max) ms. Sequence numbers count up from 0 on each channel.
+//! **Log times** are synthetic and monotonic: the scene at 0, the k-th grouping event (every
+//! event, written at this detail or not) at k ms, then `/levels/<d>` at (events + 1 + d) ms and
+//! `/cover` at (events + 2 + depth max) ms. Sequence numbers count from 0 on each channel.
 
 mod levels;
 pub mod messages;
@@ -42,8 +21,9 @@ pub mod scene_msgs;
 
 pub use read::{Recorded, read_recording};
 
+use crate::events::{RefineParams, Step};
 use crate::geom::Aabb;
-use crate::grouping::{Event, Observer};
+use crate::grouping::{Event, Merge, Observer, Part};
 use crate::record::{Detail, Outcome, RunInfo};
 use anyhow::{Context, Result, anyhow};
 use foxglove::Encode;
@@ -54,15 +34,14 @@ use std::collections::BTreeMap;
 use std::io::{Seek, Write};
 
 /// LZ4 level of every chunk with [`Compression::Lz4`]: 0, the fast (not high-compression)
-/// mode. On the 10^6-triangle recording it compresses 3× faster than zstd level 2, for chunks
-/// 16 % larger (README).
+/// mode: faster than Zstandard, for chunks a little larger (`docs/recordings.md`, "Sizes").
 pub const LZ4_LEVEL: u32 = 0;
 /// Zstandard level of every chunk with [`Compression::Zstd`].
 pub const ZSTD_LEVEL: u32 = 2;
 
 /// Scenes of at least this many primitives get uncompressed chunks under
-/// [`Compression::Auto`]: at 10^6 triangles LZ4 costs about 0.4 s of CPU, nearly as much as the
-/// grouping, for a file 14 % smaller (README, Recordings at scale).
+/// [`Compression::Auto`]: there LZ4 costs about as much as the grouping for a file little
+/// smaller (`docs/recordings.md`, "`.mcap` (Foxglove)").
 pub const AUTO_UNCOMPRESSED_FROM: usize = 500_000;
 
 /// How the `.mcap`'s chunks are compressed (`record --mcap-compression`).
@@ -312,11 +291,10 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
         self.all_levels = on;
     }
 
+    /// Writes one event at its log time (the k-th event at k ms) on its topics.
     fn record(&mut self, event: &Event<'_>) -> Result<()> {
         let t = self.events * MS;
         let (w, buf) = (&mut self.writer, &mut self.buf);
-        let detail = self.topics.detail.as_mut();
-        let bodies_topic = self.topics.bodies.as_mut();
         match *event {
             Event::RoundStart {
                 round,
@@ -337,57 +315,24 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
                     merges: 0,
                 };
                 emit(w, buf, &mut self.topics.round, t, &msg)?;
-                if let Some([active_topic, _]) = detail {
-                    let mut e = scene_msgs::entity("active", t);
-                    let bodies = &self.bodies;
-                    e.cubes = active[..if active.len() > ACTIVE_CAP {
-                        0
-                    } else {
-                        active.len()
-                    }]
-                        .iter()
-                        .map(|&id| {
-                            let b = bodies.get(id as usize).copied().unwrap_or(Aabb::EMPTY);
-                            scene_msgs::cube(&b, scene_msgs::ACTIVE_COLOR)
-                        })
-                        .collect();
-                    emit(w, buf, active_topic, t, &scene_msgs::update(vec![e]))?;
-                }
+                self.record_active(t, active)
             }
-            Event::Merge(m) => {
-                emit(w, buf, &mut self.topics.merge, t, &MergeEvent::from(&m))?;
-                let new = m.new as usize;
-                if self.bodies.len() <= new {
-                    self.bodies.resize(new + 1, Aabb::EMPTY);
-                }
-                self.bodies[new] = m.aabb;
-                let drawn = crate::record::boxes_drawn(m.step, self.info.scene.len());
-                if let Some(bodies_topic) = bodies_topic.filter(|_| drawn) {
-                    let mut e = scene_msgs::entity("merge", t);
-                    let get =
-                        |id: u32| self.bodies.get(id as usize).copied().unwrap_or(Aabb::EMPTY);
-                    e.cubes = vec![
-                        scene_msgs::cube(&get(m.a), scene_msgs::PAIR_COLOR),
-                        scene_msgs::cube(&get(m.b), scene_msgs::PAIR_COLOR),
-                        scene_msgs::cube(&m.aabb, scene_msgs::NEW_COLOR),
-                    ];
-                    emit(w, buf, bodies_topic, t, &scene_msgs::update(vec![e]))?;
-                }
-            }
+            Event::Merge(m) => self.record_merge(t, &m),
             Event::Dormant {
                 round,
                 body,
                 diameter,
-            } => {
-                if let Some([_, dormant_topic]) = detail {
+            } => match self.topics.detail.as_mut() {
+                Some([_, dormant_topic]) => {
                     let msg = DormantEvent {
                         round,
                         body,
                         diameter,
                     };
-                    emit(w, buf, dormant_topic, t, &msg)?;
+                    emit(w, buf, dormant_topic, t, &msg)
                 }
-            }
+                None => Ok(()),
+            },
             Event::Doubling {
                 round,
                 merges,
@@ -404,40 +349,11 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
                     pairs: 0,
                     merges,
                 };
-                emit(w, buf, &mut self.topics.round, t, &msg)?;
+                emit(w, buf, &mut self.topics.round, t, &msg)
             }
-            Event::Part(p) => {
-                let topic = match &mut self.topics.part {
-                    Some(topic) => topic,
-                    None => {
-                        let schema = add_schema::<PartEvent, W>(w)?;
-                        self.topics
-                            .part
-                            .insert(add_topic(w, schema, "/grouping/part")?)
-                    }
-                };
-                emit(w, buf, topic, t, &PartEvent::from(&p))?;
-            }
-            Event::RefineStart { params, sah } => {
-                let schema = add_schema::<RefineStepEvent, W>(w)?;
-                let topic = add_topic(w, schema, "/refine/step")?;
-                let summary = metadata::RefineSummary {
-                    params,
-                    steps: 0,
-                    sah_before: sah,
-                    sah_after: sah,
-                };
-                self.refine = Some((summary, topic));
-            }
-            Event::Refine(step) => {
-                let (summary, topic) = self
-                    .refine
-                    .as_mut()
-                    .ok_or_else(|| anyhow!("refinement step before its start"))?;
-                emit(w, buf, topic, t, &RefineStepEvent::from(&step))?;
-                summary.steps = step.step + 1;
-                summary.sah_after = step.sah;
-            }
+            Event::Part(p) => self.record_part(t, &p),
+            Event::RefineStart { params, sah } => self.start_refine(params, sah),
+            Event::Refine(step) => self.record_refine_step(t, &step),
             Event::Finish {
                 root,
                 rounds,
@@ -448,9 +364,104 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
                     rounds,
                     merges,
                 };
-                emit(w, buf, &mut self.topics.finish, t, &msg)?;
+                emit(w, buf, &mut self.topics.finish, t, &msg)
             }
         }
+    }
+
+    /// With per-merge detail, a round's active bodies as boxes on `/grouping/active` (an empty
+    /// update above [`ACTIVE_CAP`] of them).
+    fn record_active(&mut self, t: u64, active: &[u32]) -> Result<()> {
+        let Some([active_topic, _]) = self.topics.detail.as_mut() else {
+            return Ok(());
+        };
+        let shown = if active.len() > ACTIVE_CAP {
+            &[][..]
+        } else {
+            active
+        };
+        let mut e = scene_msgs::entity("active", t);
+        let bodies = &self.bodies;
+        e.cubes = shown
+            .iter()
+            .map(|&id| {
+                let b = bodies.get(id as usize).copied().unwrap_or(Aabb::EMPTY);
+                scene_msgs::cube(&b, scene_msgs::ACTIVE_COLOR)
+            })
+            .collect();
+        let update = scene_msgs::update(vec![e]);
+        emit(&mut self.writer, &mut self.buf, active_topic, t, &update)
+    }
+
+    /// A merge on `/grouping/merge`; keeps the new body's box, and with `--detail full` draws
+    /// the pair and the new body on `/grouping/bodies` for the last [`BODIES_CAP`] merges.
+    fn record_merge(&mut self, t: u64, m: &Merge) -> Result<()> {
+        let (w, buf) = (&mut self.writer, &mut self.buf);
+        emit(w, buf, &mut self.topics.merge, t, &MergeEvent::from(m))?;
+        let new = m.new as usize;
+        if self.bodies.len() <= new {
+            self.bodies.resize(new + 1, Aabb::EMPTY);
+        }
+        self.bodies[new] = m.aabb;
+        let drawn = crate::record::boxes_drawn(m.step, self.info.scene.len());
+        if let Some(bodies_topic) = self.topics.bodies.as_mut().filter(|_| drawn) {
+            let mut e = scene_msgs::entity("merge", t);
+            let get = |id: u32| self.bodies.get(id as usize).copied().unwrap_or(Aabb::EMPTY);
+            e.cubes = vec![
+                scene_msgs::cube(&get(m.a), scene_msgs::PAIR_COLOR),
+                scene_msgs::cube(&get(m.b), scene_msgs::PAIR_COLOR),
+                scene_msgs::cube(&m.aabb, scene_msgs::NEW_COLOR),
+            ];
+            emit(w, buf, bodies_topic, t, &scene_msgs::update(vec![e]))?;
+        }
+        Ok(())
+    }
+
+    /// A part on `/grouping/part`, the channel added at the run's first part.
+    fn record_part(&mut self, t: u64, p: &Part) -> Result<()> {
+        let w = &mut self.writer;
+        let topic = match &mut self.topics.part {
+            Some(topic) => topic,
+            None => {
+                let schema = add_schema::<PartEvent, W>(w)?;
+                self.topics
+                    .part
+                    .insert(add_topic(w, schema, "/grouping/part")?)
+            }
+        };
+        emit(w, &mut self.buf, topic, t, &PartEvent::from(p))
+    }
+
+    /// The refinement starts: adds `/refine/step` and its summary, at SAH `sah` so far.
+    fn start_refine(&mut self, params: RefineParams, sah: f64) -> Result<()> {
+        let w = &mut self.writer;
+        let schema = add_schema::<RefineStepEvent, W>(w)?;
+        let topic = add_topic(w, schema, "/refine/step")?;
+        let summary = metadata::RefineSummary {
+            params,
+            steps: 0,
+            sah_before: sah,
+            sah_after: sah,
+        };
+        self.refine = Some((summary, topic));
+        Ok(())
+    }
+
+    /// A kept refinement step on `/refine/step`, counted in the summary.
+    fn record_refine_step(&mut self, t: u64, step: &Step) -> Result<()> {
+        let (summary, topic) = self
+            .refine
+            .as_mut()
+            .ok_or_else(|| anyhow!("refinement step before its start"))?;
+        emit(
+            &mut self.writer,
+            &mut self.buf,
+            topic,
+            t,
+            &RefineStepEvent::from(step),
+        )?;
+        summary.steps = step.step + 1;
+        summary.sah_after = step.sah;
         Ok(())
     }
 

@@ -252,53 +252,15 @@ fn check_merges(merges: &[Merge], n: u32, complete: bool) -> Result<(), String> 
     Ok(())
 }
 
+/// Checks what was read against the run record and assembles the [`Recorded`] run.
 fn interpret(raw: Raw) -> Result<Recorded> {
-    let mut meta = None;
-    let mut timing = BTreeMap::new();
-    for (name, m) in raw.metadata {
-        match name.as_str() {
-            metadata::RUN if meta.is_none() => meta = Some(m),
-            metadata::TIMING => timing = m,
-            _ => {}
-        }
-    }
-    let m = meta.ok_or_else(|| {
-        anyhow!(
-            "not a wraptree recording (no `{}` metadata record)",
-            metadata::RUN
-        )
-    })?;
-    let scene_file_name = metadata::get(&m, "scene_file")?.to_string();
-    let scene_bytes = raw
-        .attachments
-        .into_iter()
-        .find(|(name, _)| *name == scene_file_name)
-        .map(|(_, data)| data)
-        .ok_or_else(|| anyhow!("the embedded scene `{scene_file_name}` is missing"))?;
-    let sha256: String = Sha256::digest(&scene_bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    if !sha256.eq_ignore_ascii_case(metadata::get(&m, "scene_sha256")?) {
-        bail!("the embedded scene `{scene_file_name}` does not match its recorded sha256");
-    }
+    let (m, timing) = run_and_timing(raw.metadata)?;
+    let (scene_file_name, scene_bytes) = embedded_scene(raw.attachments, &m)?;
     let complete = metadata::parse::<bool>(&m, "complete")?;
     let primitives = metadata::parse::<u32>(&m, "primitives")?;
     check_merges(&raw.merges, primitives, complete).map_err(|e| anyhow!(e))?;
     let refine = metadata::refine(&m)?;
-    let steps_named = refine.map_or(0, |r| r.steps as usize);
-    if raw.refine.len() != steps_named
-        || raw
-            .refine
-            .iter()
-            .enumerate()
-            .any(|(i, s)| s.step as usize != i)
-    {
-        bail!(
-            "the recording holds {} refinement steps, its metadata says {steps_named}",
-            raw.refine.len()
-        );
-    }
+    check_refine_steps(&raw.refine, refine.map_or(0, |r| r.steps as usize))?;
     let round_starts = raw.rounds.iter().filter(|r| !r.doubling);
     let rounds = match m.get("rounds") {
         Some(_) => metadata::parse(&m, "rounds")?,
@@ -335,6 +297,60 @@ fn interpret(raw: Raw) -> Result<Recorded> {
         metadata: m,
         timing,
     })
+}
+
+/// A metadata record's keys and values.
+type KeyValues = BTreeMap<String, String>;
+
+/// The run record (the first `wraptree` one) and the timing record (empty when left out).
+/// Err: no run record.
+fn run_and_timing(records: Vec<(String, KeyValues)>) -> Result<(KeyValues, KeyValues)> {
+    let mut meta = None;
+    let mut timing = BTreeMap::new();
+    for (name, m) in records {
+        match name.as_str() {
+            metadata::RUN if meta.is_none() => meta = Some(m),
+            metadata::TIMING => timing = m,
+            _ => {}
+        }
+    }
+    let m = meta.ok_or_else(|| {
+        anyhow!(
+            "not a wraptree recording (no `{}` metadata record)",
+            metadata::RUN
+        )
+    })?;
+    Ok((m, timing))
+}
+
+/// The attached scene file named by the run record `m`, with its name. Err: missing, or its
+/// SHA-256 is not the recorded one.
+fn embedded_scene(attachments: Vec<(String, Vec<u8>)>, m: &KeyValues) -> Result<(String, Vec<u8>)> {
+    let scene_file_name = metadata::get(m, "scene_file")?.to_string();
+    let scene_bytes = attachments
+        .into_iter()
+        .find(|(name, _)| *name == scene_file_name)
+        .map(|(_, data)| data)
+        .ok_or_else(|| anyhow!("the embedded scene `{scene_file_name}` is missing"))?;
+    let sha256: String = Sha256::digest(&scene_bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    if !sha256.eq_ignore_ascii_case(metadata::get(m, "scene_sha256")?) {
+        bail!("the embedded scene `{scene_file_name}` does not match its recorded sha256");
+    }
+    Ok((scene_file_name, scene_bytes))
+}
+
+/// Checks that the refinement steps are the `steps_named` of the metadata, numbered in order.
+fn check_refine_steps(steps: &[crate::refine::Step], steps_named: usize) -> Result<()> {
+    if steps.len() != steps_named || steps.iter().enumerate().any(|(i, s)| s.step as usize != i) {
+        bail!(
+            "the recording holds {} refinement steps, its metadata says {steps_named}",
+            steps.len()
+        );
+    }
+    Ok(())
 }
 
 /// Reads a wraptree `.mcap` recording. Truncated, corrupted or foreign files give one error line

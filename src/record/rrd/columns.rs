@@ -2,8 +2,8 @@
 //! series (always) and the merged pair's and new body's boxes (with per-merge geometry); per
 //! round start, doubling and finish, the text log lines and the active bodies' boxes.
 //!
-//! Every `send_columns` call becomes one chunk, and the SDK spends about 60 µs on each chunk
-//! whatever its size, so rows are sent together, one chunk per entity per batch.
+//! Every `send_columns` call becomes one chunk, and the SDK has a fixed cost per chunk whatever
+//! its size, so rows are sent together, one chunk per entity per batch.
 
 use std::fmt::Write as _;
 use std::sync::Arc;

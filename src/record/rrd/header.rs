@@ -7,6 +7,7 @@ use super::{ACTIVE_BLUE, PrimMesh, RrdRecorder, SCENE_GREY, columns, send_static
 use crate::grouping::Pregroup;
 use crate::record::{Outcome, RunInfo};
 use crate::scene::components;
+use rerun::RecordingStream;
 
 /// The recording id: a UUID-shaped hex digest of the scene hash and the resolved parameters.
 pub(super) fn recording_id(info: &RunInfo<'_>) -> String {
@@ -37,41 +38,7 @@ impl RrdRecorder {
     /// Metadata, transforms, the scene mesh and static styling.
     pub(super) fn write_header(&self, info: &RunInfo<'_>, mesh: &PrimMesh) -> anyhow::Result<()> {
         let rec = self.rec()?;
-        let scene = info.scene;
-        rec.send_recording_name(format!(
-            "{} ({} primitives)",
-            info.source.file_name,
-            scene.len()
-        ))?;
-        let text = |s: String| [rerun::components::Text::from(s)];
-        rec.send_property(
-            "wraptree",
-            &rerun::AnyValues::default()
-                .with_component::<rerun::components::Text>(
-                    "version",
-                    text(env!("CARGO_PKG_VERSION").into()),
-                )
-                .with_component::<rerun::components::Text>(
-                    "scene",
-                    text(info.source.file_name.clone()),
-                )
-                .with_component::<rerun::components::Text>(
-                    "sha256",
-                    text(info.source.sha256.clone()),
-                )
-                .with_component::<rerun::components::Text>(
-                    "primitives",
-                    text(scene.len().to_string()),
-                )
-                .with_component::<rerun::components::Text>(
-                    "params",
-                    text(serde_json::to_string(info.params)?),
-                )
-                .with_component::<rerun::components::Text>(
-                    "detail",
-                    text(format!("{:?}", info.detail).to_lowercase()),
-                ),
-        )?;
+        send_run_properties(rec, info)?;
         let o = self.origin;
         for root in ["scene", "grouping", "levels", "refine"] {
             send_static(
@@ -81,24 +48,7 @@ impl RrdRecorder {
             )?;
         }
         send_static(rec, "/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
-        let primitives = rerun::Mesh3D::new(mesh.positions.iter().copied())
-            .with_vertex_normals(mesh.normals.iter().copied());
-        // Without indices the viewer reads each three positions as a triangle.
-        let primitives = if mesh.sequential() {
-            primitives
-        } else {
-            primitives.with_triangle_indices(mesh.all_tris().iter().copied())
-        };
-        // With pre-grouping, each component in its own colour.
-        let primitives = match info.params.mode.pregroup {
-            Pregroup::None => primitives.with_albedo_factor(SCENE_GREY),
-            Pregroup::Objects => {
-                primitives.with_vertex_colors(mesh.component_colors(&components::objects(scene).of))
-            }
-            Pregroup::Connected => primitives
-                .with_vertex_colors(mesh.component_colors(&components::connected(scene).of)),
-        };
-        send_static(rec, "scene/primitives", &primitives)?;
+        send_static(rec, "scene/primitives", &scene_primitives(info, mesh))?;
         for ((path, names), colors) in columns::SERIES.iter().zip(columns::SERIES_COLORS) {
             let lines = rerun::SeriesLines::new()
                 .with_names(names.iter().copied())
@@ -144,5 +94,60 @@ impl RrdRecorder {
                 ),
         )?;
         Ok(())
+    }
+}
+
+/// The recording's name (scene file and size) and its `wraptree` property: version, scene,
+/// SHA-256, primitives, parameters (JSON) and detail.
+fn send_run_properties(rec: &RecordingStream, info: &RunInfo<'_>) -> anyhow::Result<()> {
+    let scene = info.scene;
+    rec.send_recording_name(format!(
+        "{} ({} primitives)",
+        info.source.file_name,
+        scene.len()
+    ))?;
+    let text = |s: String| [rerun::components::Text::from(s)];
+    rec.send_property(
+        "wraptree",
+        &rerun::AnyValues::default()
+            .with_component::<rerun::components::Text>(
+                "version",
+                text(env!("CARGO_PKG_VERSION").into()),
+            )
+            .with_component::<rerun::components::Text>("scene", text(info.source.file_name.clone()))
+            .with_component::<rerun::components::Text>("sha256", text(info.source.sha256.clone()))
+            .with_component::<rerun::components::Text>("primitives", text(scene.len().to_string()))
+            .with_component::<rerun::components::Text>(
+                "params",
+                text(serde_json::to_string(info.params)?),
+            )
+            .with_component::<rerun::components::Text>(
+                "detail",
+                text(format!("{:?}", info.detail).to_lowercase()),
+            ),
+    )?;
+    Ok(())
+}
+
+/// Every input primitive in one shaded mesh: light grey, or with pre-grouping one colour per
+/// component.
+fn scene_primitives(info: &RunInfo<'_>, mesh: &PrimMesh) -> rerun::Mesh3D {
+    let scene = info.scene;
+    let primitives = rerun::Mesh3D::new(mesh.positions.iter().copied())
+        .with_vertex_normals(mesh.normals.iter().copied());
+    // Without indices the viewer reads each three positions as a triangle.
+    let primitives = if mesh.sequential() {
+        primitives
+    } else {
+        primitives.with_triangle_indices(mesh.all_tris().iter().copied())
+    };
+    match info.params.mode.pregroup {
+        Pregroup::None => primitives.with_albedo_factor(SCENE_GREY),
+        Pregroup::Objects => {
+            primitives.with_vertex_colors(mesh.component_colors(&components::objects(scene).of))
+        }
+        Pregroup::Connected => {
+            primitives.with_vertex_colors(mesh.component_colors(&components::connected(scene).of))
+        }
     }
 }

@@ -1,23 +1,16 @@
 //! The tree levels on the `level` timeline: at d = 0..=depth max, the cut at depth d
-//! ([`SubsetTree::level`]) as interior-node wrappers and leaf polygons (`levels/leaves`), like
-//! the frames of the paper's Figure 1. Wrappers are drawn for the kinds recorded
-//! (`record --wrapper`): spheres (`levels/spheres`), convex hulls (`levels/hulls`),
-//! axis-aligned boxes (`levels/boxes`) and oriented boxes (`levels/obbs`).
+//! ([`SubsetTree::level`]) as interior-node wrappers of the kinds recorded (`record --wrapper`:
+//! `levels/spheres`, `levels/hulls`, `levels/boxes`, `levels/obbs`) and leaf polygons, like the
+//! frames of the paper's Figure 1.
 //!
-//! Each leaf is logged once: `levels/leaves/<k>` holds the leaves at depth k (vertices,
-//! normals, see [`PrimMesh`], and triangles) at tick k, and stays, so tick d shows the leaves of
-//! depth ≤ d, which are the cut's leaves. The hulls' vertices are input points, shared by a
-//! node's hull and its ancestors' hulls, so each distinct point is logged once, at d = 0, and
-//! without normals (the hulls are drawn translucent and unshaded); later levels send only the
-//! triangle indices of the cut's hulls (a partial `Mesh3D` update). Each level costs 12 bytes
-//! per hull triangle, 16 bytes per sphere, 24 per box and 40 per oriented box.
+//! Geometry is logged once: `levels/leaves/<k>` holds the leaves at depth k (see [`PrimMesh`])
+//! at tick k and stays, so tick d shows the cut's leaves; the hulls' vertices (input points,
+//! shared by a node's hull and its ancestors') are logged once at d = 0, unshaded, and later
+//! levels send only the cut's triangle indices (a partial `Mesh3D` update).
 //!
-//! So that the Levels view shows something whatever timeline is selected, one level, the
-//! *preview* (the shallowest whose cut has at least 64 nodes), is also logged at tick 0 of the
-//! `merge` and `round` timelines.
-//!
-//! A cover (`record --cover-tolerance`/`--cover-budget`) is one more level at tick
-//! `depth_max + 1` under `cover/*` ([`log_cover`]); its meshes are sent whole.
+//! One level, the *preview* (the shallowest cut of at least 64 nodes), is also logged at tick 0
+//! of `merge` and `round`, so the Levels view shows something on any timeline. A cover is one
+//! more level at tick `depth_max + 1` under `cover/*` ([`log_cover`]), its meshes sent whole.
 
 use std::collections::HashMap;
 
@@ -26,11 +19,11 @@ use rerun::components::FillMode;
 
 use super::mesh::PrimMesh;
 use super::{rel, send_at, send_static};
-use crate::geom::{P3, V3};
+use crate::geom::{Aabb, P3, V3};
 use crate::grouping::SubsetTree;
 use crate::record::CoverLevel;
 use crate::wrap::cover::export::{self, Geometry};
-use crate::wrap::{Hull, Sphere, Wrappers};
+use crate::wrap::{Hull, Obb, Sphere, Wrappers};
 
 /// Translucent blue of the level spheres.
 const SPHERE_BLUE: u32 = 0x1E90FF40;
@@ -130,19 +123,11 @@ pub(super) fn log_levels(
     wrappers: Option<&Wrappers>,
     origin: &P3,
 ) -> anyhow::Result<()> {
-    if !spheres.is_empty() {
-        check_len("spheres", Some(spheres.len()), tree)?;
-    }
     let none = Wrappers::default();
     let w = wrappers.unwrap_or(&none);
-    check_len("hulls", w.hulls.as_ref().map(Vec::len), tree)?;
-    check_len("boxes", w.boxes.as_ref().map(Vec::len), tree)?;
-    check_len("oriented boxes", w.obbs.as_ref().map(Vec::len), tree)?;
+    check_lens(tree, spheres, w)?;
     let hull_mesh = w.hulls.as_deref().map(|h| HullMesh::new(tree, h, origin));
-    let mut leaves_by_depth = vec![Vec::new(); tree.depth_max() as usize + 1];
-    for x in 0..tree.leaves() as u32 {
-        leaves_by_depth[tree.depth[x as usize] as usize].push(x);
-    }
+    let leaves_by_depth = leaves_by_depth(tree);
     let mut preview = None;
     for d in 0..=tree.depth_max() {
         let cut = tree.level(d);
@@ -165,84 +150,122 @@ pub(super) fn log_levels(
         };
         let interior: Vec<u32> = cut.iter().copied().filter(|&x| !tree.is_leaf(x)).collect();
         if !spheres.is_empty() || w.trees().is_empty() {
-            let (centers, radii): (Vec<_>, Vec<_>) = interior
-                .iter()
-                .filter(|_| !spheres.is_empty())
-                .map(|&x| {
-                    let s = &spheres[x as usize];
-                    (rel(&s.center, origin), s.radius as f32)
-                })
-                .unzip();
-            let arch = rerun::Ellipsoids3D::from_centers_and_radii(centers, radii)
-                .with_colors([SPHERE_BLUE])
-                .with_fill_mode(FillMode::TransparentFillMajorWireframe);
-            send("levels/spheres", &arch)?;
+            send("levels/spheres", &level_spheres(&interior, spheres, origin))?;
         }
         if let Some(hm) = &hull_mesh {
-            let tris = interior.iter().flat_map(|&x| hm.node_tris(x)).copied();
-            let arch = if d == 0 {
-                rerun::Mesh3D::new(hm.positions.iter().copied()).with_albedo_factor(HULL_GREEN)
-            } else {
-                rerun::Mesh3D::update_fields()
-            }
-            .with_triangle_indices(nonempty(tris.collect()));
-            send("levels/hulls", &arch)?;
+            send("levels/hulls", &level_hulls(hm, &interior, d))?;
         }
         if let Some(b) = &w.boxes {
-            let (centers, halves): (Vec<_>, Vec<_>) = interior
-                .iter()
-                .map(|&x| {
-                    let b = &b[x as usize];
-                    let h = b.extents() / 2.0;
-                    (
-                        rel(&b.center(), origin),
-                        [h.x as f32, h.y as f32, h.z as f32],
-                    )
-                })
-                .unzip();
-            let arch = rerun::Boxes3D::from_centers_and_half_sizes(centers, halves)
-                .with_colors([BOX_VIOLET])
-                .with_fill_mode(FillMode::TransparentFillMajorWireframe);
-            send("levels/boxes", &arch)?;
+            send("levels/boxes", &level_boxes(&interior, b, origin))?;
         }
         if let Some(b) = &w.obbs {
-            let mut centers = Vec::with_capacity(interior.len());
-            let mut halves = Vec::with_capacity(interior.len());
-            let mut rotations = Vec::with_capacity(interior.len());
-            for &x in &interior {
-                let b = &b[x as usize];
-                centers.push(rel(&b.center, origin));
-                halves.push(b.half.map(|h| h as f32));
-                let q = b.rotation().coords.map(|c| c as f32);
-                rotations.push(rerun::datatypes::Quaternion::from_xyzw([
-                    q.x, q.y, q.z, q.w,
-                ]));
-            }
-            let arch = rerun::Boxes3D::from_centers_and_half_sizes(
-                centers,
-                halves.iter().map(|h| [h.x, h.y, h.z]),
-            )
-            .with_quaternions(rotations)
-            .with_colors([OBB_VIOLET])
-            .with_fill_mode(FillMode::TransparentFillMajorWireframe);
-            send("levels/obbs", &arch)?;
+            send("levels/obbs", &level_obbs(&interior, b, origin))?;
         }
         let new_leaves = &leaves_by_depth[d as usize];
         if !new_leaves.is_empty() {
-            let m = mesh.subset(new_leaves);
-            let arch = rerun::Mesh3D::new(m.positions.iter().copied())
-                .with_vertex_normals(m.normals.iter().copied())
-                .with_triangle_indices(nonempty(m.all_tris().to_vec()))
-                .with_albedo_factor(LEAF_ORANGE);
             let leaf_times: Vec<_> = if in_preview {
                 [level].into_iter().chain(PREVIEW).collect()
             } else {
                 vec![level]
             };
+            let arch = leaf_mesh(mesh, new_leaves);
             send_at(rec, &format!("levels/leaves/{d}"), &leaf_times, &arch)?;
         }
     }
     Ok(())
+}
+
+/// Checks that every wrapper given has one entry per node of `tree` (no spheres: none drawn).
+fn check_lens(tree: &SubsetTree, spheres: &[Sphere], w: &Wrappers) -> anyhow::Result<()> {
+    if !spheres.is_empty() {
+        check_len("spheres", Some(spheres.len()), tree)?;
+    }
+    check_len("hulls", w.hulls.as_ref().map(Vec::len), tree)?;
+    check_len("boxes", w.boxes.as_ref().map(Vec::len), tree)?;
+    check_len("oriented boxes", w.obbs.as_ref().map(Vec::len), tree)
+}
+
+/// The leaves of `tree` by depth, each list increasing.
+fn leaves_by_depth(tree: &SubsetTree) -> Vec<Vec<u32>> {
+    let mut by_depth = vec![Vec::new(); tree.depth_max() as usize + 1];
+    for x in 0..tree.leaves() as u32 {
+        by_depth[tree.depth[x as usize] as usize].push(x);
+    }
+    by_depth
+}
+
+/// The cut's `interior` nodes as translucent spheres (none when `spheres` is empty).
+fn level_spheres(interior: &[u32], spheres: &[Sphere], origin: &P3) -> rerun::Ellipsoids3D {
+    let (centers, radii): (Vec<_>, Vec<_>) = interior
+        .iter()
+        .filter(|_| !spheres.is_empty())
+        .map(|&x| {
+            let s = &spheres[x as usize];
+            (rel(&s.center, origin), s.radius as f32)
+        })
+        .unzip();
+    rerun::Ellipsoids3D::from_centers_and_radii(centers, radii)
+        .with_colors([SPHERE_BLUE])
+        .with_fill_mode(FillMode::TransparentFillMajorWireframe)
+}
+
+/// The hulls of the cut's `interior` nodes: every hull vertex with the triangles at depth 0,
+/// then only the triangle indices (a partial update).
+fn level_hulls(hm: &HullMesh, interior: &[u32], d: u32) -> rerun::Mesh3D {
+    let tris = interior.iter().flat_map(|&x| hm.node_tris(x)).copied();
+    if d == 0 {
+        rerun::Mesh3D::new(hm.positions.iter().copied()).with_albedo_factor(HULL_GREEN)
+    } else {
+        rerun::Mesh3D::update_fields()
+    }
+    .with_triangle_indices(nonempty(tris.collect()))
+}
+
+/// The axis-aligned boxes of the cut's `interior` nodes.
+fn level_boxes(interior: &[u32], boxes: &[Aabb], origin: &P3) -> rerun::Boxes3D {
+    let (centers, halves): (Vec<_>, Vec<_>) = interior
+        .iter()
+        .map(|&x| {
+            let b = &boxes[x as usize];
+            let h = b.extents() / 2.0;
+            (
+                rel(&b.center(), origin),
+                [h.x as f32, h.y as f32, h.z as f32],
+            )
+        })
+        .unzip();
+    rerun::Boxes3D::from_centers_and_half_sizes(centers, halves)
+        .with_colors([BOX_VIOLET])
+        .with_fill_mode(FillMode::TransparentFillMajorWireframe)
+}
+
+/// The oriented boxes of the cut's `interior` nodes, rotations as quaternions.
+fn level_obbs(interior: &[u32], obbs: &[Obb], origin: &P3) -> rerun::Boxes3D {
+    let mut centers = Vec::with_capacity(interior.len());
+    let mut halves = Vec::with_capacity(interior.len());
+    let mut rotations = Vec::with_capacity(interior.len());
+    for &x in interior {
+        let b = &obbs[x as usize];
+        centers.push(rel(&b.center, origin));
+        halves.push(b.half.map(|h| h as f32));
+        let q = b.rotation().coords.map(|c| c as f32);
+        rotations.push(rerun::datatypes::Quaternion::from_xyzw([
+            q.x, q.y, q.z, q.w,
+        ]));
+    }
+    rerun::Boxes3D::from_centers_and_half_sizes(centers, halves.iter().map(|h| [h.x, h.y, h.z]))
+        .with_quaternions(rotations)
+        .with_colors([OBB_VIOLET])
+        .with_fill_mode(FillMode::TransparentFillMajorWireframe)
+}
+
+/// The polygons of `leaves` as one shaded mesh.
+fn leaf_mesh(mesh: &PrimMesh, leaves: &[u32]) -> rerun::Mesh3D {
+    let m = mesh.subset(leaves);
+    rerun::Mesh3D::new(m.positions.iter().copied())
+        .with_vertex_normals(m.normals.iter().copied())
+        .with_triangle_indices(nonempty(m.all_tris().to_vec()))
+        .with_albedo_factor(LEAF_ORANGE)
 }
 
 /// Logs `cover` as one more level, at tick `depth_max + 1` of the `level` timeline: its spheres
@@ -264,83 +287,11 @@ pub(super) fn log_cover(
         &rerun::Transform3D::from_translation([origin.x as f32, origin.y as f32, origin.z as f32]),
     )?;
     send_at(rec, "levels", &times, &rerun::Clear::recursive())?;
-    let (mut centers, mut radii) = (Vec::new(), Vec::new());
-    let mut boxes: Vec<([f32; 3], [f32; 3], [f32; 4])> = Vec::new();
-    let mut oriented = false;
-    let mut hulls = (Vec::new(), Vec::new());
-    let mut leaves = (Vec::new(), Vec::new());
-    let f = |a: &[f64; 3]| P3::new(a[0], a[1], a[2]);
+    let mut geometry = CoverGeometry::default();
     for w in cover.wrappers {
-        match &w.geometry {
-            Geometry::Sphere { center, radius } => {
-                centers.push(rel(&f(center), origin));
-                radii.push(*radius as f32);
-            }
-            Geometry::Box { min, max } => {
-                let (lo, hi) = (f(min), f(max));
-                let h = (hi - lo) / 2.0;
-                let c = rel(&nalgebra::center(&lo, &hi), origin);
-                boxes.push((
-                    c,
-                    [h.x as f32, h.y as f32, h.z as f32],
-                    [0.0, 0.0, 0.0, 1.0],
-                ));
-            }
-            Geometry::Obb {
-                center,
-                axes,
-                half_extents,
-            } => {
-                oriented = true;
-                let col = |k: usize| V3::new(axes[k][0], axes[k][1], axes[k][2]);
-                let m = nalgebra::Matrix3::from_columns(&[col(0), col(1), col(2)]);
-                let q = nalgebra::UnitQuaternion::from_matrix(&m)
-                    .coords
-                    .map(|c| c as f32);
-                boxes.push((
-                    rel(&f(center), origin),
-                    half_extents.map(|h| h as f32),
-                    [q.x, q.y, q.z, q.w],
-                ));
-            }
-            Geometry::Hull { .. } => append_mesh(&mut hulls, &w.geometry, origin),
-            Geometry::Primitive { .. } => append_mesh(&mut leaves, &w.geometry, origin),
-        }
+        geometry.add(&w.geometry, origin);
     }
-    if !centers.is_empty() {
-        let arch = rerun::Ellipsoids3D::from_centers_and_radii(centers, radii)
-            .with_colors([SPHERE_BLUE])
-            .with_fill_mode(FillMode::TransparentFillMajorWireframe);
-        send_at(rec, "cover/spheres", &times, &arch)?;
-    }
-    if !boxes.is_empty() {
-        let mut arch = rerun::Boxes3D::from_centers_and_half_sizes(
-            boxes.iter().map(|b| b.0),
-            boxes.iter().map(|b| b.1),
-        );
-        if oriented {
-            arch = arch.with_quaternions(
-                boxes
-                    .iter()
-                    .map(|b| rerun::datatypes::Quaternion::from_xyzw(b.2)),
-            );
-        }
-        let arch = arch
-            .with_colors([BOX_VIOLET])
-            .with_fill_mode(FillMode::TransparentFillMajorWireframe);
-        send_at(rec, "cover/boxes", &times, &arch)?;
-    }
-    for (path, (positions, tris), rgba) in [
-        ("cover/hulls", hulls, HULL_GREEN),
-        ("cover/leaves", leaves, LEAF_ORANGE),
-    ] {
-        if !positions.is_empty() {
-            let arch = rerun::Mesh3D::new(positions)
-                .with_triangle_indices(nonempty(tris))
-                .with_albedo_factor(rgba);
-            send_at(rec, path, &times, &arch)?;
-        }
-    }
+    geometry.send(rec, &times)?;
     let c = cover.cover;
     let limit = match cover.budget {
         Some(k) => format!("budget {k}, tolerance {:.4e}", c.tolerance),
@@ -354,6 +305,103 @@ pub(super) fn log_cover(
     );
     send_static(rec, "cover/summary", &rerun::TextLog::new(line))?;
     Ok(())
+}
+
+/// A cover's wrappers gathered by entity, relative to the scene origin.
+#[derive(Default)]
+struct CoverGeometry {
+    centers: Vec<[f32; 3]>,
+    radii: Vec<f32>,
+    /// Axis-aligned and oriented boxes: centre, half size, rotation (x, y, z, w).
+    boxes: Vec<([f32; 3], [f32; 3], [f32; 4])>,
+    /// Whether any box is oriented (the boxes then carry their rotations).
+    oriented: bool,
+    /// Hulls and leaves drawn as themselves, each as one mesh: positions and triangles.
+    hulls: (Vec<[f32; 3]>, Vec<[u32; 3]>),
+    leaves: (Vec<[f32; 3]>, Vec<[u32; 3]>),
+}
+
+impl CoverGeometry {
+    /// Adds one wrapper of the cover.
+    fn add(&mut self, g: &Geometry, origin: &P3) {
+        let f = |a: &[f64; 3]| P3::new(a[0], a[1], a[2]);
+        match g {
+            Geometry::Sphere { center, radius } => {
+                self.centers.push(rel(&f(center), origin));
+                self.radii.push(*radius as f32);
+            }
+            Geometry::Box { min, max } => {
+                let (lo, hi) = (f(min), f(max));
+                let h = (hi - lo) / 2.0;
+                let c = rel(&nalgebra::center(&lo, &hi), origin);
+                self.boxes.push((
+                    c,
+                    [h.x as f32, h.y as f32, h.z as f32],
+                    [0.0, 0.0, 0.0, 1.0],
+                ));
+            }
+            Geometry::Obb {
+                center,
+                axes,
+                half_extents,
+            } => {
+                self.oriented = true;
+                let col = |k: usize| V3::new(axes[k][0], axes[k][1], axes[k][2]);
+                let m = nalgebra::Matrix3::from_columns(&[col(0), col(1), col(2)]);
+                let q = nalgebra::UnitQuaternion::from_matrix(&m)
+                    .coords
+                    .map(|c| c as f32);
+                self.boxes.push((
+                    rel(&f(center), origin),
+                    half_extents.map(|h| h as f32),
+                    [q.x, q.y, q.z, q.w],
+                ));
+            }
+            Geometry::Hull { .. } => append_mesh(&mut self.hulls, g, origin),
+            Geometry::Primitive { .. } => append_mesh(&mut self.leaves, g, origin),
+        }
+    }
+
+    /// Sends the entities used (`cover/spheres`, `cover/boxes`, `cover/hulls`, `cover/leaves`)
+    /// at `times`.
+    fn send(self, rec: &RecordingStream, times: &[(&'static str, i64)]) -> anyhow::Result<()> {
+        if !self.centers.is_empty() {
+            let arch = rerun::Ellipsoids3D::from_centers_and_radii(self.centers, self.radii)
+                .with_colors([SPHERE_BLUE])
+                .with_fill_mode(FillMode::TransparentFillMajorWireframe);
+            send_at(rec, "cover/spheres", times, &arch)?;
+        }
+        let boxes = &self.boxes;
+        if !boxes.is_empty() {
+            let mut arch = rerun::Boxes3D::from_centers_and_half_sizes(
+                boxes.iter().map(|b| b.0),
+                boxes.iter().map(|b| b.1),
+            );
+            if self.oriented {
+                arch = arch.with_quaternions(
+                    boxes
+                        .iter()
+                        .map(|b| rerun::datatypes::Quaternion::from_xyzw(b.2)),
+                );
+            }
+            let arch = arch
+                .with_colors([BOX_VIOLET])
+                .with_fill_mode(FillMode::TransparentFillMajorWireframe);
+            send_at(rec, "cover/boxes", times, &arch)?;
+        }
+        for (path, (positions, tris), rgba) in [
+            ("cover/hulls", self.hulls, HULL_GREEN),
+            ("cover/leaves", self.leaves, LEAF_ORANGE),
+        ] {
+            if !positions.is_empty() {
+                let arch = rerun::Mesh3D::new(positions)
+                    .with_triangle_indices(nonempty(tris))
+                    .with_albedo_factor(rgba);
+                send_at(rec, path, times, &arch)?;
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Appends the mesh of `g` ([`export::mesh`]) to (positions, triangles), relative to `origin`.

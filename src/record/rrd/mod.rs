@@ -1,77 +1,18 @@
-//! The Rerun `.rrd` recorder: the grouping run as a file for the Rerun viewer (SDK 0.36.3).
+//! The Rerun `.rrd` recorder: the grouping run as a file for the Rerun viewer (SDK 0.36.3). Its
+//! timelines, entities and layout are listed in `docs/recordings.md`, "`.rrd` (Rerun)".
 //!
-//! [`RrdRecorder`] is an [`Observer`]; it saves through a sink of its own (the SDK's encoder
-//! on a writer thread that bypasses the page cache, no viewer is spawned), checks at the end
-//! that the file is complete (`sink.rs`), writes what precedes the events in `header.rs`, and
-//! embeds a blueprint (`blueprint.rs`) so the file opens on a useful layout.
+//! [`RrdRecorder`] is an [`Observer`]. It saves through a sink of its own (`sink.rs`: the SDK's
+//! encoder on a thread that bypasses the page cache, the file checked complete at the end),
+//! writes what precedes the events (`header.rs`) and embeds a blueprint (`blueprint.rs`).
 //!
-//! # Timelines
-//!
-//! | timeline | kind     | one tick per |
-//! |----------|----------|--------------|
-//! | `merge`  | sequence | merge (tick = merge step, 0..N−1) |
-//! | `round`  | sequence | DLimit round (0 = first round) |
-//! | `level`  | sequence | Subset Tree depth d, 0..=depth max; then the cover, if any, at depth max + 1 |
-//! | `refine` | sequence | with `record --refine`: 0 = the grouping's tree, k = after the k-th kept move of the refinement |
-//!
-//! The wall-clock `log_time` timeline is switched off with
-//! `RecordingStream::set_log_time_enabled(false)`, and every temporal row is sent with
-//! `send_columns`, which never injects `log_time`/`log_tick`; the file is therefore indexed only
-//! by the timelines above. (The blueprint, a separate store in the same file, is written by
-//! the SDK's own blueprint stream and carries `log_time`; it holds no recorded data.)
-//!
-//! # Entities
-//!
-//! All 3D positions are `f32` relative to the scene origin (the centre of the scene's AABB); a
-//! static `Transform3D` translation by that origin at `scene`, `grouping` and `levels` puts them
-//! back in scene coordinates, so scenes far from the world origin keep their precision.
-//!
-//! | entity | archetype | time | `--detail` | content |
-//! |--------|-----------|------|------------|---------|
-//! | `/` | `ViewCoordinates` | static | all | right-handed, Z up (the generated scenes' convention) |
-//! | `scene`, `grouping`, `levels` | `Transform3D` | static | all | translation by the scene origin |
-//! | `scene/primitives` | `Mesh3D` | static | all | every input primitive in one shaded mesh, light grey (with `--pregroup`: one colour per component) |
-//! | `grouping/merge` | `Boxes3D` (3 boxes) | `merge`, `round` | merges, full | the AABBs of the two merged bodies (orange), then of the new body (green), for the last [`BODIES_CAP`](crate::record::BODIES_CAP) merges |
-//! | `grouping/active` | `Boxes3D` | `round`, `merge` | merges, full | at each round start, the AABBs of all active bodies (blue); none (an empty row) above [`ACTIVE_CAP`] active bodies |
-//! | `series/cost` | `Scalars` (1) | `merge` | all | Cost of each merge |
-//! | `series/limits` | `Scalars` (3: diameter, DLimit, GLimit) | `merge` | all | each merge's diameter, and DLimit and GLimit in force at it |
-//! | `series/fill_balance` | `Scalars` (2: Fill, Balance) | `merge` | all | Fill and Balance of each merge |
-//! | `series/queue_len` | `Scalars` (1) | `merge` | all | MPairs entries left after each pop |
-//!
-//! Each series entity carries static `SeriesLines` names and colours, one per scalar of its rows.
-//! | `log/doublings` | `TextLog` | `merge`, `round` | all | one line per round start (DLimit, GLimit, active, dormant, pairs), per doubling, per part of the run (each run of consecutive chunks of at most 8 bodies as one line, `parts.rs`) and at the finish |
-//! | `levels/spheres` | `Ellipsoids3D` | `level` (and the preview level at `merge` 0, `round` 0) | levels, full | interior nodes of the cut at depth d, as translucent blue spheres (`--wrapper sphere`) |
-//! | `levels/hulls` | `Mesh3D` | `level` | levels, full | interior nodes' convex hulls, translucent green (`--wrapper hull`; every distinct hull vertex once at d = 0, then only the triangle indices of the cut's hulls) |
-//! | `levels/boxes` | `Boxes3D` | `level` | levels, full | interior nodes' axis-aligned boxes, translucent violet (`--wrapper box`) |
-//! | `levels/obbs` | `Boxes3D` | `level` | levels, full | interior nodes' oriented boxes (rotations as quaternions), translucent dark violet (`--wrapper obb`) |
-//! | `levels/leaves/<k>` | `Mesh3D` | `level` (tick k; ticks ≤ the preview also at `merge` 0, `round` 0) | levels, full | the leaves at depth k, as their polygons, logged once and never cleared: at tick d the entities k ≤ d draw the cut's leaves |
-//! | `cover/spheres`, `cover/boxes` | `Ellipsoids3D`, `Boxes3D` | `level` (depth max + 1) | levels, full | the cover's spheres and boxes (oriented ones with rotations), colours as in `levels/*` (`--cover-tolerance`/`--cover-budget`) |
-//! | `cover/hulls`, `cover/leaves` | `Mesh3D` | `level` (depth max + 1) | levels, full | the cover's hulls, and its leaves drawn as themselves, each one mesh |
-//! | `cover/summary` | `TextLog` | static | levels, full | tolerance (and budget), size and largest error of the cover |
-//! | `levels` | `Clear` (recursive) | `level` (depth max + 1) | with a cover | hides the last level under the cover |
-//!
-//! With `record --refine`, the refinement's `series/refine_sah`, `refine/move` and `log/refine`
-//! are written on the `refine` timeline (see `refine.rs`), and the levels are those of the
-//! *refined* tree.
-//!
-//! Each `cover/*` geometry entity exists only when the cover uses that kind; `cover` carries the
-//! same static origin translation as `levels`.
-//!
-//! Each `levels/*` wrapper entity exists only for the kinds chosen with `record --wrapper`, and
-//! then has one row per level. Run metadata (scene, hash, parameters) is a recording property
-//! (`__properties/wraptree`) and the recording is named after the scene. A run stopped before
-//! the root (Ctrl-C, SIGTERM, `--max-seconds`, `--max-pairs`) has no levels, a warning line in
-//! `log/doublings` and the property `__properties/wraptree_outcome` (`complete` = `false`,
-//! `stop_reason`, `merges`).
-//!
-//! The per-merge series and boxes, the text lines and the active sets are buffered and sent as
-//! columns every 4,096 merges (`columns::BATCH`), one chunk per entity, so memory stays bounded
-//! and most of a long run is already on its way to the file when it is interrupted;
-//! [`RrdRecorder::finish`] (also called after Ctrl-C) sends the rest and ends the file with its
-//! footer.
-//!
-//! The recording id is derived from the scene's SHA-256 and the resolved parameters (not the
-//! detail level), so recordings of the same run share it and the viewer shows them as one.
+//! - Only the timelines `merge`, `round`, `level` and `refine`: `log_time` is switched off and
+//!   temporal rows go through `send_columns`, which adds no `log_time`/`log_tick`.
+//! - Positions are `f32` relative to the scene's AABB centre, moved back by a static
+//!   `Transform3D`, so that scenes far from the origin keep their precision.
+//! - Per-merge rows are sent as columns every `columns::BATCH` merges: memory stays bounded and
+//!   an interrupted run is mostly on its way to the file. A stopped run has no levels and the
+//!   property `wraptree_outcome`. The recording id comes from the scene's SHA-256 and the
+//!   parameters (not the detail), so recordings of one run open as one.
 
 mod blueprint;
 mod columns;
@@ -91,8 +32,9 @@ use anyhow::{anyhow, bail};
 use rerun::external::arrow::array::Array as _;
 use rerun::{AsComponents, RecordingStream, SerializedComponentColumn, TimeColumn};
 
+use crate::events::Step;
 use crate::geom::{Aabb, P3};
-use crate::grouping::{Event, Observer};
+use crate::grouping::{Event, Merge, Observer};
 use crate::record::{ACTIVE_CAP, Detail, Outcome, RunInfo, boxes_drawn};
 use columns::Columns;
 use mesh::PrimMesh;
@@ -104,7 +46,7 @@ const SCENE_GREY: u32 = 0xC8C8C8FF;
 /// Blue of the active bodies' boxes.
 const ACTIVE_BLUE: u32 = 0x3C78D8A0;
 
-/// Records a grouping run to a Rerun `.rrd` file; see the [module docs](self) for its layout.
+/// Records a grouping run to a Rerun `.rrd` file, laid out as `docs/recordings.md` lists.
 pub struct RrdRecorder {
     rec: Option<RecordingStream>,
     /// How the file's writer ended.
@@ -290,82 +232,14 @@ impl RrdRecorder {
                 active,
                 dormant,
                 pairs,
-            } => {
-                self.round = round;
-                self.dlimit = dlimit;
-                self.glimit = glimit;
-                let n = active.len();
-                let limits = format!("DLimit {dlimit:.6e}, GLimit {glimit:.6e}");
-                let sets = format!("{n} active, {dormant} dormant, {pairs} pairs");
-                let capped = self.detail.merges() && n > ACTIVE_CAP;
-                let note = if capped {
-                    format!(" (active boxes not drawn above {ACTIVE_CAP})")
-                } else {
-                    String::new()
-                };
-                self.text(round, format_args!("round {round}: {limits}, {sets}{note}"));
-                if self.detail.merges() {
-                    // Above the cap the row is empty: it still clears the previous round's boxes.
-                    let drawn = if capped { &active[..0] } else { active };
-                    let boxes = drawn
-                        .iter()
-                        .map(|&b| self.body(b))
-                        .collect::<anyhow::Result<Vec<_>>>()?;
-                    self.columns.push_active(self.merges, round, &boxes);
-                }
-            }
-            Event::Merge(m) => {
-                let boxes = if self.detail.merges() {
-                    let new = BoxF32::new(&m.aabb, &self.origin);
-                    let expected = self.boxes.len();
-                    if m.new as usize != expected {
-                        bail!(
-                            "merge {} creates body {}, expected {expected}",
-                            m.step,
-                            m.new
-                        );
-                    }
-                    // Only the drawn merges read their pair's boxes (a random access into
-                    // every body's box); the others check that the pair exists.
-                    let drawn = boxes_drawn(m.step, self.primitives);
-                    let pair = if drawn {
-                        Some([self.body(m.a)?, self.body(m.b)?])
-                    } else if m.a.max(m.b) as usize >= expected {
-                        let id = m.a.max(m.b);
-                        bail!("event names body {id}, which does not exist yet");
-                    } else {
-                        None
-                    };
-                    self.boxes.push(new);
-                    pair.map(|pair| (pair, new))
-                } else {
-                    None
-                };
-                self.columns.push(&m, self.dlimit, self.glimit, boxes);
-                self.merges = m.step + 1;
-                if self.columns.len() >= columns::BATCH {
-                    let rec = self.rec.as_ref().ok_or_else(closed)?;
-                    self.columns.flush(rec)?;
-                }
-            }
+            } => self.round_start(round, dlimit, glimit, active, dormant, pairs)?,
+            Event::Merge(m) => self.merge(&m)?,
             Event::Dormant { .. } => {}
             Event::RefineStart { params, sah } => {
                 let rec = self.rec.as_ref().ok_or_else(closed)?;
                 self.refine.start(rec, &params, sah, self.detail.merges())?;
             }
-            Event::Refine(s) => {
-                let boxes = self.detail.merges().then(|| {
-                    [
-                        BoxF32::new(&s.aabb, &self.origin),
-                        BoxF32::new(&s.parent_aabb, &self.origin),
-                    ]
-                });
-                self.refine.push(&s, boxes);
-                if self.refine.len() >= columns::BATCH {
-                    let rec = self.rec.as_ref().ok_or_else(closed)?;
-                    self.refine.flush(rec)?;
-                }
-            }
+            Event::Refine(s) => self.refine_step(&s)?,
             Event::Part(p) => {
                 let lines = part_lines(&mut self.columns, self.round);
                 self.parts.part(&p, self.merges, lines);
@@ -390,6 +264,103 @@ impl RrdRecorder {
                     format_args!("finished: root {root} after {rounds} rounds and {merges} merges");
                 self.text(self.round, line);
             }
+        }
+        Ok(())
+    }
+
+    /// A round starts: its limits are kept for the merges, its log line written and, with
+    /// per-merge geometry, its active bodies' boxes.
+    fn round_start(
+        &mut self,
+        round: u32,
+        dlimit: f64,
+        glimit: f64,
+        active: &[u32],
+        dormant: u32,
+        pairs: u64,
+    ) -> anyhow::Result<()> {
+        self.round = round;
+        self.dlimit = dlimit;
+        self.glimit = glimit;
+        let n = active.len();
+        let limits = format!("DLimit {dlimit:.6e}, GLimit {glimit:.6e}");
+        let sets = format!("{n} active, {dormant} dormant, {pairs} pairs");
+        let capped = self.detail.merges() && n > ACTIVE_CAP;
+        let note = if capped {
+            format!(" (active boxes not drawn above {ACTIVE_CAP})")
+        } else {
+            String::new()
+        };
+        self.text(round, format_args!("round {round}: {limits}, {sets}{note}"));
+        if self.detail.merges() {
+            // Above the cap the row is empty: it still clears the previous round's boxes.
+            let drawn = if capped { &active[..0] } else { active };
+            let boxes = drawn
+                .iter()
+                .map(|&b| self.body(b))
+                .collect::<anyhow::Result<Vec<_>>>()?;
+            self.columns.push_active(self.merges, round, &boxes);
+        }
+        Ok(())
+    }
+
+    /// A merge's row of the series (and of its boxes, see [`RrdRecorder::merge_boxes`]); the
+    /// columns are sent every [`columns::BATCH`] merges.
+    fn merge(&mut self, m: &Merge) -> anyhow::Result<()> {
+        let boxes = if self.detail.merges() {
+            self.merge_boxes(m)?
+        } else {
+            None
+        };
+        self.columns.push(m, self.dlimit, self.glimit, boxes);
+        self.merges = m.step + 1;
+        if self.columns.len() >= columns::BATCH {
+            let rec = self.rec.as_ref().ok_or_else(closed)?;
+            self.columns.flush(rec)?;
+        }
+        Ok(())
+    }
+
+    /// Keeps the new body's box; returns the merged pair's and the new body's boxes when the
+    /// merge is drawn ([`boxes_drawn`]). Err: a merge whose ids do not follow the events so far.
+    fn merge_boxes(&mut self, m: &Merge) -> anyhow::Result<Option<([BoxF32; 2], BoxF32)>> {
+        let new = BoxF32::new(&m.aabb, &self.origin);
+        let expected = self.boxes.len();
+        if m.new as usize != expected {
+            bail!(
+                "merge {} creates body {}, expected {expected}",
+                m.step,
+                m.new
+            );
+        }
+        // Only the drawn merges read their pair's boxes (a random access into every body's
+        // box); the others check that the pair exists.
+        let drawn = boxes_drawn(m.step, self.primitives);
+        let pair = if drawn {
+            Some([self.body(m.a)?, self.body(m.b)?])
+        } else if m.a.max(m.b) as usize >= expected {
+            let id = m.a.max(m.b);
+            bail!("event names body {id}, which does not exist yet");
+        } else {
+            None
+        };
+        self.boxes.push(new);
+        Ok(pair.map(|pair| (pair, new)))
+    }
+
+    /// A kept refinement step's row (with per-merge geometry, the moved subtree's and its new
+    /// parent's boxes); the rows are sent every [`columns::BATCH`] steps.
+    fn refine_step(&mut self, s: &Step) -> anyhow::Result<()> {
+        let boxes = self.detail.merges().then(|| {
+            [
+                BoxF32::new(&s.aabb, &self.origin),
+                BoxF32::new(&s.parent_aabb, &self.origin),
+            ]
+        });
+        self.refine.push(s, boxes);
+        if self.refine.len() >= columns::BATCH {
+            let rec = self.rec.as_ref().ok_or_else(closed)?;
+            self.refine.flush(rec)?;
         }
         Ok(())
     }

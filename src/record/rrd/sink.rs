@@ -1,14 +1,14 @@
 //! `.rrd` files written by a sink of our own: the SDK's encoder (the same bytes as its
 //! `FileSink`) on a writer thread, into a [`DirectWriter`] that bypasses the page cache.
 //!
-//! Besides the cost (README, Recordings at scale), two behaviours of the SDK's `FileSink` in
-//! 0.36.3 made us write this: its writer thread stops at the first write error and only logs
-//! it, and a flush queued behind the failed write is never answered, so `flush_blocking` (and
-//! dropping the stream after it) waits forever. [`DirectSink`] keeps the first error, drops
-//! later messages instead of blocking, answers every flush, and [`close`] returns that error
-//! with the system's reason. After a clean end [`close`] still reads the footer back (the
-//! stream footer at the end of the file must parse and the RRD footer it points at must match
-//! its CRC), an independent check that the file is whole.
+//! Besides the cost (`docs/recordings.md`, "How the files are written"), two behaviours of the
+//! SDK's `FileSink` in 0.36.3 made us write this: its writer thread stops at the first write error
+//! and only logs it, and a flush queued behind the failed write is never answered, so
+//! `flush_blocking` (and dropping the stream after it) waits forever. [`DirectSink`] keeps the
+//! first error, drops later messages instead of blocking, answers every flush, and [`close`]
+//! returns that error with the system's reason. After a clean end [`close`] still reads the footer
+//! back (the stream footer at the end of the file must parse and the RRD footer it points at must
+//! match its CRC), an independent check that the file is whole.
 
 use std::fs::File;
 use std::io::{Read as _, Seek as _, SeekFrom, Write as _};
