@@ -1,11 +1,12 @@
-//! The bundled scenes in `scenes/`: every `.obj` there is listed in a table of
-//! `scenes/README.md` and loads with the primitive count that table states; the composed
-//! assemblies hold their parts as separate objects, placed where their URDF puts them.
+//! The bundled scenes in `scenes/`: every `.obj` there (and every URDF robot in a folder of its
+//! own, `scenes/NAME/NAME.urdf`) is listed in a table of `scenes/README.md` and loads with the
+//! primitive count that table states; the composed assemblies hold their parts as separate
+//! objects, placed where their URDF puts them; the monastery stands upright with `--up y`.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use wraptree::scene::{LoadOptions, PrimitiveKind, load_path};
+use wraptree::scene::{LoadOptions, PrimitiveKind, Up, load_path};
 
 fn repo(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
@@ -98,11 +99,22 @@ fn the_readme_parser_reads_file_mode_and_count() {
 fn every_bundled_scene_loads_with_the_count_its_readme_states() {
     let readme = std::fs::read_to_string(repo("scenes/README.md")).unwrap();
     let stated = stated_counts(&readme);
-    let mut on_disk: Vec<String> = std::fs::read_dir(repo("scenes"))
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".obj"))
-        .collect();
+    let mut on_disk: Vec<String> = Vec::new();
+    for e in std::fs::read_dir(repo("scenes")).unwrap() {
+        let e = e.unwrap();
+        let n = e.file_name().to_string_lossy().into_owned();
+        if n.ends_with(".obj") {
+            on_disk.push(n);
+        } else if e.path().is_dir() {
+            // A robot in a folder of its own: its URDFs.
+            for f in std::fs::read_dir(e.path()).unwrap() {
+                let f = f.unwrap().file_name().to_string_lossy().into_owned();
+                if f.ends_with(".urdf") {
+                    on_disk.push(format!("{n}/{f}"));
+                }
+            }
+        }
+    }
     on_disk.sort();
     let listed: Vec<String> = stated.keys().cloned().collect();
     assert_eq!(
@@ -113,6 +125,7 @@ fn every_bundled_scene_loads_with_the_count_its_readme_states() {
         let opts = LoadOptions {
             polyhedra: s.polyhedra,
             strict: s.polyhedra,
+            up: None,
         };
         let l =
             load_path(&repo(&format!("scenes/{name}")), &opts).unwrap_or_else(|e| panic!("{e}"));
@@ -126,8 +139,10 @@ fn every_bundled_scene_loads_with_the_count_its_readme_states() {
                 .all(|p| p.iter().all(|c| c.is_finite())),
             "{name}"
         );
-        assert_eq!(l.source.file_name, *name);
-        assert_eq!(l.scene.name, name.trim_end_matches(".obj"));
+        let stem = Path::new(name).file_stem().unwrap().to_string_lossy();
+        // A URDF is embedded in recordings as the OBJ of its scene.
+        assert_eq!(l.source.file_name.trim_end_matches(".obj"), stem, "{name}");
+        assert_eq!(l.scene.name, stem);
         if s.polyhedra {
             assert_eq!(l.scene.labels.len(), s.primitives, "{name}");
         }
@@ -227,4 +242,54 @@ fn kuka_iiwa_links_are_stacked_along_the_arm() {
     }
     // Zero configuration: the arm stands upright, 1.306 m tall (base 0, flange 1.306).
     assert!((prev_top - 1.306).abs() < 1e-3, "{prev_top}");
+}
+
+#[test]
+fn r2d2_links_are_objects_and_its_wheels_are_placed_copies() {
+    let l = load_path(&repo("scenes/r2d2/r2d2.urdf"), &LoadOptions::default()).unwrap();
+    let text = String::from_utf8(l.source.bytes.clone()).unwrap();
+    let names: Vec<&str> = text.lines().filter_map(|s| s.strip_prefix("o ")).collect();
+    assert_eq!(names.len(), 16);
+    assert_eq!(names[0], "base_link");
+    // Each wheel's vertices in order of first use.
+    let points = |name: &str| -> Vec<[f64; 3]> {
+        let id = names.iter().position(|n| *n == name).unwrap() as u32;
+        let mut seen = std::collections::BTreeSet::new();
+        let mut out = Vec::new();
+        for i in (0..l.scene.len()).filter(|&i| l.scene.object(i) == id) {
+            for &v in l.scene.prim(i) {
+                if seen.insert(v) {
+                    let p = l.scene.points[v as usize];
+                    out.push([p.x, p.y, p.z]);
+                }
+            }
+        }
+        out
+    };
+    let rf = points("right_front_wheel");
+    for (other, want) in [
+        ("right_back_wheel", [0.0, -0.266666666666, 0.0]),
+        ("left_front_wheel", [-0.44, 0.0, 0.0]),
+        ("left_back_wheel", [-0.44, -0.266666666666, 0.0]),
+    ] {
+        let d = translation(&rf, &points(other)).unwrap_or_else(|| panic!("{other} is no copy"));
+        assert!(
+            (0..3).all(|k| (d[k] - want[k]).abs() < 1e-9),
+            "{other}: {d:?}"
+        );
+    }
+}
+
+#[test]
+fn the_monastery_stands_upright_with_up_y() {
+    let path = repo("scenes/samurai-monastery.obj");
+    let y_up = LoadOptions {
+        up: Some(Up::Y),
+        ..LoadOptions::default()
+    };
+    let a = load_path(&path, &y_up).unwrap().scene.aabb();
+    let e = a.max - a.min;
+    // A compound of about 124 × 121 m, 30 m tall, standing on z = 0.
+    assert!(e.z < 0.3 * e.x.min(e.y), "{e:?}");
+    assert!(a.min.z.abs() < 0.1, "{a:?}");
 }

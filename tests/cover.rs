@@ -202,6 +202,7 @@ fn cover_command_writes_json_and_obj() {
     let opts = LoadOptions {
         polyhedra: true,
         strict: false,
+        up: None,
     };
     let loaded = load_bytes("rb.obj", bytes, &opts).unwrap();
     assert_eq!(loaded.scene.len(), wrappers.len());

@@ -244,6 +244,7 @@ fn mutated_obj_files_load_or_fail_with_one_line() {
         let opts = LoadOptions {
             polyhedra: *polyhedra,
             strict: false,
+            up: None,
         };
         load_bytes("seed.obj", text.clone(), &opts).expect("every seed is valid");
     }
@@ -262,7 +263,11 @@ fn mutated_obj_files_load_or_fail_with_one_line() {
         for m in &edits {
             apply(&mut text, m, &seeds);
         }
-        let opts = LoadOptions { polyhedra, strict };
+        let opts = LoadOptions {
+            polyhedra,
+            strict,
+            up: None,
+        };
         match load_bytes("mutant.obj", text, &opts) {
             Ok(l) => {
                 check_scene(&l.scene)?;

@@ -102,6 +102,7 @@ fn bundled() -> Vec<(String, Scene)> {
         let opts = LoadOptions {
             polyhedra,
             strict: false,
+            up: None,
         };
         let loaded = wraptree::scene::load_path(&p, &opts).unwrap_or_else(|e| panic!("{e}"));
         out.push((name, loaded.scene));

@@ -249,6 +249,7 @@ fn tiny_and_polyhedra_scenes_record() {
             LoadOptions {
                 polyhedra: true,
                 strict: true,
+                up: None,
             },
         ),
     ];

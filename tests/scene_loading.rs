@@ -12,14 +12,17 @@ use wraptree::scene::{LoadOptions, Loaded, PrimitiveKind, Scene, load_bytes, loa
 const POLYGONS: LoadOptions = LoadOptions {
     polyhedra: false,
     strict: false,
+    up: None,
 };
 const POLYHEDRA: LoadOptions = LoadOptions {
     polyhedra: true,
     strict: false,
+    up: None,
 };
 const STRICT: LoadOptions = LoadOptions {
     polyhedra: true,
     strict: true,
+    up: None,
 };
 
 fn repo(rel: &str) -> PathBuf {
@@ -478,7 +481,11 @@ proptest! {
         strict in any::<bool>(),
     ) {
         let text = [verts, lines].concat().join("\n");
-        let opts = LoadOptions { polyhedra, strict };
+        let opts = LoadOptions {
+            polyhedra,
+            strict,
+            up: None,
+        };
         match load_bytes("fuzz.obj", text.clone().into_bytes(), &opts) {
             Ok(l) => {
                 prop_assert!(!l.scene.is_empty());

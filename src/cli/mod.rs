@@ -17,7 +17,7 @@ use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use wraptree::grouping::{CostMeasure, Mode, PSet, Params, Pregroup, Schedule, Weights};
-use wraptree::scene::{LoadOptions, Loaded};
+use wraptree::scene::{LoadOptions, Loaded, Up, UrdfOptions};
 
 /// Build, record and inspect bounding-volume hierarchies with the bottom-up grouping phase of
 /// Xavier's "A Generic Algorithm for Constructing Hierarchical Representations of Geometric
@@ -57,14 +57,30 @@ enum Command {
 /// How to read a scene file.
 #[derive(Args, Debug, Clone)]
 pub struct SceneArgs {
-    /// Wavefront OBJ file.
+    /// Scene file: Wavefront OBJ, STL, PLY, glTF/GLB or URDF (by its extension).
     pub scene: PathBuf,
-    /// Treat each OBJ object/group as one convex polyhedron (default: each face is a polygon).
+    /// Treat each object (OBJ o/g, STL solid, glTF node, URDF link) as one convex polyhedron
+    /// (default: each face is a polygon).
     #[arg(long)]
     pub polyhedra: bool,
-    /// With --polyhedra: a group whose vertices are not in convex position is an error.
+    /// With --polyhedra: an object whose vertices are not in convex position is an error.
     #[arg(long)]
     pub strict: bool,
+    /// The file's up axis, turned to +Z when loading: y or z [default: y for glTF, z for the
+    /// other formats].
+    #[arg(long, value_enum)]
+    pub up: Option<Up>,
+    /// URDF: read each link's collision geometry instead of its visual geometry.
+    #[arg(long)]
+    pub urdf_collision: bool,
+    /// URDF: a joint's value, NAME=VALUE (radians, or metres for a prismatic joint); repeat
+    /// for more joints. Other joints are at 0.
+    #[arg(long, value_name = "NAME=VALUE", value_parser = parse_joint, allow_hyphen_values = true)]
+    pub joint: Vec<(String, f64)>,
+    /// URDF: a folder to find package://NAME/… meshes in (DIR/NAME/… or DIR/… for a DIR named
+    /// NAME); repeatable, searched before ROS_PACKAGE_PATH and the URDF's own folders.
+    #[arg(long, value_name = "DIR")]
+    pub package_path: Vec<PathBuf>,
     /// Before grouping, cut polygons whose aspect (principal : secondary extent) exceeds R
     /// into slabs of aspect ≤ R (§4); the split scene is what is grouped and recorded.
     #[arg(long, value_name = "R")]
@@ -77,8 +93,16 @@ impl SceneArgs {
         let opts = LoadOptions {
             polyhedra: self.polyhedra,
             strict: self.strict,
+            up: self.up,
         };
-        let mut loaded = wraptree::scene::load_path(&self.scene, &opts)?;
+        let mut package_path = self.package_path.clone();
+        package_path.extend(UrdfOptions::ros_package_path());
+        let urdf = UrdfOptions {
+            collision: self.urdf_collision,
+            joints: self.joint.clone(),
+            package_path,
+        };
+        let mut loaded = wraptree::scene::load_path_with(&self.scene, &opts, &urdf)?;
         if let Some(r) = self.split_aspect {
             let (split, line) = wraptree::scene::split::split_flag(loaded, r)?;
             eprintln!("{line}");
@@ -89,6 +113,22 @@ impl SceneArgs {
         }
         Ok(loaded)
     }
+
+    /// Whether any flag about reading the scene file is given (they do not apply to a
+    /// recording, which carries its own).
+    pub fn has_load_flags(&self) -> bool {
+        self.polyhedra
+            || self.strict
+            || self.up.is_some()
+            || self.urdf_collision
+            || !self.joint.is_empty()
+            || !self.package_path.is_empty()
+    }
+}
+
+/// Parses a `--joint NAME=VALUE`.
+fn parse_joint(s: &str) -> Result<(String, f64), String> {
+    wraptree::scene::urdf::parse_joint(s)
 }
 
 /// Parameters of the grouping phase (§2.2).

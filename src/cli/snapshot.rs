@@ -65,7 +65,7 @@ fn load(cmd: &SnapshotCmd) -> Result<(Scene, ResolvedParams, Option<Vec<Merge>>)
         let params = cmd.group.params()?.resolve(&loaded.scene);
         return Ok((loaded.scene, params, None));
     }
-    if cmd.scene.polyhedra || cmd.scene.strict || cmd.group.params()? != Params::default() {
+    if cmd.scene.has_load_flags() || cmd.group.params()? != Params::default() {
         bail!(
             "{}: loading and grouping flags do not apply to a recording (it carries its own)",
             path.display()

@@ -5,7 +5,10 @@
 //! and the triangles `tris[tri_start[i]..tri_start[i+1]]` that draw it (a fan for a convex polygon,
 //! the hull's faces for a polyhedron).
 //!
-//! - [`obj`] loads Wavefront OBJ (via `tobj`) as polygons or as polyhedra, with validation;
+//! - [`load`] loads a scene file by its extension: [`obj`] Wavefront OBJ (via `tobj`), [`stl`],
+//!   [`ply`], [`gltf`] (glTF/GLB) and [`urdf`] (a robot's links placed by its joints), as
+//!   polygons or as polyhedra, with validation; `faces` holds the rules the non-OBJ formats
+//!   share and [`export`] the OBJ a multi-file input is embedded as in recordings;
 //! - [`generate`] makes the seeded synthetic scenes (robot base, lamp, replicas, soups);
 //! - [`pathological`] makes the seeded scenes that stress builders (spaghetti, slabs, …);
 //! - [`soup`] makes random triangle soups (used by both);
@@ -13,14 +16,25 @@
 //! - [`split`] cuts long thin polygons into pieces of limited aspect (§4).
 
 pub mod components;
+pub mod export;
+pub(crate) mod faces;
 pub mod generate;
+pub mod gltf;
+pub mod load;
 pub mod obj;
 pub mod pathological;
+pub mod ply;
 pub mod soup;
 pub mod spec;
 pub mod split;
+pub mod stl;
+pub mod urdf;
 
-pub use obj::{LoadError, LoadOptions, Loaded, SceneSource, load_bytes, load_path};
+pub use load::{
+    Format, LoadError, LoadErrorKind, LoadOptions, Loaded, SceneSource, Up, load_bytes, load_path,
+    load_path_with,
+};
+pub use urdf::UrdfOptions;
 
 use crate::geom::{Aabb, P3};
 

@@ -8,122 +8,32 @@
 //! OBJ object/group becomes one `PrimitiveKind::Polyhedron` by the rules of [`polyhedron`].
 //! Every primitive records the object id of its group ([`Scene::objects`]; groups of the same
 //! name share one id, in order of first appearance). Vertices with bit-identical positions are
-//! merged; loading the same bytes twice gives the same scene.
+//! merged; loading the same bytes twice gives the same scene. With [`LoadOptions::up`] = Y the
+//! coordinates are turned so that +Y becomes +Z (OBJ itself says nothing about up: Z is kept by
+//! default).
 
-use std::fmt;
 use std::path::Path;
 
-use sha2::{Digest, Sha256};
-
-use self::groups::{INDEX_SPLIT, collect_groups};
+use self::groups::{Group, INDEX_SPLIT, collect_groups};
 use self::pipe::Cleaned;
 use self::polygon::PolygonStats;
 use self::polyhedron::PolyhedronStats;
 use super::Scene;
+use super::faces::{Faces, turn_y_up};
+use super::load::{Format, Up};
+// The loading API lived here before other formats came; these paths keep working.
+pub use super::load::{
+    LoadError, LoadErrorKind, LoadOptions, Loaded, MAX_COORDINATE, SceneSource, load_bytes,
+    load_path,
+};
 
 mod groups;
 mod pipe;
 pub mod polygon;
 pub mod polyhedron;
 
-/// How to turn an OBJ file into primitives.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
-)]
-pub struct LoadOptions {
-    /// One convex polyhedron per OBJ object/group instead of one polygon per face.
-    pub polyhedra: bool,
-    /// With `polyhedra`: a group whose vertices are not in convex position is an error instead
-    /// of being replaced by its convex hull with a warning.
-    pub strict: bool,
-}
-
-/// The exact input of a loaded scene, kept so recordings can re-create it.
-#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub struct SceneSource {
-    /// File name (no directory), e.g. `mug.obj`.
-    pub file_name: String,
-    /// The file's bytes, verbatim.
-    pub bytes: Vec<u8>,
-    /// The options it was loaded with.
-    pub options: LoadOptions,
-    /// Lowercase hex SHA-256 of `bytes`.
-    pub sha256: String,
-}
-
-/// A loaded scene, its source and the warnings raised while loading it.
-#[derive(Clone, Debug)]
-pub struct Loaded {
-    /// The primitives.
-    pub scene: Scene,
-    /// What it was loaded from.
-    pub source: SceneSource,
-    /// One line per kind of repair (dropped, split or hulled primitives), naming the file.
-    pub warnings: Vec<String>,
-}
-
-/// What went wrong while loading.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LoadErrorKind {
-    /// The file could not be read.
-    Read,
-    /// The bytes are not a well-formed OBJ file.
-    Malformed,
-    /// A vertex has a NaN, infinite or absurdly large coordinate.
-    NonFinite,
-    /// A face refers to a vertex that does not exist.
-    BadIndex,
-    /// Nothing usable: no faces, or only degenerate ones.
-    NoFaces,
-    /// `--strict --polyhedra` and a group is not in convex position.
-    NotConvex,
-}
-
-/// A loading failure; its `Display` is one line `FILE: PROBLEM`.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct LoadError {
-    /// The file as the user named it.
-    pub file: String,
-    /// The category of the problem.
-    pub kind: LoadErrorKind,
-    /// The problem, one line, with the OBJ line number where known.
-    pub problem: String,
-}
-
-impl fmt::Display for LoadError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: {}", self.file, self.problem)
-    }
-}
-
-impl std::error::Error for LoadError {}
-
-/// Largest accepted coordinate magnitude: squared distances must stay finite in `f64`.
-pub const MAX_COORDINATE: f64 = 1e100;
-
-/// Reads and loads the OBJ file at `path`; errors name the path as given.
-pub fn load_path(path: &Path, opts: &LoadOptions) -> Result<Loaded, LoadError> {
-    let shown = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| {
-        let msg = e.to_string();
-        let msg = msg.split(" (os error").next().unwrap_or(&msg).to_string();
-        LoadError {
-            file: shown.clone(),
-            kind: LoadErrorKind::Read,
-            problem: format!("cannot read: {msg}"),
-        }
-    })?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| shown.clone());
-    load_bytes(&name, bytes, opts).map_err(|e| LoadError { file: shown, ..e })
-}
-
 /// Loads OBJ `bytes` named `file_name` (the scene is named after its stem).
-///
-/// Deterministic: the same bytes and options always give the same scene and warnings.
-pub fn load_bytes(
+pub(super) fn load(
     file_name: &str,
     bytes: Vec<u8>,
     opts: &LoadOptions,
@@ -131,19 +41,38 @@ pub fn load_bytes(
     load_piped_from(file_name, bytes, opts, pipe::PIPELINE_FROM)
 }
 
-/// [`load_bytes`], with the pre-pass and `tobj` at once from `pipeline_from` bytes up.
-fn load_piped_from(
+/// The faces of OBJ `bytes`, one object per group (for a URDF's meshes): the file's
+/// coordinates, not turned.
+pub(super) fn read_faces(file_name: &str, bytes: Vec<u8>) -> Result<Faces, LoadError> {
+    let mut points = Vec::new();
+    let (groups, scanned) = parse(file_name, &bytes, None, &mut points, pipe::PIPELINE_FROM)?;
+    let mut faces = Faces::new();
+    faces.coords = points.iter().map(|p| [p.x, p.y, p.z]).collect();
+    faces.short = scanned.short_faces;
+    for g in &groups {
+        let o = faces.object(&g.name);
+        for f in g.faces() {
+            faces.face(f.iter().copied(), o);
+        }
+    }
+    Ok(faces)
+}
+
+/// Checks and parses OBJ `bytes` (pre-pass, then `tobj`): the groups over `points`, which it
+/// fills (turned by `up` when that is Y), and the pre-pass's counts.
+fn parse(
     file_name: &str,
-    bytes: Vec<u8>,
-    opts: &LoadOptions,
+    bytes: &[u8],
+    up: Option<Up>,
+    points: &mut Vec<crate::geom::P3>,
     pipeline_from: usize,
-) -> Result<Loaded, LoadError> {
+) -> Result<(Vec<Group>, Scanned), LoadError> {
     let err = |kind, problem: String| LoadError {
         file: file_name.to_string(),
         kind,
         problem,
     };
-    let text = std::str::from_utf8(&bytes).map_err(|e| {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
         let line = bytes[..e.valid_up_to()]
             .iter()
             .filter(|&&b| b == b'\n')
@@ -161,7 +90,7 @@ fn load_piped_from(
         ignore_lines: true,
     };
     // tobj reads the pre-pass's cleaned text as it is written (a large file) or after it.
-    let (scanned, parsed) = pipe::scan_then(text, pipeline_from, scan, |cleaned| {
+    let (mut scanned, parsed) = pipe::scan_then(text, pipeline_from, scan, |cleaned| {
         tobj::load_obj_buf(cleaned, &tobj_opts, |_| {
             Err(tobj::LoadError::OpenFileFailed)
         })
@@ -180,14 +109,39 @@ fn load_piped_from(
             format!("not a valid OBJ file ({e})"),
         )
     })?;
+    if up == Some(Up::Y) {
+        turn_y_up(&mut scanned.coords);
+    }
+    let groups = collect_groups(&models, &scanned.coords, points)
+        .map_err(|p| err(LoadErrorKind::Malformed, p))?;
+    Ok((groups, scanned))
+}
 
+/// [`load_bytes`], with the pre-pass and `tobj` at once from `pipeline_from` bytes up.
+fn load_piped_from(
+    file_name: &str,
+    bytes: Vec<u8>,
+    opts: &LoadOptions,
+    pipeline_from: usize,
+) -> Result<Loaded, LoadError> {
+    let err = |kind, problem: String| LoadError {
+        file: file_name.to_string(),
+        kind,
+        problem,
+    };
+    let up = opts.up.unwrap_or(Format::Obj.default_up());
     let stem = Path::new(file_name)
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
     let mut scene = Scene::new(stem);
-    let groups = collect_groups(&models, &scanned.coords, &mut scene.points)
-        .map_err(|p| err(LoadErrorKind::Malformed, p))?;
+    let (groups, scanned) = parse(
+        file_name,
+        &bytes,
+        Some(up),
+        &mut scene.points,
+        pipeline_from,
+    )?;
     let mut warnings = Vec::new();
     // Object ids by group name, in order of first appearance.
     let mut object_ids = std::collections::HashMap::<&str, u32>::new();
@@ -242,16 +196,7 @@ fn load_piped_from(
         ));
     }
     debug_assert!(scene.points.iter().all(|p| p.iter().all(|c| c.is_finite())));
-    let sha256 = Sha256::digest(&bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    let source = SceneSource {
-        file_name: file_name.to_string(),
-        bytes,
-        options: *opts,
-        sha256,
-    };
+    let source = super::load::source(file_name, bytes, *opts);
     Ok(Loaded {
         scene,
         source,
@@ -301,7 +246,9 @@ fn shown(tok: &str) -> String {
 /// and `f32` would lose detail; small integers it holds exactly), so the vertex indices in
 /// `tobj`'s positions lead back to the `f64` coordinates. Faces with fewer than 3 vertices and
 /// every statement we ignore (`vt`, `vn`, `l`, `p`, `mtllib`, `usemtl`, `s`, …) are blanked;
-/// `f`, `o` and `g` lines are kept verbatim.
+/// `f`, `o` and `g` lines are kept verbatim. A line ending in `\\` continues on the next (the
+/// OBJ specification's long lines): the statement is checked and copied whole on its last line,
+/// its errors naming its first.
 fn scan(text: &str, out: &mut dyn Cleaned) -> Result<Scanned, (LoadErrorKind, String)> {
     let mut s = Scanned::default();
     // A vertex's rewritten line, written out whole.
@@ -310,9 +257,34 @@ fn scan(text: &str, out: &mut dyn Cleaned) -> Result<Scanned, (LoadErrorKind, St
     // Positive indices may point forward: the largest (with its face and line) is checked
     // once all vertices are known.
     let mut forward: Option<(i64, usize, usize)> = None;
-    for (i, raw) in text.split('\n').enumerate() {
-        let line = i + 1;
-        let raw = raw.strip_suffix('\r').unwrap_or(raw);
+    // A statement continued over lines ending in `\`: its text so far and its first line.
+    let mut joined = String::new();
+    let mut joined_from = 0;
+    let mut pieces = text.split('\n').enumerate().peekable();
+    while let Some((i, piece)) = pieces.next() {
+        let piece = piece.strip_suffix('\r').unwrap_or(piece);
+        if let Some(head) = piece.trim_end_matches([' ', '\t']).strip_suffix('\\')
+            && pieces.peek().is_some()
+        {
+            if joined.is_empty() {
+                joined_from = i + 1;
+            }
+            joined.push_str(head);
+            joined.push(' ');
+            // The copy keeps one line per line of the file.
+            out.push_str("\n");
+            continue;
+        }
+        let (line, raw) = if joined.is_empty() {
+            (i + 1, std::borrow::Cow::Borrowed(piece))
+        } else {
+            joined.push_str(piece);
+            (
+                joined_from,
+                std::borrow::Cow::Owned(std::mem::take(&mut joined)),
+            )
+        };
+        let raw: &str = &raw;
         let mut words = raw.split_whitespace();
         match words.next() {
             Some("v") => {

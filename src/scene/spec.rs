@@ -1,4 +1,5 @@
-//! Scenes named on a command line: an OBJ path, or a generated scene as `KIND[:COUNT]`
+//! Scenes named on a command line: a scene file (OBJ, STL, PLY, glTF, URDF), or a generated
+//! scene as `KIND[:COUNT]`
 //! (`wraptree bench`, `sweep`).
 
 use super::Scene;
@@ -7,7 +8,7 @@ use super::obj::{LoadOptions, Loaded, load_bytes, load_path};
 use anyhow::{Result, anyhow};
 use std::path::Path;
 
-/// Loads an OBJ path, or generates `KIND[:COUNT]` (COUNT = triangles for `soup`, copies for
+/// Loads a scene file (any format [`super::load`] reads), or generates `KIND[:COUNT]` (COUNT = triangles for `soup`, copies for
 /// `lamps`/`robot-bases`; see [`generate::by_name`]),
 /// seed 1, named after the spec (`soup:300` → `soup-300`). Returns the scene and the loader's
 /// warnings.
@@ -19,7 +20,7 @@ use std::path::Path;
 /// ```
 pub fn scene_spec(spec: &str) -> Result<(Scene, Vec<String>)> {
     let path = Path::new(spec);
-    if path.exists() || spec.ends_with(".obj") {
+    if path.exists() || super::load::Format::is_scene_file(spec) {
         let loaded = load_path(path, &LoadOptions::default())?;
         return Ok((loaded.scene, loaded.warnings));
     }

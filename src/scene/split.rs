@@ -7,7 +7,7 @@
 //! a panic: a zero-area primitive and every polyhedron are kept unchanged; R below 2 is taken as
 //! 2 and R = ∞ or NaN keeps the scene as it is.
 
-use super::{LoadError, Loaded, PrimitiveKind, Scene, load_bytes};
+use super::{LoadError, LoadOptions, Loaded, PrimitiveKind, Scene, load_bytes};
 use crate::geom::pca::Frame;
 use crate::geom::{P3, V3};
 
@@ -138,7 +138,8 @@ pub fn split_aspect_stats(scene: &Scene, r: f64) -> (Scene, Vec<u32>, SplitStats
 
 /// A loaded scene with its polygons split at aspect `r` ([`split_aspect`]), as if loaded from
 /// the split scene's OBJ: the source bytes are the split scene written by [`Scene::write_obj`]
-/// and loaded back with the same options (file `{stem}-split{r}.obj`), so a recording of it
+/// and loaded back with the same options less the up axis (file `{stem}-split{r}.obj`, already
+/// upright), so a recording of it
 /// embeds exactly the scene that was grouped and `replay --verify` reproduces it. When nothing
 /// is split, `loaded` is returned unchanged.
 pub fn split_loaded(loaded: Loaded, r: f64) -> Result<(Loaded, SplitStats), LoadError> {
@@ -151,7 +152,12 @@ pub fn split_loaded(loaded: Loaded, r: f64) -> Result<(Loaded, SplitStats), Load
         .write_obj(&mut bytes)
         .expect("writing to a Vec cannot fail");
     let name = format!("{}-split{r}.obj", loaded.scene.name);
-    let mut out = load_bytes(&name, bytes, &loaded.source.options)?;
+    // The split scene is written already turned upright: loaded without turning it again.
+    let opts = LoadOptions {
+        up: None,
+        ..loaded.source.options
+    };
+    let mut out = load_bytes(&name, bytes, &opts)?;
     out.warnings.splice(0..0, loaded.warnings);
     Ok((out, stats))
 }

@@ -54,6 +54,11 @@ pub const KEYS: &[&str] = &[
 /// announced.
 pub const STOP_KEYS: &[&str] = &["stop_reason", "stop_eligible_pairs"];
 
+/// Keys the `wraptree` record adds about loading the scene: `up` (`y` or `z`) when the scene
+/// was loaded with an up axis (`--up`); without it `replay` loads the embedded file with its
+/// format's own.
+pub const LOAD_KEYS: &[&str] = &["up"];
+
 /// Keys the `wraptree` record adds for the partitioned schedule ([`Chunking`]): its chunk size
 /// δ (informative, fixed in a build), the reduction function's ε (`--chunk-epsilon`), the
 /// root's share `top` (`--chunk-top`) and the SAH cuts' range size (`--chunk-sah`), the last
@@ -206,6 +211,9 @@ pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String,
     put("scene_sha256", info.source.sha256.clone());
     put("polyhedra", info.source.options.polyhedra.to_string());
     put("strict", info.source.options.strict.to_string());
+    if let Some(up) = info.source.options.up {
+        put("up", up.name().to_string());
+    }
     put("primitives", info.scene.len().to_string());
     put("rounds", outcome.rounds.to_string());
     put("merges", outcome.merges.to_string());

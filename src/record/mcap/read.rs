@@ -273,6 +273,11 @@ fn interpret(raw: Raw) -> Result<Recorded> {
         load_options: LoadOptions {
             polyhedra: metadata::parse(&m, "polyhedra")?,
             strict: metadata::parse(&m, "strict")?,
+            // Written only when the scene was loaded with an up axis (`--up`).
+            up: match m.contains_key("up") {
+                true => Some(metadata::parse(&m, "up")?),
+                false => None,
+            },
         },
         scene_file_name,
         scene_bytes,
