@@ -256,8 +256,7 @@ fn new_nodes(
                 .expect("every set has a slot")]
         }
     };
-    sets
-        .iter()
+    sets.iter()
         .zip(&slot)
         .map(|(&s, &x)| {
             let p = split[s] as usize;
