@@ -5,11 +5,13 @@ use super::group::{BudgetArgs, EXIT_INTERRUPTED, Progress};
 use super::{GroupArgs, SceneArgs};
 use anyhow::Result;
 use clap::Args;
+use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use wraptree::output::output_prefix;
+use wraptree::record::live::{self, Live, LiveOptions, RerunLive};
 use wraptree::record::mcap::Compression;
 use wraptree::record::{Detail, RecordOptions, Written, record};
 use wraptree::refine::RefineParams;
@@ -77,6 +79,95 @@ pub struct RecordCmd {
     /// Treelet restructuring passes before the reinsertion passes (with --refine; 0 = none).
     #[arg(long, default_value_t = RefineParams::default().treelet_passes, requires = "refine")]
     refine_treelet_passes: u32,
+    #[command(flatten)]
+    live: LiveArgs,
+}
+
+/// Watching the run live while the files are written (`record`, `replay --a/--b/--c`); see
+/// docs/recordings.md, "Live viewing".
+#[derive(Args, Debug, Clone)]
+pub struct LiveArgs {
+    /// Also stream the .rrd to a running Rerun viewer (or `rerun --serve-grpc`) at URL
+    /// [default: rerun+http://127.0.0.1:9876/proxy].
+    #[arg(long, value_name = "URL", num_args = 0..=1, require_equals = true,
+          default_missing_value = live::DEFAULT_CONNECT_URL, conflicts_with_all = ["serve", "spawn"])]
+    connect: Option<String>,
+    /// Also serve the .rrd's stream from a gRPC server on IP:PORT, for Rerun viewers that connect
+    /// during or after the run (`rerun --connect rerun+http://HOST:PORT/proxy`); after the run it
+    /// keeps serving until Ctrl-C [default: 0.0.0.0:9876].
+    #[arg(long, value_name = "IP:PORT", num_args = 0..=1, require_equals = true,
+          default_missing_value = "0.0.0.0:9876", conflicts_with = "spawn")]
+    serve: Option<SocketAddr>,
+    /// With --serve: how much of the stream the server keeps for late viewers (e.g. 2GB, 25%
+    /// of the RAM, unlimited); above it the oldest merges are dropped first, then the scene;
+    /// the layout is always kept.
+    #[arg(long, value_name = "LIMIT", default_value = "25%", requires = "serve")]
+    serve_memory_limit: String,
+    /// Also start a Rerun viewer (`rerun` on PATH; one already listening on port 9876 is
+    /// reused) and stream the .rrd to it.
+    #[arg(long)]
+    spawn: bool,
+    /// Also serve the .mcap's topics over the Foxglove WebSocket protocol on HOST:PORT (port 0:
+    /// any free port), during and after the run; after the run it keeps serving until Ctrl-C
+    /// [default: 127.0.0.1:8765].
+    #[arg(long, value_name = "HOST:PORT", num_args = 0..=1, require_equals = true,
+          default_missing_value = live::foxglove::DEFAULT_ADDR)]
+    foxglove_ws: Option<String>,
+    /// With --foxglove-ws: wait for a Foxglove client to connect before the run starts (a
+    /// client gets no history, only the latest message of each topic).
+    #[arg(long, requires = "foxglove_ws")]
+    foxglove_wait: bool,
+}
+
+impl LiveArgs {
+    /// Whether any live flag is given.
+    pub fn any(&self) -> bool {
+        self.connect.is_some() || self.serve.is_some() || self.spawn || self.foxglove_ws.is_some()
+    }
+
+    /// Starts what the flags ask for, prints where each stream goes, and with --foxglove-wait
+    /// waits for a Foxglove client (or Ctrl-C, which then stops the run at once).
+    pub fn start(&self, stop: &AtomicBool) -> Result<Live> {
+        let rerun = match (&self.connect, self.serve, self.spawn) {
+            (Some(url), _, _) => Some(RerunLive::Connect(url.clone())),
+            (_, Some(addr), _) => Some(RerunLive::Serve {
+                addr,
+                memory_limit: self.serve_memory_limit.clone(),
+            }),
+            (_, _, true) => Some(RerunLive::Spawn),
+            _ => None,
+        };
+        let opts = LiveOptions {
+            rerun,
+            foxglove: self.foxglove_ws.clone(),
+            ..LiveOptions::default()
+        };
+        let live = Live::start(&opts)?;
+        for line in live.describe() {
+            println!("{line}");
+        }
+        if self.foxglove_wait {
+            println!("live Foxglove: waiting for a client to connect before the run");
+            live.wait_for_foxglove_client(stop);
+        }
+        Ok(live)
+    }
+}
+
+/// After the run: lets the live streams hand over what they hold, warns about what did not get
+/// through, and, with a server (--serve, --foxglove-ws) and no Ctrl-C so far, keeps serving
+/// until Ctrl-C or SIGTERM.
+pub fn after_run(live: &Live, stop: &AtomicBool) {
+    if !live.is_on() {
+        return;
+    }
+    for line in live.finish() {
+        eprintln!("warning: {line}");
+    }
+    if live.serves() && !stop.load(Ordering::Relaxed) {
+        println!("live: the run is recorded; still serving it until Ctrl-C");
+        live.keep_serving(stop);
+    }
 }
 
 /// Success for a finished grouping, else the stop's exit code (3 for a limit, 130 for
@@ -117,12 +208,12 @@ impl RecordCmd {
         let stop = stop_flag();
         let limits = self.limits.limits()?;
         let limit = CoverLimit::from_flags(self.cover_tolerance, self.cover_budget);
-        let opts = RecordOptions {
+        let mut opts = RecordOptions {
             detail: self.detail,
             force: self.force,
             reproducible: self.reproducible,
             limits,
-            stop: Some(stop),
+            stop: Some(stop.clone()),
             wrappers: self.wrapper,
             cover: limit.map(|l| (l, self.cover_kinds)),
             all_levels: self.all_levels,
@@ -133,14 +224,19 @@ impl RecordCmd {
                 treelet: self.refine_treelet,
                 treelet_passes: self.refine_treelet_passes,
             }),
+            live: Live::default(),
         };
         opts.check()?;
+        // Started before loading, so that a viewer can connect while the scene loads.
+        let live = self.live.start(&stop)?;
+        opts.live = live.clone();
         let loaded = self.scene.load()?;
         let params = self.group.params()?.resolve(&loaded.scene);
         let prefix = output_prefix(self.output.as_deref(), &loaded.source.file_name, "")?;
         let progress = Progress::for_merges(loaded.scene.len() as u64);
         let w = record(&loaded, &params, &prefix, &opts, progress)?;
         print_written(&w, &loaded.scene);
+        after_run(&live, &stop);
         Ok(exit_code(&w))
     }
 }

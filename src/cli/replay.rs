@@ -2,7 +2,7 @@
 //! ([`wraptree::replay`]).
 
 use super::group::{BudgetArgs, Progress};
-use super::record::{exit_code, print_written, stop_flag};
+use super::record::{LiveArgs, after_run, exit_code, print_written, stop_flag};
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
@@ -41,12 +41,22 @@ pub struct ReplayCmd {
     /// Limits on the re-run of --verify and --a/--b/--c.
     #[command(flatten)]
     limits: BudgetArgs,
+    /// Live viewing of the re-weighted run (with --a/--b/--c).
+    #[command(flatten)]
+    live: LiveArgs,
 }
 
 impl ReplayCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         let limits = self.limits.limits()?;
+        let reweights = self.a.is_some() || self.b.is_some() || self.c.is_some();
+        if self.live.any() && !reweights {
+            anyhow::bail!(
+                "--connect, --serve, --spawn and --foxglove-ws stream a re-weighted run: give --a, \
+                 --b or --c"
+            );
+        }
         let replay = replay::open(&self.file)?;
         let (rec, loaded) = (&replay.rec, &replay.loaded);
         let name = self.file.display().to_string();
@@ -69,7 +79,7 @@ impl ReplayCmd {
                 return Ok(ExitCode::FAILURE);
             }
         }
-        if self.a.is_some() || self.b.is_some() || self.c.is_some() {
+        if reweights {
             return self.reweight(&replay, limits);
         }
         Ok(ExitCode::SUCCESS)
@@ -80,24 +90,29 @@ impl ReplayCmd {
         let weights = replay::weights(rec, self.a, self.b, self.c)?;
         let suffix = format!("-a{}-b{}-c{}", weights.a, weights.b, weights.c);
         let prefix = output_prefix(self.output.as_deref(), &rec.scene_file_name, &suffix)?;
+        let stop = stop_flag();
+        let live = self.live.start(&stop)?;
         let opts = RecordOptions {
             detail: self.detail,
             force: self.force,
             limits,
-            stop: Some(stop_flag()),
+            stop: Some(stop.clone()),
             refine: rec.refine.map(|r| r.params),
+            live: live.clone(),
             ..RecordOptions::default()
         };
         let progress = Progress::for_merges(loaded.scene.len() as u64);
         let r = replay::reweight(replay, weights, &prefix, &opts, progress)?;
         let (Some(g), Some(log)) = (&r.written.grouping, &r.log) else {
             print_written(&r.written, &loaded.scene);
+            after_run(&live, &stop);
             return Ok(exit_code(&r.written));
         };
         print!("{}", report::pairs_compared(&rec.merges, &log.merges));
         let old = replay.tree()?;
         print!("{}", report::reweight_table(rec, &old, g, &log.merges));
         print_written(&r.written, &loaded.scene);
+        after_run(&live, &stop);
         Ok(exit_code(&r.written))
     }
 }

@@ -2,10 +2,12 @@
 //! ([`mcap`]). Both recorders are [`Observer`](crate::grouping::Observer)s fed the same events and
 //! share nothing else; [`output`](crate::output) makes their files appear atomically, and
 //! [`background`] lets a recorder consume the events on another thread while the grouping runs;
-//! [`record()`] runs a grouping with both recorders listening, and [`Written`] says what it wrote.
+//! [`record()`] runs a grouping with both recorders listening, and [`Written`] says what it wrote;
+//! [`live`] streams the same run to viewers while it happens.
 
 pub mod background;
 pub mod direct;
+pub mod live;
 pub mod mcap;
 mod options;
 pub mod rrd;

@@ -13,6 +13,7 @@
 //! ```
 
 use super::direct::DirectWriter;
+use super::live::Live;
 use super::mcap::{Compression, McapRecorder};
 use super::rrd::RrdRecorder;
 use super::{CoverLevel, Detail, Outcome, RunInfo, background};
@@ -57,6 +58,9 @@ pub struct RecordOptions {
     pub refine: Option<crate::refine::RefineParams>,
     /// How the `.mcap`'s chunks are compressed.
     pub mcap_compression: Compression,
+    /// Live streams that see the run as it is recorded (`--connect`, `--serve`, `--spawn`,
+    /// `--foxglove-ws`), started with [`Live::start`]; the files are the same with or without.
+    pub live: Live,
 }
 
 impl Default for RecordOptions {
@@ -74,6 +78,7 @@ impl Default for RecordOptions {
             all_levels: false,
             refine: None,
             mcap_compression: Compression::Auto,
+            live: Live::default(),
         }
     }
 }
@@ -138,7 +143,7 @@ pub fn record<O: Observer>(
         let [rrd_worker, mcap_worker]: [background::Worker; 2] = workers
             .try_into()
             .map_err(|_| anyhow!("two event channels"))?;
-        let rrd_thread = spawn_rrd(s, rrd_worker, &rrd_file, &info, opts.refine.is_some())?;
+        let rrd_thread = spawn_rrd(s, rrd_worker, &rrd_file, &info, opts)?;
         let mcap_thread = spawn_mcap(s, mcap_worker, mcap_out, &info, opts)?;
         // The grouping starts without waiting for either recorder: a recorder that fails to
         // start drops its worker (the grouping stops sending to it) and its error is reported
@@ -180,12 +185,14 @@ fn spawn_rrd<'scope, 'a: 'scope>(
     worker: background::Worker,
     file: &'scope Pending,
     info: &'scope RunInfo<'a>,
-    refined: bool,
+    opts: &'scope RecordOptions,
 ) -> Result<ScopedJoinHandle<'scope, Result<RrdRecorder>>> {
+    let (refined, live) = (opts.refine.is_some(), &opts.live);
     std::thread::Builder::new()
         .name("rrd-recorder".into())
         .spawn_scoped(s, move || {
-            let mut rrd = RrdRecorder::with_refine(file.path(), file.dest(), info, refined)?;
+            let (path, name) = (file.path(), file.dest());
+            let mut rrd = RrdRecorder::with_live(path, name, info, refined, live)?;
             worker.run(&mut rrd);
             Ok(rrd)
         })
@@ -203,7 +210,8 @@ fn spawn_mcap<'scope, 'a: 'scope>(
     std::thread::Builder::new()
         .name("mcap-recorder".into())
         .spawn_scoped(s, move || {
-            let mut mcap = McapRecorder::start(out, info, opts.mcap_compression)?;
+            let live = opts.live.mcap_tee();
+            let mut mcap = McapRecorder::start_live(out, info, opts.mcap_compression, live)?;
             mcap.set_reproducible(opts.reproducible);
             mcap.set_all_levels(opts.all_levels);
             mcap.write_scene();

@@ -24,6 +24,7 @@ pub use read::{Recorded, read_recording};
 use crate::events::{RefineParams, Step};
 use crate::geom::Aabb;
 use crate::grouping::{Event, Merge, Observer, Part};
+use crate::record::live::foxglove::McapTee;
 use crate::record::{Detail, Outcome, RunInfo};
 use anyhow::{Context, Result, anyhow};
 use foxglove::Encode;
@@ -113,7 +114,7 @@ struct Topics {
 /// [`DirectWriter`](crate::record::direct::DirectWriter), tests a `BufWriter`). Write errors do
 /// not panic: the first one is kept, later events are ignored, and `finish` returns it.
 pub struct McapRecorder<'a, W: Write + Seek> {
-    writer: mcap::Writer<W>,
+    writer: Out<W>,
     info: RunInfo<'a>,
     topics: Topics,
     /// The `/scene` channel, written once by [`McapRecorder::write_scene`].
@@ -130,19 +131,49 @@ pub struct McapRecorder<'a, W: Write + Seek> {
     buf: Vec<u8>,
 }
 
-fn add_schema<T: Encode, W: Write + Seek>(w: &mut mcap::Writer<W>) -> Result<u16> {
-    let s = T::get_schema().ok_or_else(|| anyhow!("message type without a schema"))?;
-    Ok(w.add_schema(&s.name, &s.encoding, &s.data)?)
+/// The MCAP writer, and the live Foxglove stream (`record --foxglove-ws`) that gets a copy of
+/// every schema, channel and message written through [`add_schema`], [`add_topic`] and
+/// [`emit`]. The file's bytes do not depend on it.
+struct Out<W: Write + Seek> {
+    mcap: mcap::Writer<W>,
+    live: Option<McapTee>,
 }
 
-fn add_topic<W: Write + Seek>(w: &mut mcap::Writer<W>, schema: u16, name: &str) -> Result<Topic> {
-    let id = w.add_channel(schema, name, "protobuf", &BTreeMap::new())?;
+impl<W: Write + Seek> std::ops::Deref for Out<W> {
+    type Target = mcap::Writer<W>;
+    fn deref(&self) -> &mcap::Writer<W> {
+        &self.mcap
+    }
+}
+
+impl<W: Write + Seek> std::ops::DerefMut for Out<W> {
+    fn deref_mut(&mut self) -> &mut mcap::Writer<W> {
+        &mut self.mcap
+    }
+}
+
+fn add_schema<T: Encode, W: Write + Seek>(w: &mut Out<W>) -> Result<u16> {
+    let s = T::get_schema().ok_or_else(|| anyhow!("message type without a schema"))?;
+    let id = w.mcap.add_schema(&s.name, &s.encoding, &s.data)?;
+    if let Some(live) = &w.live {
+        live.schema(id, &s.name, &s.encoding, &s.data);
+    }
+    Ok(id)
+}
+
+fn add_topic<W: Write + Seek>(w: &mut Out<W>, schema: u16, name: &str) -> Result<Topic> {
+    let id = w
+        .mcap
+        .add_channel(schema, name, "protobuf", &BTreeMap::new())?;
+    if let Some(live) = &w.live {
+        live.channel(id, schema, name, "protobuf");
+    }
     Ok(Topic { id, seq: 0 })
 }
 
 /// Encodes `msg` into `buf` and writes it on `topic` at `t_ns`.
 fn emit<T: Encode, W: Write + Seek>(
-    w: &mut mcap::Writer<W>,
+    w: &mut Out<W>,
     buf: &mut Vec<u8>,
     topic: &mut Topic,
     t_ns: u64,
@@ -158,7 +189,11 @@ fn emit<T: Encode, W: Write + Seek>(
         publish_time: t_ns,
     };
     topic.seq += 1;
-    Ok(w.write_to_known_channel(&header, buf)?)
+    w.mcap.write_to_known_channel(&header, buf)?;
+    if let Some(live) = &w.live {
+        live.message(topic.id, t_ns, buf);
+    }
+    Ok(())
 }
 
 impl<'a, W: Write + Seek> McapRecorder<'a, W> {
@@ -177,6 +212,18 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
     /// Starts a recording whose chunks are compressed with `compression`: writes the header,
     /// schemas and channels (small; a buffered writer holds them), but not yet the scene.
     pub fn start(writer: W, info: &RunInfo<'a>, compression: Compression) -> Result<Self> {
+        Self::start_live(writer, info, compression, None)
+    }
+
+    /// As [`McapRecorder::start`], also copying every schema, channel and message written to
+    /// `live`, the live Foxglove stream (`record --foxglove-ws`), if given. The file is the same
+    /// with or without it.
+    pub fn start_live(
+        writer: W,
+        info: &RunInfo<'a>,
+        compression: Compression,
+        live: Option<McapTee>,
+    ) -> Result<Self> {
         let (compression, level) = match compression.for_scene(info.scene.len()) {
             Compression::None | Compression::Auto => (None, 0),
             Compression::Lz4 => (Some(mcap::Compression::Lz4), LZ4_LEVEL),
@@ -196,7 +243,8 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             .calculate_data_section_crc(true)
             .calculate_summary_section_crc(true)
             .calculate_attachment_crcs(true);
-        let mut w = options.create(writer).context("starting the MCAP file")?;
+        let mcap = options.create(writer).context("starting the MCAP file")?;
+        let mut w = Out { mcap, live };
         let scene_update = add_schema::<SceneUpdate, W>(&mut w)?;
         let round_schema = add_schema::<RoundEvent, W>(&mut w)?;
         let merge_schema = add_schema::<MergeEvent, W>(&mut w)?;
@@ -500,7 +548,7 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
         }
         self.write_tail(outcome)
             .context("writing the MCAP recording")?;
-        Ok(self.writer.into_inner())
+        Ok(self.writer.mcap.into_inner())
     }
 }
 

@@ -35,6 +35,7 @@ use rerun::{AsComponents, RecordingStream, SerializedComponentColumn, TimeColumn
 use crate::events::Step;
 use crate::geom::{Aabb, P3};
 use crate::grouping::{Event, Merge, Observer};
+use crate::record::live::Live;
 use crate::record::{ACTIVE_CAP, Detail, Outcome, RunInfo, boxes_drawn};
 use columns::Columns;
 use mesh::PrimMesh;
@@ -154,10 +155,23 @@ impl RrdRecorder {
         info: &RunInfo<'_>,
         refined: bool,
     ) -> anyhow::Result<Self> {
+        Self::with_live(path, name, info, refined, &Live::default())
+    }
+
+    /// As [`RrdRecorder::with_refine`], also streaming every message to `live`'s Rerun viewer or
+    /// server, if it has one: the recording stream sends each message to the file and to the
+    /// live stream, which never holds the file up ([`crate::record::live`]).
+    pub fn with_live(
+        path: &Path,
+        name: &Path,
+        info: &RunInfo<'_>,
+        refined: bool,
+        live: &Live,
+    ) -> anyhow::Result<Self> {
         let scene = info.scene;
         let builder =
             rerun::RecordingStreamBuilder::new("wraptree").recording_id(header::recording_id(info));
-        let (rec, status) = sink::save(builder, path)
+        let (rec, status) = sink::save(builder, path, live.rerun_sink())
             .map_err(|e| file_error(name, "cannot create the Rerun recording", e))?;
         // The SDK builds a blueprint through a stream of its own (two threads, one chunk per
         // view); a thread of ours does it while this one writes the header and the events.

@@ -29,7 +29,7 @@ impl SeriesFile {
         if let Some(b) = blueprint {
             builder = builder.with_blueprint(b);
         }
-        let (rec, status) = sink::save(builder, pending.path())
+        let (rec, status) = sink::save(builder, pending.path(), None)
             .map_err(|e| anyhow::anyhow!("{}: {}", dest.display(), e.root_cause()))?;
         Ok(SeriesFile {
             rec,

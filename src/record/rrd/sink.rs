@@ -164,13 +164,17 @@ impl Drop for DirectSink {
 
 /// Creates (or truncates) `path` and starts a stream saving to it, without the wall-clock
 /// `log_time` and `log_tick` timelines; [`close`] ends it and reports how the writing went.
+/// With a `live` sink the stream sends every message to both (the SDK's `MultiSink`): the file
+/// gets the same messages as without it.
 pub(super) fn save(
     builder: RecordingStreamBuilder,
     path: &Path,
+    live: Option<Box<dyn LogSink>>,
 ) -> anyhow::Result<(RecordingStream, Status)> {
     let status = Status::default();
     let sink: Box<dyn LogSink> = Box::new(DirectSink::start(path, status.clone())?);
-    let rec = builder.enabled(true).set_sinks(vec![sink])?;
+    let sinks = std::iter::once(sink).chain(live).collect::<Vec<_>>();
+    let rec = builder.enabled(true).set_sinks(sinks)?;
     rec.set_log_time_enabled(false);
     rec.set_log_tick_enabled(false);
     Ok((rec, status))
