@@ -15,6 +15,8 @@
 
 mod common;
 
+use common::mutate::{at, lines, number_tokens};
+
 use proptest::prelude::*;
 use proptest::test_runner::{TestCaseError, TestRunner};
 use std::cell::Cell;
@@ -130,45 +132,6 @@ fn mutation() -> impl Strategy<Value = Mutation> {
     ]
 }
 
-/// Byte ranges of the number-like tokens of `text` (runs of digits, signs, dots, `e`, `/`).
-fn number_tokens(text: &[u8]) -> Vec<(usize, usize)> {
-    let num = |b: u8| b.is_ascii_digit() || matches!(b, b'-' | b'+' | b'.' | b'e' | b'/');
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < text.len() {
-        if num(text[i]) && (i == 0 || !num(text[i - 1])) {
-            let start = i;
-            while i < text.len() && num(text[i]) {
-                i += 1;
-            }
-            out.push((start, i));
-        } else {
-            i += 1;
-        }
-    }
-    out
-}
-
-/// Byte ranges of the lines of `text`, each with its newline.
-fn lines(text: &[u8]) -> Vec<(usize, usize)> {
-    let mut out = Vec::new();
-    let mut start = 0;
-    for (i, &b) in text.iter().enumerate() {
-        if b == b'\n' {
-            out.push((start, i + 1));
-            start = i + 1;
-        }
-    }
-    if start < text.len() {
-        out.push((start, text.len()));
-    }
-    out
-}
-
-fn at(f: f64, len: usize) -> usize {
-    ((f * len as f64) as usize).min(len)
-}
-
 fn apply(text: &mut Vec<u8>, m: &Mutation, seeds: &[(Vec<u8>, bool)]) {
     match *m {
         Mutation::Flip(p, mask) if !text.is_empty() => {
@@ -184,7 +147,9 @@ fn apply(text: &mut Vec<u8>, m: &Mutation, seeds: &[(Vec<u8>, bool)]) {
             text.splice(a..b, other[c..d].iter().copied());
         }
         Mutation::Token(k, t) => {
-            let toks = number_tokens(text);
+            let toks = number_tokens(text, |b| {
+                b.is_ascii_digit() || matches!(b, b'-' | b'+' | b'.' | b'e' | b'/')
+            });
             if !toks.is_empty() {
                 let (a, b) = toks[k % toks.len()];
                 text.splice(a..b, t.bytes());
