@@ -1,7 +1,9 @@
-//! The Foxglove layout shipped in `recordings/foxglove-layout.json` (importable in Foxglove and
-//! Lichtblick): its panel tree is well formed, and every topic and message field it names exists
-//! in a recording written by `wraptree record`, checked with the independent Python `mcap`
-//! reader (provisioned by the tests, `common::readers`).
+//! The Foxglove layouts shipped in `recordings/` (importable in Foxglove and Lichtblick): their
+//! panel trees are well formed, and every topic and message field they name exists in a
+//! recording of the kind they are for (`foxglove-layout.json`: `wraptree record`;
+//! `foxglove-compare-layout.json`: the `.compare.mcap` of `wraptree replay --a/--b/--c`),
+//! checked with the independent Python `mcap` reader (provisioned by the tests,
+//! `common::readers`).
 
 mod common;
 
@@ -13,6 +15,10 @@ use serde_json::Value;
 const LAYOUT: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/recordings/foxglove-layout.json"
+);
+const COMPARE_LAYOUT: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/recordings/foxglove-compare-layout.json"
 );
 
 /// For each `[topic, field path]` of `argv[2]` (a JSON list; an empty path names the topic
@@ -150,16 +156,14 @@ fn layout_panels_are_laid_out_once_each() {
     assert!(paths.iter().any(|(t, _)| t.starts_with("/levels/")));
 }
 
-#[test]
-fn every_topic_and_field_of_the_layout_is_in_a_recording() {
+/// Checks that every topic and field `layout` names is in `mcap`.
+fn assert_in_recording(layout: &str, mcap: &Path) {
     let layout: Value =
-        serde_json::from_str(&std::fs::read_to_string(LAYOUT).unwrap()).expect("layout is JSON");
+        serde_json::from_str(&std::fs::read_to_string(layout).unwrap()).expect("layout is JSON");
     let wanted: Vec<(String, String)> = named_paths(&layout).into_iter().collect();
-    let dir = tempfile::tempdir().unwrap();
-    let mcap = record(dir.path());
     let out = common::python()
         .args(["-c", CHECK])
-        .arg(&mcap)
+        .arg(mcap)
         .arg(serde_json::to_string(&wanted).unwrap())
         .output()
         .expect("the readers' Python runs");
@@ -169,4 +173,46 @@ fn every_topic_and_field_of_the_layout_is_in_a_recording() {
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
+}
+
+#[test]
+fn every_topic_and_field_of_the_layout_is_in_a_recording() {
+    let dir = tempfile::tempdir().unwrap();
+    let mcap = record(dir.path());
+    assert_in_recording(LAYOUT, &mcap);
+}
+
+#[test]
+fn the_comparison_layout_shows_both_runs_of_a_comparison() {
+    let layout: Value = serde_json::from_str(&std::fs::read_to_string(COMPARE_LAYOUT).unwrap())
+        .expect("layout is JSON");
+    let mut ids = Vec::new();
+    panel_ids(&layout["layout"], &mut ids);
+    assert_eq!(ids.len(), layout["configById"].as_object().unwrap().len());
+    let paths = named_paths(&layout);
+    for run in ["/runs/0", "/runs/1"] {
+        for topic in ["bodies", "divergence"] {
+            assert!(paths.contains(&(format!("{run}/{topic}"), String::new())));
+        }
+        assert!(paths.contains(&(format!("{run}/merge"), "cost".into())));
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let mcap = record(dir.path());
+    let out = common::wraptree(
+        &[
+            "replay",
+            mcap.to_str().unwrap(),
+            "--c",
+            "0.5",
+            "-o",
+            "rb-c05",
+        ],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_in_recording(COMPARE_LAYOUT, &dir.path().join("rb-c05.compare.mcap"));
 }

@@ -2,6 +2,7 @@
 
 mod bench;
 mod bench_partitioned;
+mod compare;
 mod cover;
 mod group;
 mod record;
@@ -37,12 +38,17 @@ enum Command {
     Record(record::RecordCmd),
     /// Rebuild a run from its .mcap; --verify re-runs it; --a/--b/--c re-weights it.
     Replay(replay::ReplayCmd),
+    /// Two or more .mcap recordings of one scene side by side in one .rrd, their first
+    /// divergence marked.
+    Compare(compare::CompareCmd),
     /// Generate a seeded synthetic scene as Wavefront OBJ.
     Scene(scene_cmd::SceneCmd),
     /// Compare every hierarchy builder × wrapper on scenes (CSV, charts, .rrd), or print the
     /// targets table against obvhs PLOC and parry Binned.
     Bench(bench::BenchCmd),
-    /// Run the A/B/C grid of the grouping Cost on a scene: table, heat maps and one .rrd.
+    /// Run the A/B/C grid of the grouping Cost on a scene: table, heat maps, the series of every
+    /// setting (sweep.rrd) and the trees of the 6 best distinct settings side by side
+    /// (compare.rrd).
     Sweep(sweep::SweepCmd),
     /// Render the input and chosen tree levels as PNG/SVG frames and a figure sheet.
     Snapshot(snapshot::SnapshotCmd),
@@ -258,6 +264,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Group(c) => c.run(),
         Command::Record(c) => c.run(),
         Command::Replay(c) => c.run(),
+        Command::Compare(c) => c.run(),
         Command::Scene(c) => c.run(),
         Command::Bench(c) => c.run(),
         Command::Sweep(c) => c.run(),

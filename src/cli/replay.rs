@@ -29,7 +29,9 @@ pub struct ReplayCmd {
     #[arg(long)]
     c: Option<f64>,
     /// Output prefix for the re-weighted recordings [default: recordings/<stem>-a<A>-b<B>-c<C>];
-    /// the prefix's directory must exist.
+    /// the prefix's directory must exist. Besides PREFIX.rrd and PREFIX.mcap, a finished run
+    /// writes PREFIX.compare.rrd and PREFIX.compare.mcap: the recorded and the re-weighted run
+    /// side by side.
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// What the re-weighted recordings hold.
@@ -112,6 +114,9 @@ impl ReplayCmd {
         let old = replay.tree()?;
         print!("{}", report::reweight_table(rec, &old, g, &log.merges));
         print_written(&r.written, &loaded.scene);
+        for path in r.comparison.iter().flatten() {
+            println!("  {} (both runs side by side)", path.display());
+        }
         after_run(&live, &stop);
         Ok(exit_code(&r.written))
     }

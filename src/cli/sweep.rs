@@ -1,5 +1,6 @@
 //! `wraptree sweep`: the A/B/C × size-measure grid of the grouping phase's Cost on one scene, as a table,
-//! `sweep.csv`, heat maps and one `.rrd` with every setting side by side.
+//! `sweep.csv`, heat maps, one `.rrd` with every setting's series (`sweep.rrd`) and one with
+//! the trees of the best distinct settings side by side (`compare.rrd`).
 
 use anyhow::{Result, anyhow};
 use clap::Args;
@@ -7,7 +8,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use wraptree::grouping::{CostMeasure, PSet, Params};
 use wraptree::metrics::report::{SweepRrd, setting_name, sweep_table, write_sweep};
-use wraptree::metrics::sweep::{grid, sweep};
+use wraptree::metrics::sweep::{grid, sweep, write_sweep_comparison};
 use wraptree::output::output_dir;
 
 /// Arguments of `wraptree sweep`.
@@ -59,15 +60,21 @@ impl SweepCmd {
             ..Params::default()
         };
         let bar = super::bench::method_bar(settings.len(), &scene.name);
+        let mut runs = Vec::with_capacity(settings.len());
         let rows = sweep(&scene, &settings, &base, self.repeat, 1, |_, w, merges| {
             bar.set_message(setting_name(w));
             bar.inc(1);
+            runs.push(merges.to_vec());
             rrd.setting(w, merges)
         })?;
         bar.finish_and_clear();
         print!("{}", sweep_table(&rows));
         let mut written = write_sweep(&dir, &scene.name, &rows, self.force)?;
         written.push(rrd.finish(&rows)?);
+        let names: Vec<String> = settings.iter().map(setting_name).collect();
+        let compare = dir.join("compare");
+        let pair = write_sweep_comparison(&compare, &scene, &rows, &runs, &names, self.force)?;
+        written.extend(pair.into_iter().flatten());
         for p in written {
             eprintln!("wrote {}", p.display());
         }

@@ -7,10 +7,16 @@
 //! grid still lists what was asked for.
 
 use super::{Quality, quality};
-use crate::grouping::{self, CostMeasure, EventLog, Merge, Mode, Params, Weights};
+use crate::geom::Aabb;
+use crate::grouping::{self, CostMeasure, EventLog, Merge, Mode, Params, SubsetTree, Weights};
 use crate::query::{self, Bv, QueryCost, Workload};
+use crate::record::compare::{CompareRun, write_comparison};
 use crate::scene::Scene;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+/// Settings shown side by side in the sweep's comparison recording, at most.
+pub const COMPARED: usize = 6;
 
 /// One point of the grid: Cost weights and size measure.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -99,6 +105,70 @@ pub fn sweep(
         });
     }
     Ok(rows)
+}
+
+/// Which settings the comparison shows: one per distinct merge sequence (the first setting that
+/// gives it), the [`COMPARED`] lowest SAH first; indices into `rows` and `merges`.
+pub fn compared(rows: &[SweepRow], merges: &[Vec<Merge>]) -> Vec<usize> {
+    let mut distinct: Vec<usize> = Vec::new();
+    for k in 0..rows.len().min(merges.len()) {
+        if !distinct.iter().any(|&j| same_pairs(&merges[j], &merges[k])) {
+            distinct.push(k);
+        }
+    }
+    distinct.sort_by(|&x, &y| {
+        rows[x]
+            .quality
+            .sah
+            .total_cmp(&rows[y].quality.sah)
+            .then(x.cmp(&y))
+    });
+    distinct.truncate(COMPARED);
+    distinct
+}
+
+fn same_pairs(a: &[Merge], b: &[Merge]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x.a, x.b) == (y.a, y.b))
+}
+
+/// Writes `PREFIX.rrd` and `PREFIX.mcap`: the [`compared`] settings' runs side by side, the
+/// lowest SAH first as the reference ([`write_comparison`]); `names` label the settings.
+/// Replaces existing files only with `force`. `None` when fewer than two settings differ.
+pub fn write_sweep_comparison(
+    prefix: &Path,
+    scene: &Scene,
+    rows: &[SweepRow],
+    merges: &[Vec<Merge>],
+    names: &[String],
+    force: bool,
+) -> anyhow::Result<Option<[PathBuf; 2]>> {
+    let shown = compared(rows, merges);
+    if shown.len() < 2 {
+        return Ok(None);
+    }
+    let leaves: Vec<Aabb> = (0..scene.len()).map(|i| scene.prim_aabb(i)).collect();
+    let diameters: Vec<f64> = leaves.iter().map(Aabb::diameter).collect();
+    let trees = shown
+        .iter()
+        .map(|&k| {
+            let m: Vec<_> = merges[k]
+                .iter()
+                .map(|m| (m.a, m.b, m.aabb, m.diameter))
+                .collect();
+            SubsetTree::from_merges(leaves.clone(), diameters.clone(), &m)
+                .map_err(anyhow::Error::msg)
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let runs: Vec<CompareRun<'_>> = shown
+        .iter()
+        .zip(&trees)
+        .map(|(&k, t)| CompareRun {
+            label: format!("{} (SAH {:.4})", names[k], rows[k].quality.sah),
+            merges: &merges[k],
+            tree: Some(t),
+        })
+        .collect();
+    write_comparison(prefix, scene, &scene.name, &runs, force).map(Some)
 }
 
 #[cfg(test)]

@@ -6,6 +6,7 @@
 //! [`live`] streams the same run to viewers while it happens.
 
 pub mod background;
+pub mod compare;
 pub mod direct;
 pub mod live;
 pub mod mcap;

@@ -20,12 +20,14 @@ use crate::grouping::{
     self, Event, EventLog, Limits, Merge, Observer, Part, ResolvedParams, StopReason, Stopped,
     SubsetTree, Weights,
 };
+use crate::output::with_ext;
+use crate::record::compare::{CompareRun, divergence, write_comparison};
 use crate::record::mcap::{Recorded, read_recording};
 use crate::record::{RecordOptions, Written, record};
 use crate::refine::{self, Step};
 use crate::scene::{Loaded, load_bytes};
 use anyhow::{Context, Result, bail};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The magic bytes that open every Rerun `.rrd` stream, and the 8 bytes before the entry count
@@ -315,13 +317,87 @@ pub fn weights(rec: &Recorded, a: Option<f64>, b: Option<f64>, c: Option<f64>) -
     Ok(weights)
 }
 
-/// A re-weighted run: its recordings and, when it finished, its events.
+/// A re-weighted run: its recordings and, when it finished, its events and the comparison.
 #[derive(Debug)]
 pub struct Reweighted {
     /// The recordings of the re-weighted run.
     pub written: Written,
     /// The re-weighted run's events (`None` when it was stopped).
     pub log: Option<EventLog>,
+    /// The `.rrd` and `.mcap` with the recorded and the re-weighted run side by side (when it
+    /// finished).
+    pub comparison: Option<[PathBuf; 2]>,
+}
+
+/// How a run is named in a comparison: its weights, and its size measure unless it is the
+/// diameter.
+pub fn run_label(params: &ResolvedParams) -> String {
+    let w = params.weights;
+    let measure = match params.mode.cost {
+        grouping::CostMeasure::Diameter => String::new(),
+        other => format!(" {}", format!("{other:?}").to_lowercase()),
+    };
+    format!("A{} B{} C{}{measure}", w.a, w.b, w.c)
+}
+
+/// What [`compare`] wrote and found.
+#[derive(Debug)]
+pub struct Compared {
+    /// The comparison's `.rrd` and `.mcap`.
+    pub paths: [PathBuf; 2],
+    /// The runs' labels, in order.
+    pub labels: Vec<String>,
+    /// The first merge where the second run merges another pair than the first, if any.
+    pub divergence: Option<usize>,
+}
+
+/// Writes `PREFIX.rrd` and `PREFIX.mcap`, the runs of `replays` (recordings of one scene) side
+/// by side ([`write_comparison`]); `labels` name them. Replaces existing files only with
+/// `force`. Err: recordings of different scenes, or a write that fails (old files are kept).
+pub fn compare(
+    replays: &[&Replay],
+    labels: &[String],
+    prefix: &Path,
+    force: bool,
+) -> Result<Compared> {
+    let Some(first) = replays.first() else {
+        bail!("{}: nothing to compare", prefix.display());
+    };
+    for r in &replays[1..] {
+        if r.rec.metadata.get("scene_sha256") != first.rec.metadata.get("scene_sha256")
+            || r.rec.primitives != first.rec.primitives
+        {
+            bail!(
+                "{} and {} record different scenes (their scene hashes differ)",
+                first.rec.scene_file_name,
+                r.rec.scene_file_name
+            );
+        }
+    }
+    let trees = replays
+        .iter()
+        .map(|r| r.rec.complete.then(|| r.tree()).transpose())
+        .collect::<Result<Vec<_>>>()?;
+    let runs: Vec<CompareRun<'_>> = replays
+        .iter()
+        .zip(&trees)
+        .zip(labels)
+        .map(|((r, t), label)| CompareRun {
+            label: label.clone(),
+            merges: &r.rec.merges,
+            tree: t.as_ref(),
+        })
+        .collect();
+    let scene = &first.loaded.scene;
+    let paths = write_comparison(prefix, scene, &first.rec.scene_file_name, &runs, force)?;
+    let divergence = runs
+        .get(1)
+        .and_then(|b| divergence(runs[0].merges, b.merges));
+    Ok(Compared {
+        paths,
+        labels: labels.to_vec(),
+        divergence,
+    })
 }
 
 /// Re-runs the recording with `weights` (other parameters as recorded) and records the new run
@@ -343,5 +419,31 @@ pub fn reweight<O: Observer>(
         rerun(&replay.loaded, &params, &Limits::default(), None)
             .expect("an unlimited re-run is never stopped")
     });
-    Ok(Reweighted { written, log })
+    let comparison = match (&log, &written.grouping) {
+        (Some(log), Some(g)) => {
+            let old = replay.rec.complete.then(|| replay.tree()).transpose()?;
+            let runs = [
+                CompareRun {
+                    label: run_label(&replay.rec.params),
+                    merges: &replay.rec.merges,
+                    tree: old.as_ref(),
+                },
+                CompareRun {
+                    label: run_label(&params),
+                    merges: &log.merges,
+                    tree: Some(&g.tree),
+                },
+            ];
+            let scene = &replay.loaded.scene;
+            let name = &replay.rec.scene_file_name;
+            let prefix = with_ext(prefix, ".compare");
+            Some(write_comparison(&prefix, scene, name, &runs, opts.force)?)
+        }
+        _ => None,
+    };
+    Ok(Reweighted {
+        written,
+        log,
+        comparison,
+    })
 }

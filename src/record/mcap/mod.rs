@@ -13,12 +13,14 @@
 //! event, written at this detail or not) at k ms, then `/levels/<d>` at (events + 1 + d) ms and
 //! `/cover` at (events + 2 + depth max) ms. Sequence numbers count from 0 on each channel.
 
+mod compare;
 mod levels;
 pub mod messages;
 pub mod metadata;
 mod read;
 pub mod scene_msgs;
 
+pub use compare::write_comparison_mcap;
 pub use read::{Recorded, read_recording};
 
 use crate::events::{RefineParams, Step};

@@ -16,6 +16,7 @@
 
 mod blueprint;
 mod columns;
+mod compare;
 mod header;
 mod levels;
 mod mesh;
@@ -24,6 +25,7 @@ mod refine;
 mod series_file;
 mod sink;
 
+pub use compare::write_comparison_rrd;
 pub use series_file::SeriesFile;
 
 use std::path::{Path, PathBuf};
@@ -74,8 +76,15 @@ pub struct RrdRecorder {
     merges: u32,
     /// The primitives' mesh, kept for the levels written by `finish`.
     mesh: Option<PrimMesh>,
-    /// The thread sending the blueprint (joined before the file is closed).
-    blueprint: Option<std::thread::JoinHandle<Result<(), rerun::RecordingStreamError>>>,
+    /// The thread sending the first blueprint (joined before the file is closed).
+    blueprint: Option<std::thread::JoinHandle<anyhow::Result<()>>>,
+    /// What the layout is fitted to; its ranges are filled in as the merges come.
+    fit: blueprint::Fit,
+    /// Per plot of the merge series, the largest value so far ([`blueprint::Fit::ranges`]).
+    maxima: [f64; 4],
+    /// The recording id, the seed of the blueprints' ids.
+    id: String,
+    refined: bool,
     error: Option<anyhow::Error>,
 }
 
@@ -169,23 +178,26 @@ impl RrdRecorder {
         live: &Live,
     ) -> anyhow::Result<Self> {
         let scene = info.scene;
-        let builder =
-            rerun::RecordingStreamBuilder::new("wraptree").recording_id(header::recording_id(info));
+        let id = header::recording_id(info);
+        let builder = rerun::RecordingStreamBuilder::new("wraptree").recording_id(id.clone());
         let (rec, status) = sink::save(builder, path, live.rerun_sink())
             .map_err(|e| file_error(name, "cannot create the Rerun recording", e))?;
-        // The SDK builds a blueprint through a stream of its own (two threads, one chunk per
-        // view); a thread of ours does it while this one writes the header and the events.
-        let (layout, bp_rec) = (blueprint::layout(info.detail, refined), rec.clone());
-        let activation = rerun::blueprint::BlueprintActivation {
-            make_active: true,
-            make_default: true,
+        let bbox = scene.aabb();
+        let fit = blueprint::Fit {
+            eye: blueprint::framing(&bbox),
+            last_merge: scene.len().saturating_sub(2) as i64,
+            ranges: None,
+            refine_steps: 0,
         };
+        // The SDK builds a blueprint through a stream of its own (two threads); a thread of
+        // ours does it while this one writes the header and the events.
+        let (layout, bp_rec) = (blueprint::layout(info.detail, refined, &fit), rec.clone());
+        let seed = format!("{id}/start");
         let blueprint = std::thread::Builder::new()
             .name("rrd-blueprint".into())
-            .spawn(move || layout.send(&bp_rec, activation))
+            .spawn(move || layout.send(&bp_rec, &seed))
             .map_err(|e| file_error(name, "cannot start the blueprint thread", e))?;
 
-        let bbox = scene.aabb();
         let center = bbox.center();
         let origin = if center.iter().all(|c| c.is_finite()) {
             center
@@ -217,6 +229,10 @@ impl RrdRecorder {
             merges: 0,
             mesh: None,
             blueprint: Some(blueprint),
+            fit,
+            maxima: [0.0; 4],
+            id,
+            refined,
             error: None,
         };
         let mesh = PrimMesh::new(scene, &origin);
@@ -251,7 +267,9 @@ impl RrdRecorder {
             Event::Dormant { .. } => {}
             Event::RefineStart { params, sah } => {
                 let rec = self.rec.as_ref().ok_or_else(closed)?;
-                self.refine.start(rec, &params, sah, self.detail.merges())?;
+                let last_merge = i64::from(self.merges) - 1;
+                self.refine
+                    .start(rec, &params, sah, self.detail.merges(), last_merge)?;
             }
             Event::Refine(s) => self.refine_step(&s)?,
             Event::Part(p) => {
@@ -327,6 +345,17 @@ impl RrdRecorder {
             None
         };
         self.columns.push(m, self.dlimit, self.glimit, boxes);
+        let values = [
+            m.cost,
+            m.diameter.max(self.dlimit).max(self.glimit),
+            m.fill.max(m.balance),
+            f64::from(m.queue_len),
+        ];
+        for (max, v) in self.maxima.iter_mut().zip(values) {
+            if v.is_finite() {
+                *max = max.max(v);
+            }
+        }
         self.merges = m.step + 1;
         if self.columns.len() >= columns::BATCH {
             let rec = self.rec.as_ref().ok_or_else(closed)?;
@@ -400,11 +429,21 @@ impl RrdRecorder {
         self.write_tail(outcome).map_err(fail)?;
         if let Some(handle) = self.blueprint.take() {
             match handle.join() {
-                Ok(sent) => sent.map_err(|e| fail(e.into()))?,
+                Ok(sent) => sent.map_err(fail)?,
                 Err(_) => return Err(fail(anyhow!("the blueprint thread failed"))),
             }
         }
         let rec = self.rec.take().ok_or_else(closed).map_err(fail)?;
+        // The layout again, fitted to the whole run: the viewer switches to it once loaded.
+        let fit = blueprint::Fit {
+            last_merge: i64::from(self.merges.max(1)) - 1,
+            ranges: Some(self.maxima),
+            refine_steps: self.refine.steps(),
+            ..self.fit.clone()
+        };
+        blueprint::layout(self.detail, self.refined, &fit)
+            .send(&rec, &format!("{}/end", self.id))
+            .map_err(fail)?;
         sink::close(rec, &self.status, &path).map_err(fail)
     }
 

@@ -1,6 +1,7 @@
 //! The refinement's rows (`record --refine`), on their own `refine` timeline: tick 0 is the
 //! grouping's tree (its SAH), tick k the tree after the k-th kept step (a rebuilt treelet or a
-//! move).
+//! move). The same rows continue the `merge` timeline after the last merge (refine tick k at
+//! merge tick last + k), so the layout's `merge` cursor reaches them too.
 //!
 //! | entity | archetype | content |
 //! |---|---|---|
@@ -39,17 +40,22 @@ pub(super) struct RefineColumns {
     first_sah: f64,
     last_sah: f64,
     steps: u32,
+    /// The last merge's tick: refine tick k is `merge` tick `merge_offset + k`.
+    merge_offset: i64,
 }
 
 impl RefineColumns {
-    /// The start: styling (once), the starting SAH at tick 0 and a log line.
+    /// The start after the merge at tick `last_merge`: styling (once), the starting SAH at tick
+    /// 0 and a log line.
     pub(super) fn start(
         &mut self,
         rec: &RecordingStream,
         params: &RefineParams,
         sah: f64,
         boxes: bool,
+        last_merge: i64,
     ) -> anyhow::Result<()> {
+        self.merge_offset = last_merge;
         if !self.started {
             self.started = true;
             super::send_static(
@@ -96,6 +102,11 @@ impl RefineColumns {
         self.steps = s.step + 1;
     }
 
+    /// Kept steps so far.
+    pub(super) fn steps(&self) -> u32 {
+        self.steps
+    }
+
     /// Buffered steps.
     pub(super) fn len(&self) -> usize {
         self.tick.len()
@@ -125,13 +136,21 @@ impl RefineColumns {
         result
     }
 
+    /// The `refine` and `merge` time columns of refine ticks `ticks`.
+    fn times(&self, ticks: &[i64]) -> [TimeColumn; 2] {
+        let offset = self.merge_offset;
+        [
+            TimeColumn::new_sequence("refine", ticks.iter().copied()),
+            TimeColumn::new_sequence("merge", ticks.iter().map(|t| t + offset)),
+        ]
+    }
+
     fn send(&self, rec: &RecordingStream) -> anyhow::Result<()> {
         let k = self.tick.len();
         if k > 0 {
-            let tick = || TimeColumn::new_sequence("refine", self.tick.iter().copied());
             let scalars =
                 rerun::Scalars::new(self.sah.iter().copied()).columns(std::iter::repeat_n(1, k))?;
-            rec.send_columns(SAH, [tick()], scalars)?;
+            rec.send_columns(SAH, self.times(&self.tick), scalars)?;
             if !self.centers.is_empty() {
                 // Tick 0 (the start) has no move: the boxes belong to ticks 1.. of this batch.
                 let moved: Vec<i64> = self.tick.iter().copied().filter(|&t| t > 0).collect();
@@ -139,11 +158,7 @@ impl RefineColumns {
                     .with_centers(self.centers.iter().copied())
                     .with_half_sizes(self.halves.iter().copied())
                     .columns(std::iter::repeat_n(2, moved.len()))?;
-                rec.send_columns(
-                    "refine/move",
-                    [TimeColumn::new_sequence("refine", moved)],
-                    boxes,
-                )?;
+                rec.send_columns("refine/move", self.times(&moved), boxes)?;
             }
         }
         if !self.text.is_empty() {
@@ -152,14 +167,7 @@ impl RefineColumns {
                 .with_many_text(self.text.iter().map(String::as_str))
                 .with_many_level(std::iter::repeat_n(info, self.text.len()))
                 .columns_of_unit_batches()?;
-            rec.send_columns(
-                "log/refine",
-                [TimeColumn::new_sequence(
-                    "refine",
-                    self.text_ticks.iter().copied(),
-                )],
-                log,
-            )?;
+            rec.send_columns("log/refine", self.times(&self.text_ticks), log)?;
         }
         Ok(())
     }

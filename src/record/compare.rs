@@ -1,0 +1,85 @@
+//! Comparisons: several runs of one scene in one `.rrd` and one `.mcap`, side by side, so that
+//! two weightings can be told apart at a glance (what `replay --a/--b/--c`, `compare` and `sweep`
+//! write). The first run is the reference; each other run's first divergence from it is the
+//! first merge where it merges another pair. The `.rrd` is laid out with the runs' 3D views side
+//! by side ([`rrd::write_comparison_rrd`](crate::record::rrd::write_comparison_rrd)); the `.mcap`
+//! holds the same runs under `/runs/<i>/…` for Foxglove with `recordings/foxglove-compare-layout.json`
+//! ([`mcap::write_comparison_mcap`](crate::record::mcap::write_comparison_mcap)).
+
+use std::path::{Path, PathBuf};
+
+use crate::grouping::{Merge, SubsetTree};
+use crate::output::{Pending, with_ext};
+use crate::scene::Scene;
+
+/// One run of a comparison.
+pub struct CompareRun<'a> {
+    /// How the run is named in the views, plots and log (e.g. `A1 B1 C0`).
+    pub label: String,
+    /// Its merges, in order.
+    pub merges: &'a [Merge],
+    /// Its Subset Tree, when the run finished.
+    pub tree: Option<&'a SubsetTree>,
+}
+
+/// Index of the first merge where `a` and `b` merge a different pair (their Costs differ
+/// whenever their weights do, so only the bodies count), if any.
+pub fn divergence(a: &[Merge], b: &[Merge]) -> Option<usize> {
+    let same = |x: &Merge, y: &Merge| x.a == y.a && x.b == y.b && x.new == y.new;
+    (0..a.len().max(b.len())).find(|&i| match (a.get(i), b.get(i)) {
+        (Some(x), Some(y)) => !same(x, y),
+        _ => true,
+    })
+}
+
+/// Writes `PREFIX.rrd` and `PREFIX.mcap`, the comparison of `runs` (at least two) over `scene`
+/// (named `scene_name`). Each file appears whole or not at all; existing files are replaced
+/// only with `force`. Returns both paths.
+pub fn write_comparison(
+    prefix: &Path,
+    scene: &Scene,
+    scene_name: &str,
+    runs: &[CompareRun<'_>],
+    force: bool,
+) -> anyhow::Result<[PathBuf; 2]> {
+    let (rrd, mcap) = (with_ext(prefix, ".rrd"), with_ext(prefix, ".mcap"));
+    let rrd_file = Pending::create(&rrd, force)?;
+    let mcap_file = Pending::create(&mcap, force)?;
+    super::rrd::write_comparison_rrd(rrd_file.path(), &rrd, scene, scene_name, runs)?;
+    super::mcap::write_comparison_mcap(&mcap_file, scene, scene_name, runs)?;
+    Ok([rrd_file.commit()?, mcap_file.commit()?])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{Aabb, P3};
+
+    fn merge(step: u32, a: u32, b: u32) -> Merge {
+        Merge {
+            step,
+            round: 0,
+            a,
+            b,
+            new: 4 + step,
+            aabb: Aabb::from_points(&[P3::origin()]),
+            diameter: 1.0,
+            fill: 1.0,
+            balance: 1.0,
+            cost: 1.0,
+            queue_len: 0,
+            active: true,
+        }
+    }
+
+    #[test]
+    fn divergence_is_the_first_different_pair() {
+        let a = [merge(0, 0, 1), merge(1, 2, 3), merge(2, 4, 5)];
+        let b = [merge(0, 0, 1), merge(1, 1, 2), merge(2, 3, 4)];
+        assert_eq!(divergence(&a, &a), None);
+        assert_eq!(divergence(&a, &b), Some(1));
+        assert_eq!(divergence(&a, &a[..2]), Some(2));
+        let costlier = [Merge { cost: 9.0, ..a[0] }, a[1], a[2]];
+        assert_eq!(divergence(&a, &costlier), None, "only the pairs count");
+    }
+}
