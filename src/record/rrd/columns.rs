@@ -140,6 +140,12 @@ impl Columns {
     /// Sends every buffered merge and empties the buffers.
     pub(super) fn flush(&mut self, rec: &RecordingStream) -> anyhow::Result<()> {
         let result = self.send(rec);
+        self.clear();
+        result
+    }
+
+    /// Empties every buffer.
+    fn clear(&mut self) {
         self.step.clear();
         self.round.clear();
         self.series.iter_mut().for_each(Vec::clear);
@@ -152,11 +158,32 @@ impl Columns {
         self.active_rows.clear();
         self.active_centers.clear();
         self.active_halves.clear();
-        result
     }
 
     fn send(&mut self, rec: &RecordingStream) -> anyhow::Result<()> {
         self.send_rounds(rec)?;
+        self.send_merges(rec)
+    }
+
+    /// Sends the buffered text lines and active sets now, and returns the buffered merges' rows
+    /// as a batch to send later with [`Columns::send_held`]; empties the buffers.
+    pub(super) fn flush_rounds(&mut self, rec: &RecordingStream) -> anyhow::Result<Columns> {
+        let sent = self.send_rounds(rec);
+        let held = Columns {
+            step: std::mem::take(&mut self.step),
+            round: std::mem::take(&mut self.round),
+            series: std::mem::take(&mut self.series),
+            box_ticks: std::mem::take(&mut self.box_ticks),
+            box_centers: std::mem::take(&mut self.box_centers),
+            box_halves: std::mem::take(&mut self.box_halves),
+            ..Columns::default()
+        };
+        self.clear();
+        sent.map(|()| held)
+    }
+
+    /// Sends a batch of merges held back by [`Columns::flush_rounds`].
+    pub(super) fn send_held(&self, rec: &RecordingStream) -> anyhow::Result<()> {
         self.send_merges(rec)
     }
 

@@ -9,8 +9,12 @@
 //!   temporal rows go through `send_columns`, which adds no `log_time`/`log_tick`.
 //! - Positions are `f32` relative to the scene's AABB centre, moved back by a static
 //!   `Transform3D`, so that scenes far from the origin keep their precision.
-//! - Per-merge rows are sent as columns every `columns::BATCH` merges: memory stays bounded and
-//!   an interrupted run is mostly on its way to the file. A stopped run has no levels and the
+//! - Per-merge rows are buffered as columns, `columns::BATCH` merges per batch. Written to a
+//!   file alone (no live viewer) a run of at most [`HOLD_MAX`] primitives keeps its batches of
+//!   per-merge series and boxes until the end and sends them after the tree levels, so that a
+//!   viewer reading the file shows the round log and the levels first and the plots fill
+//!   afterwards; the round log and active sets go out with every batch. Larger or live runs send
+//!   each batch as it fills (memory stays bounded, the live view follows the run). A stopped run has no levels and the
 //!   property `wraptree_outcome`. The recording id comes from the scene's SHA-256 and the
 //!   parameters (not the detail), so recordings of one run open as one.
 
@@ -48,6 +52,9 @@ const INFO: &str = rerun::TextLogLevel::INFO;
 const SCENE_GREY: u32 = 0xC8C8C8FF;
 /// Blue of the active bodies' boxes.
 const ACTIVE_BLUE: u32 = 0x3C78D8A0;
+/// Runs of at most this many primitives, written to a file alone, hold their per-merge batches
+/// until the levels are written (about 72 bytes per merge held).
+pub const HOLD_MAX: usize = 2_000_000;
 
 /// Records a grouping run to a Rerun `.rrd` file, laid out as `docs/recordings.md` lists.
 pub struct RrdRecorder {
@@ -65,6 +72,8 @@ pub struct RrdRecorder {
     /// Box of every body so far, relative to `origin` (only when per-merge geometry is written).
     boxes: Vec<BoxF32>,
     columns: Columns,
+    /// The per-merge batches held back until the levels are written ([`HOLD_MAX`]), when held.
+    held: Option<Vec<Columns>>,
     /// The refinement's rows (`record --refine`).
     refine: refine::RefineColumns,
     /// The part lines, small chunks summarised.
@@ -180,7 +189,9 @@ impl RrdRecorder {
         let scene = info.scene;
         let id = header::recording_id(info);
         let builder = rerun::RecordingStreamBuilder::new("wraptree").recording_id(id.clone());
-        let (rec, status) = sink::save(builder, path, live.rerun_sink())
+        let live_sink = live.rerun_sink();
+        let hold = live_sink.is_none() && scene.len() <= HOLD_MAX;
+        let (rec, status) = sink::save(builder, path, live_sink)
             .map_err(|e| file_error(name, "cannot create the Rerun recording", e))?;
         let bbox = scene.aabb();
         let fit = blueprint::Fit {
@@ -221,6 +232,7 @@ impl RrdRecorder {
             origin,
             boxes,
             columns: Columns::default(),
+            held: hold.then(Vec::new),
             refine: refine::RefineColumns::default(),
             parts: parts::PartLines::default(),
             round: 0,
@@ -358,8 +370,17 @@ impl RrdRecorder {
         }
         self.merges = m.step + 1;
         if self.columns.len() >= columns::BATCH {
-            let rec = self.rec.as_ref().ok_or_else(closed)?;
-            self.columns.flush(rec)?;
+            self.flush_columns()?;
+        }
+        Ok(())
+    }
+
+    /// Sends the buffered columns, or with held batches the rounds' now and the merges' later.
+    fn flush_columns(&mut self) -> anyhow::Result<()> {
+        let rec = self.rec.as_ref().ok_or_else(closed)?;
+        match &mut self.held {
+            Some(held) => held.push(self.columns.flush_rounds(rec)?),
+            None => self.columns.flush(rec)?,
         }
         Ok(())
     }
@@ -458,8 +479,8 @@ impl RrdRecorder {
         if outcome.grouping.is_none() {
             self.mark_incomplete(outcome)?;
         }
+        self.flush_columns()?;
         let rec = self.rec.as_ref().ok_or_else(closed)?;
-        self.columns.flush(rec)?;
         self.refine.finish(rec)?;
         if let (Some(mesh), Some(grouping), Some(spheres)) =
             (&self.mesh, outcome.grouping, outcome.spheres)
@@ -469,6 +490,9 @@ impl RrdRecorder {
             if let Some(cover) = &outcome.cover {
                 levels::log_cover(rec, tree, cover, &self.origin)?;
             }
+        }
+        for batch in self.held.take().unwrap_or_default() {
+            batch.send_held(rec)?;
         }
         Ok(())
     }
