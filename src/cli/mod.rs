@@ -4,6 +4,7 @@ mod bench;
 mod bench_partitioned;
 mod cover;
 mod group;
+mod progress;
 mod record;
 mod replay;
 mod scene_cmd;
@@ -259,11 +260,11 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Record(c) => c.run(),
         Command::Replay(c) => c.run(),
         Command::Scene(c) => c.run(),
-        Command::Bench(c) => c.run(),
-        Command::Sweep(c) => c.run(),
-        Command::Snapshot(c) => c.run(),
-        Command::Wrap(c) => c.run(),
-        Command::Cover(c) => c.run(),
-        Command::Stress(c) => c.run(),
+        Command::Bench(c) => progress::or_stopped("bench", c.run()),
+        Command::Sweep(c) => progress::or_stopped("sweep", c.run()),
+        Command::Snapshot(c) => progress::or_stopped("snapshot", c.run()),
+        Command::Wrap(c) => progress::or_stopped("wrap", c.run()),
+        Command::Cover(c) => progress::or_stopped("cover", c.run()),
+        Command::Stress(c) => progress::or_stopped("stress", c.run()),
     }
 }
