@@ -9,6 +9,7 @@ use std::time::Duration;
 use wraptree::metrics::report::stress_table;
 use wraptree::metrics::stress::{self, Step, StressOptions, check_outputs};
 use wraptree::output::output_dir;
+use wraptree::stop::Stop;
 
 /// Arguments of `wraptree stress`.
 #[derive(Args, Debug)]
@@ -47,7 +48,8 @@ impl StressCmd {
             budget: Duration::from_secs_f64(self.budget),
             split: self.split,
         };
-        let report = stress::run(&opts, &mut |step| match step {
+        let stop = Stop::on_signals();
+        let report = stress::run(&opts, &stop, &mut |step| match step {
             Step::Scene(s) => eprintln!("stress: {} ({} primitives)", s.name, s.len()),
             Step::Sweep(s) => eprintln!("stress: sweep {} ({} primitives)", s.name, s.len()),
         })?;

@@ -83,7 +83,7 @@ pub struct Options {
     pub wrappers: Vec<Wrapper>,
     /// Grouping parameters.
     pub params: Params,
-    /// Timed repetitions of each build (the best is kept).
+    /// Timed repetitions of each build (the best is kept; see [`REPEAT_BUDGET_S`]).
     pub repeat: u32,
     /// Tightness is measured only up to this many primitives.
     pub tightness_max_n: usize,
@@ -139,10 +139,21 @@ pub struct Row {
     pub query: Option<QueryCost>,
 }
 
+/// Seconds after which a case is not repeated further: a run this long is timed well enough
+/// by itself, and repeating it would multiply the time of a bench.
+pub const REPEAT_BUDGET_S: f64 = 0.1;
+
+/// The output and time of the fastest of up to `repeat` runs of `f` (at least one), repeated
+/// only while the runs so far took less than [`REPEAT_BUDGET_S`] in total.
 fn best_of<T>(repeat: u32, mut f: impl FnMut() -> (T, f64)) -> (T, f64) {
     let (mut out, mut best) = f();
+    let mut spent = best;
     for _ in 1..repeat.max(1) {
+        if spent >= REPEAT_BUDGET_S {
+            break;
+        }
         let (o, s) = f();
+        spent += s;
         if s < best {
             (out, best) = (o, s);
         }
