@@ -48,20 +48,17 @@ fn bench_stops_at_the_next_step_and_writes_nothing() {
     let e = r.expect_err("a requested stop ends the run");
     assert!(is_interrupted(&e), "{e}");
     // Stopped right after the first tightness: no query, no second method.
-    assert!(matches!(steps.last(), Some(Step::Tightness(Method::Grouping, _))));
+    assert!(matches!(
+        steps.last(),
+        Some(Step::Tightness(Method::Grouping, _))
+    ));
     assert!(!steps.contains(&Step::Build(Method::MedianSplit)));
     // The command writes only finished rows: the previous file stays as it was.
-    assert_eq!(
-        std::fs::read_to_string(&csv).unwrap(),
-        "previous results\n"
-    );
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), "previous results\n");
     // A finished run replaces it.
     let rows = evaluate(&scene(), &options(4), &Stop::new(), &mut |_| {}).unwrap();
     write_bench(dir.path(), &rows, true).unwrap();
-    assert_ne!(
-        std::fs::read_to_string(&csv).unwrap(),
-        "previous results\n"
-    );
+    assert_ne!(std::fs::read_to_string(&csv).unwrap(), "previous results\n");
 }
 
 #[test]
@@ -76,7 +73,7 @@ fn stress_stops_after_the_case_at_hand_without_a_report() {
         scenes += 1;
         stop.request();
     });
-    let e = r.err().expect("a requested stop ends the run");
+    let e = r.expect_err("a requested stop ends the run");
     assert!(is_interrupted(&e), "{e}");
     assert_eq!(scenes, 1, "no scene after the stop");
 }
@@ -97,6 +94,9 @@ fn sampled_tightness_is_deterministic_and_near_every_node() {
         let (s, f) = (row.tightness.unwrap(), every.tightness.unwrap());
         assert!(f > 0.0);
         let case = format!("{} {}", row.method, row.wrapper);
-        assert!((s - f).abs() <= 0.15 * f, "{case}: sampled {s}, every node {f}");
+        assert!(
+            (s - f).abs() <= 0.15 * f,
+            "{case}: sampled {s}, every node {f}"
+        );
     }
 }

@@ -2,14 +2,13 @@
 //! the targets table against obvhs PLOC and parry Binned measured in the same run, and (with
 //! `--record`) what recording costs ([`wraptree::metrics::bench`]).
 
+use super::progress;
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use wraptree::metrics::bench::{record_costs, target_rows, target_scenes};
-use super::progress;
 use wraptree::metrics::compare::{Options, Step, Wrapper, evaluate};
-use wraptree::stop::Stop;
 use wraptree::metrics::report::{
     bench_table, record_cost_header, record_cost_line, record_cost_notes, refine_table,
     speedup_table, target_line, targets_header, targets_notes, write_bench,
@@ -18,6 +17,7 @@ use wraptree::output::output_dir;
 use wraptree::peers::Method;
 use wraptree::scene::generate;
 use wraptree::scene::spec::scene_spec;
+use wraptree::stop::Stop;
 
 /// Arguments of `wraptree bench`.
 #[derive(Args, Debug)]

@@ -42,7 +42,8 @@ impl WrapCmd {
         let start = Instant::now();
         let stop = Stop::on_signals();
         let resolved = params.resolve(scene);
-        let g = grouping::group_until(scene, &resolved, (), stop.flag()).map_err(|_| Interrupted)?;
+        let g =
+            grouping::group_until(scene, &resolved, (), stop.flag()).map_err(|_| Interrupted)?;
         let group_seconds = start.elapsed().as_secs_f64();
         let tree = &g.tree;
         let samples = self.samples as usize;
