@@ -114,9 +114,12 @@ impl BenchCmd {
         let mut rows = Vec::new();
         for scene in &scenes {
             let bar = progress::bar(opts.methods.len() as u64, &scene.name);
+            let mut started = 0;
             let r = evaluate(scene, &opts, &stop, &mut |step| {
                 if let Step::Build(_) = step {
-                    bar.inc(1);
+                    // Methods finished so far.
+                    bar.set_position(started);
+                    started += 1;
                 }
                 bar.set_message(step.to_string());
             });

@@ -56,7 +56,10 @@ impl CoverCmd {
             bail!("give --tolerance or --budget");
         };
         let stop = wraptree::stop::Stop::on_signals();
-        let out = cover_scene(scene, &params, limit, &self.kinds)?;
+        let bar = super::progress::spinner("cover");
+        let out = cover_scene(scene, &params, limit, &self.kinds);
+        bar.finish_and_clear();
+        let out = out?;
         stop.check()?;
         let json = serde_json::to_vec_pretty(&out).context("cover: cannot serialise")?;
         write_atomic(&json_path, &json, self.force)?;

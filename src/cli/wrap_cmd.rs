@@ -42,12 +42,16 @@ impl WrapCmd {
         let start = Instant::now();
         let stop = Stop::on_signals();
         let resolved = params.resolve(scene);
+        let bar = super::progress::spinner("wrap");
+        bar.set_message("grouping");
         let g =
             grouping::group_until(scene, &resolved, (), stop.flag()).map_err(|_| Interrupted)?;
         let group_seconds = start.elapsed().as_secs_f64();
         let tree = &g.tree;
         let samples = self.samples as usize;
+        bar.set_message("wrappers and their tightness");
         let reports = report(tree, scene, &self.wrapper, self.sphere_method, samples);
+        bar.finish_and_clear();
         stop.check()?;
         let (m, t) = (self.sphere_method, group_seconds);
         if self.json {
