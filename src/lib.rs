@@ -46,4 +46,5 @@ pub mod refine;
 pub mod render;
 pub mod replay;
 pub mod scene;
+pub mod stop;
 pub mod wrap;

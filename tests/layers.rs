@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 /// The layers of `src/`, bottom first; modules on one line may not refer to each other.
 const LAYERS: &[&[&str]] = &[
-    &["geom", "output"],
+    &["geom", "output", "stop"],
     &["scene"],
     &["events"],
     &["grouping"],

@@ -2,12 +2,13 @@
 //! the targets table against obvhs PLOC and parry Binned measured in the same run, and (with
 //! `--record`) what recording costs ([`wraptree::metrics::bench`]).
 
-use anyhow::{Result, anyhow};
+use super::progress;
+use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use wraptree::metrics::bench::{record_costs, target_rows, target_scenes};
-use wraptree::metrics::compare::{Options, Wrapper, evaluate};
+use wraptree::metrics::compare::{Options, Step, Wrapper, evaluate};
 use wraptree::metrics::report::{
     bench_table, record_cost_header, record_cost_line, record_cost_notes, refine_table,
     speedup_table, target_line, targets_header, targets_notes, write_bench,
@@ -16,6 +17,7 @@ use wraptree::output::output_dir;
 use wraptree::peers::Method;
 use wraptree::scene::generate;
 use wraptree::scene::spec::scene_spec;
+use wraptree::stop::Stop;
 
 /// Arguments of `wraptree bench`.
 #[derive(Args, Debug)]
@@ -37,9 +39,13 @@ pub struct BenchCmd {
     /// Wrappers to build on each hierarchy (comma list) [default: all].
     #[arg(long, value_delimiter = ',', value_parser = Wrapper::parse)]
     wrappers: Vec<Wrapper>,
-    /// Tightness is measured up to this many primitives (it costs more than the builds).
-    #[arg(long, default_value_t = 50_000)]
+    /// Tightness is measured up to this many primitives.
+    #[arg(long, default_value_t = 1_000_000)]
     tightness_max_n: usize,
+    /// Interior nodes per tree depth whose tightness is measured, drawn by a seeded hash (0:
+    /// every node, exact queries: slow on large scenes).
+    #[arg(long, value_name = "N", default_value_t = wraptree::wrap::NODES_PER_DEPTH)]
+    tightness_nodes: usize,
     /// Largest soup size in the targets table (10^4, 10^5, 10^6 by default; 10000000 adds a
     /// 10^7 soup to the partitioned table).
     #[arg(long, default_value_t = 1_000_000)]
@@ -48,7 +54,8 @@ pub struct BenchCmd {
     /// scans, obvhs PLOC) [default: all cores]; the partitioned table sets 1 and 2 itself.
     #[arg(long, value_name = "N")]
     threads: Option<usize>,
-    /// Timed repetitions per case (the best is reported).
+    /// Timed repetitions per case (the best is reported); with SCENEs a case is repeated only
+    /// while its runs took under 0.1 s in all.
     #[arg(long, default_value_t = 3)]
     repeat: u32,
     /// Instead: measure recording (time and file sizes per --detail) on the 3,130- and
@@ -93,6 +100,7 @@ impl BenchCmd {
         let mut opts = Options {
             repeat: self.repeat,
             tightness_max_n: self.tightness_max_n,
+            tightness_nodes: self.tightness_nodes,
             ..Options::default()
         };
         if !self.methods.is_empty() {
@@ -102,18 +110,25 @@ impl BenchCmd {
             opts.wrappers = self.wrappers.clone();
         }
         let output = output_dir(self.output.as_deref(), "recordings/bench")?;
+        let stop = Stop::on_signals();
         let mut rows = Vec::new();
         for scene in &scenes {
-            let bar = method_bar(opts.methods.len(), &scene.name);
-            let r = evaluate(scene, &opts, |m| {
-                bar.set_message(m.name());
-                bar.inc(1);
-            })
-            .map_err(|e| anyhow!(e))?;
+            let bar = progress::bar(opts.methods.len() as u64, &scene.name);
+            let mut started = 0;
+            let r = evaluate(scene, &opts, &stop, &mut |step| {
+                if let Step::Build(_) = step {
+                    // Methods finished so far.
+                    bar.set_position(started);
+                    started += 1;
+                }
+                bar.set_message(step.to_string());
+            });
             bar.finish_and_clear();
+            let r = r?;
             print!("{}", bench_table(&r.iter().collect::<Vec<_>>()));
             rows.extend(r);
         }
+        stop.check()?;
         for p in write_bench(&output, &rows, self.force)? {
             eprintln!("wrote {}", p.display());
         }
@@ -124,10 +139,15 @@ impl BenchCmd {
     fn run_targets(&self) -> Result<ExitCode> {
         let mut cases = target_scenes(self.max_soup)?;
         print!("{}", targets_header());
+        let stop = Stop::on_signals();
         let mut refined = Vec::new();
         let mut sped_up = Vec::new();
         for scene in &cases {
-            let (r, refine, speedups) = target_rows(scene, self.repeat)?;
+            stop.check()?;
+            let bar = progress::spinner(&format!("targets: {}", scene.name));
+            let rows = target_rows(scene, self.repeat);
+            bar.finish_and_clear();
+            let (r, refine, speedups) = rows?;
             refined.push(refine);
             sped_up.extend(speedups);
             print!("{}", target_line(&r));
@@ -167,20 +187,4 @@ impl BenchCmd {
         print!("{}", record_cost_notes(&fixed));
         Ok(ExitCode::SUCCESS)
     }
-}
-
-/// A bar over methods on stderr, hidden when stderr is not a terminal.
-pub(super) fn method_bar(len: usize, scene: &str) -> indicatif::ProgressBar {
-    use std::io::IsTerminal;
-    if !std::io::stderr().is_terminal() {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = indicatif::ProgressBar::new(len as u64);
-    if let Ok(style) =
-        indicatif::ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} {msg} {elapsed}")
-    {
-        bar.set_style(style);
-    }
-    bar.set_prefix(scene.to_string());
-    bar
 }

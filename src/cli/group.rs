@@ -7,11 +7,11 @@ use std::process::ExitCode;
 use std::time::Instant;
 use wraptree::grouping::{self, Event, Limits, Observer, StopReason};
 use wraptree::metrics::report::{group_json, group_text};
+use wraptree::stop::Stop;
 
 /// Exit code of a run stopped by `--max-seconds` or `--max-pairs`.
 pub const EXIT_BUDGET: u8 = 3;
-/// Exit code of a run stopped by Ctrl-C or SIGTERM (128 + SIGINT, as shells report it).
-pub const EXIT_INTERRUPTED: u8 = 130;
+pub use super::progress::EXIT_INTERRUPTED;
 
 /// Limits on the grouping phase, for runs that could run away (huge `--glimit`, dense soups).
 #[derive(Args, Debug, Clone, Copy, Default)]
@@ -102,7 +102,9 @@ impl GroupCmd {
         let start = Instant::now();
         let resolved = params.resolve(scene);
         let progress = Progress::for_merges(scene.len() as u64);
-        let g = match grouping::group_within(scene, &resolved, progress, &limits.budget(None)) {
+        let stop = Stop::on_signals();
+        let budget = limits.budget(Some(stop.flag()));
+        let g = match grouping::group_within(scene, &resolved, progress, &budget) {
             Ok(g) => g,
             Err(s) => {
                 let file = self.scene.scene.display();

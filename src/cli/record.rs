@@ -16,6 +16,7 @@ use wraptree::record::mcap::Compression;
 use wraptree::record::{Detail, RecordOptions, Written, record};
 use wraptree::refine::RefineParams;
 use wraptree::scene::Scene;
+use wraptree::stop::Stop;
 use wraptree::wrap::WrapperKind;
 use wraptree::wrap::cover::solve::{CoverLimit, Tolerance};
 
@@ -180,16 +181,9 @@ pub fn exit_code(w: &Written) -> ExitCode {
     }
 }
 
-/// A flag set by the first Ctrl-C or SIGTERM (installed once per process).
+/// The flag set by the first Ctrl-C or SIGTERM ([`Stop::on_signals`]).
 pub fn stop_flag() -> Arc<AtomicBool> {
-    static FLAG: std::sync::OnceLock<Arc<AtomicBool>> = std::sync::OnceLock::new();
-    FLAG.get_or_init(|| {
-        let f = Arc::new(AtomicBool::new(false));
-        let g = f.clone();
-        let _ = ctrlc::set_handler(move || g.store(true, Ordering::Relaxed));
-        f
-    })
-    .clone()
+    Stop::on_signals().shared()
 }
 
 /// Prints what was written: the run (or why it stopped, on stderr) and the files.

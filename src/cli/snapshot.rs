@@ -77,8 +77,10 @@ fn load(cmd: &SnapshotCmd) -> Result<(Scene, ResolvedParams, Option<Vec<Merge>>)
 impl SnapshotCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
+        let stop = wraptree::stop::Stop::on_signals();
         let (scene, params, recorded) = load(&self)?;
         let (g, differs) = regroup(&scene, &params, recorded.as_deref())?;
+        stop.check()?;
         if differs {
             eprintln!(
                 "warning: re-grouping the recorded scene differs from the recording; drawing the re-run"

@@ -59,9 +59,11 @@ impl SweepCmd {
             pset: self.pset,
             ..Params::default()
         };
-        let bar = super::bench::method_bar(settings.len(), &scene.name);
+        let bar = super::progress::bar(settings.len() as u64, &scene.name);
+        let stop = wraptree::stop::Stop::on_signals();
         let mut runs = Vec::with_capacity(settings.len());
         let rows = sweep(&scene, &settings, &base, self.repeat, 1, |_, w, merges| {
+            stop.check()?;
             bar.set_message(setting_name(w));
             bar.inc(1);
             runs.push(merges.to_vec());

@@ -8,6 +8,7 @@ use clap::Args;
 use std::process::ExitCode;
 use std::time::Instant;
 use wraptree::grouping;
+use wraptree::stop::{Interrupted, Stop};
 use wraptree::wrap::report::{report, report_json, report_text};
 use wraptree::wrap::{DEFAULT_SAMPLES, SphereMethod, WrapperKind};
 
@@ -39,11 +40,19 @@ impl WrapCmd {
         let params = self.group.params()?;
         let scene = &loaded.scene;
         let start = Instant::now();
-        let g = grouping::group(scene, &params, ());
+        let stop = Stop::on_signals();
+        let resolved = params.resolve(scene);
+        let bar = super::progress::spinner("wrap");
+        bar.set_message("grouping");
+        let g =
+            grouping::group_until(scene, &resolved, (), stop.flag()).map_err(|_| Interrupted)?;
         let group_seconds = start.elapsed().as_secs_f64();
         let tree = &g.tree;
         let samples = self.samples as usize;
+        bar.set_message("wrappers and their tightness");
         let reports = report(tree, scene, &self.wrapper, self.sphere_method, samples);
+        bar.finish_and_clear();
+        stop.check()?;
         let (m, t) = (self.sphere_method, group_seconds);
         if self.json {
             println!("{}", report_json(scene, tree, t, m, samples, &reports));

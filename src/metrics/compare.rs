@@ -5,8 +5,9 @@
 //! [`Wrapper`] is built on it and timed. Rows carry:
 //! - the hierarchy's [`Quality`] (same for every wrapper on it);
 //! - the wrapper's tightness: mean over interior nodes of the sampled surface-to-geometry
-//!   distance divided by the node box's diagonal ([`crate::wrap::node_tightness`]), skipped
-//!   above [`Options::tightness_max_n`] primitives because it costs far more than the build;
+//!   distance divided by the node box's diagonal, estimated from at most
+//!   [`Options::tightness_nodes`] nodes per depth ([`crate::wrap::DepthSample`]), skipped above
+//!   [`Options::tightness_max_n`] primitives;
 //! - for box and sphere wrappers, the cost of the standard query workload
 //!   ([`crate::query::Workload::standard`]) with those wrappers as bounding volumes.
 
@@ -15,9 +16,12 @@ use crate::grouping::{Params, SubsetTree};
 use crate::peers::{self, Method};
 use crate::query::{self, Bv, QueryCost, Workload};
 use crate::scene::Scene;
+use crate::stop::Stop;
 use crate::wrap::{
-    Hull, Sphere, SphereMethod, WrapperTree, hull_tree, node_tightness, obb_tree, sphere_tree,
+    DepthSample, Hull, MAX_VISITS, NODES_PER_DEPTH, Sphere, SphereMethod, WrapperTree, hull_tree,
+    nodes_tightness, obb_tree, sphere_tree,
 };
+use anyhow::{Result, anyhow};
 use std::time::Instant;
 
 /// A wrapper built on a hierarchy for the comparison.
@@ -79,10 +83,13 @@ pub struct Options {
     pub wrappers: Vec<Wrapper>,
     /// Grouping parameters.
     pub params: Params,
-    /// Timed repetitions of each build (the best is kept).
+    /// Timed repetitions of each build (the best is kept; see [`REPEAT_BUDGET_S`]).
     pub repeat: u32,
     /// Tightness is measured only up to this many primitives.
     pub tightness_max_n: usize,
+    /// Interior nodes per depth whose tightness is measured (0: every node, each distance
+    /// query exact).
+    pub tightness_nodes: usize,
     /// Surface samples per wrapper for tightness.
     pub samples: usize,
     /// Seed of the query workload.
@@ -96,7 +103,8 @@ impl Default for Options {
             wrappers: Wrapper::ALL.to_vec(),
             params: Params::default(),
             repeat: 3,
-            tightness_max_n: 50_000,
+            tightness_max_n: 1_000_000,
+            tightness_nodes: NODES_PER_DEPTH,
             samples: 16,
             seed: 1,
         }
@@ -131,10 +139,21 @@ pub struct Row {
     pub query: Option<QueryCost>,
 }
 
+/// Seconds after which a case is not repeated further: a run this long is timed well enough
+/// by itself, and repeating it would multiply the time of a bench.
+pub const REPEAT_BUDGET_S: f64 = 0.1;
+
+/// The output and time of the fastest of up to `repeat` runs of `f` (at least one), repeated
+/// only while the runs so far took less than [`REPEAT_BUDGET_S`] in total.
 fn best_of<T>(repeat: u32, mut f: impl FnMut() -> (T, f64)) -> (T, f64) {
     let (mut out, mut best) = f();
+    let mut spent = best;
     for _ in 1..repeat.max(1) {
+        if spent >= REPEAT_BUDGET_S {
+            break;
+        }
         let (o, s) = f();
+        spent += s;
         if s < best {
             (out, best) = (o, s);
         }
@@ -149,59 +168,99 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
 }
 
 /// Mean over interior nodes of each node's sampled error over its box diagonal, and the
-/// same per level (the cut at each depth, its interior nodes only; 0 for a cut of leaves).
+/// same per level (the cut at each depth, its interior nodes only; 0 for a cut of leaves),
+/// from at most `per_depth` nodes per depth (0: every node, exact queries).
 fn tightness(
     tree: &SubsetTree,
     scene: &Scene,
     w: WrapperTree<'_>,
     hulls: &[Hull],
-    k: usize,
+    (k, per_depth, seed): (usize, usize, u64),
 ) -> (f64, Vec<f64>) {
-    let stats = node_tightness(tree, scene, w, hulls, k);
-    let n = tree.leaves();
-    let rel = |x: usize| {
-        let d = tree.aabb[x].diameter();
-        (d > 0.0).then(|| stats[x].error / d)
+    let (per_depth, max_visits) = match per_depth {
+        0 => (usize::MAX, usize::MAX),
+        m => (m, MAX_VISITS),
     };
-    let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len().max(1) as f64;
-    let all = mean((n..tree.len()).filter_map(rel).collect());
-    let per_level = (0..=tree.depth_max())
-        .map(|d| {
-            let cut = tree.level(d);
-            mean(
-                cut.into_iter()
-                    .filter(|&x| x as usize >= n)
-                    .filter_map(|x| rel(x as usize))
-                    .collect(),
-            )
+    let sample = DepthSample::new(tree, per_depth, seed);
+    let nodes = sample.flat();
+    let stats = nodes_tightness(tree, scene, w, hulls, k, &nodes, max_visits);
+    let rel: Vec<Option<f64>> = nodes
+        .iter()
+        .zip(&stats)
+        .map(|(&x, s)| {
+            let d = tree.aabb[x as usize].diameter();
+            (d > 0.0).then(|| s.error / d)
         })
         .collect();
+    let (all, per_level) = sample.means(&rel);
+    // Depths below the deepest interior node are cuts of leaves.
+    let levels = tree.depth_max() as usize + 1;
+    let mut per_level = per_level;
+    per_level.resize(levels, 0.0);
     (all, per_level)
 }
 
-/// Runs every method × wrapper of `opts` on `scene`, calling `progress` before each method.
+/// What `bench` is measuring, for progress reports.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Step {
+    /// Building a method's hierarchy (its repetitions).
+    Build(Method),
+    /// Building a wrapper on it.
+    Wrapper(Method, Wrapper),
+    /// The wrapper's tightness.
+    Tightness(Method, Wrapper),
+    /// The query workload with the wrapper as bounding volume.
+    Query(Method, Wrapper),
+}
+
+impl std::fmt::Display for Step {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Step::Build(m) => write!(f, "{} build", m.name()),
+            Step::Wrapper(m, w) => write!(f, "{} {} wrapper", m.name(), w.name()),
+            Step::Tightness(m, w) => write!(f, "{} {} tightness", m.name(), w.name()),
+            Step::Query(m, w) => write!(f, "{} {} queries", m.name(), w.name()),
+        }
+    }
+}
+
+/// Runs every method × wrapper of `opts` on `scene`, calling `progress` before each step;
+/// checks `stop` between steps (Err: [`Interrupted`](crate::stop::Interrupted), or why a
+/// build failed).
 pub fn evaluate(
     scene: &Scene,
     opts: &Options,
-    mut progress: impl FnMut(Method),
-) -> Result<Vec<Row>, String> {
+    stop: &Stop,
+    progress: &mut dyn FnMut(Step),
+) -> Result<Vec<Row>> {
     let workload = Workload::standard(scene, opts.seed);
     let measure_tightness = scene.len() <= opts.tightness_max_n;
     let mut rows = Vec::new();
     for &method in &opts.methods {
-        progress(method);
-        let (built, build_s) = build_best(method, scene, opts)?;
+        stop.check()?;
+        progress(Step::Build(method));
+        let (built, build_s) = build_best(method, scene, opts).map_err(|e| anyhow!(e))?;
         let tree = &built.tree;
         let q = quality(tree);
         // Reference hulls for tightness (and the hull wrapper itself).
         let need_hulls = measure_tightness || opts.wrappers.contains(&Wrapper::Hull);
         let hulls = if need_hulls {
+            stop.check()?;
+            progress(Step::Wrapper(method, Wrapper::Hull));
             best_of(opts.repeat, || timed(|| hull_tree(tree, scene)))
         } else {
             (Vec::new(), 0.0)
         };
         for &wrapper in &opts.wrappers {
-            let w = measure_wrapper(scene, opts, &workload, tree, &hulls, wrapper);
+            let on = Measuring {
+                scene,
+                opts,
+                workload: &workload,
+                tree,
+                hulls: &hulls,
+                stop,
+            };
+            let w = on.wrapper(wrapper, &mut |step: StepOf| progress(step(method, wrapper)))?;
             rows.push(Row {
                 scene: scene.name.clone(),
                 n: scene.len(),
@@ -253,55 +312,82 @@ struct WrapperMeasure {
     query: Option<QueryCost>,
 }
 
-/// Builds `wrapper` on `tree` (the hull tree is `hulls`: the hulls and their time) and
-/// measures its tightness (up to [`Options::tightness_max_n`] primitives) and, for boxes and
-/// spheres, its query cost.
-fn measure_wrapper(
-    scene: &Scene,
-    opts: &Options,
-    workload: &Workload,
-    tree: &SubsetTree,
-    (hulls, hull_s): &(Vec<Hull>, f64),
-    wrapper: Wrapper,
-) -> WrapperMeasure {
-    let mut spheres: Vec<Sphere> = Vec::new();
-    let mut obbs = Vec::new();
-    let seconds = match wrapper {
-        Wrapper::Box => 0.0,
-        Wrapper::Hull => *hull_s,
-        Wrapper::Sphere(m) => {
-            let (s, t) = best_of(opts.repeat, || timed(|| sphere_tree(tree, scene, m)));
-            spheres = s;
-            t
+/// One hierarchy being measured: its scene, options, workload, tree and hull tree (the hulls
+/// and their time).
+struct Measuring<'a> {
+    scene: &'a Scene,
+    opts: &'a Options,
+    workload: &'a Workload,
+    tree: &'a SubsetTree,
+    hulls: &'a (Vec<Hull>, f64),
+    stop: &'a Stop,
+}
+
+/// A step of one wrapper on one method, as [`Step`]'s constructors.
+type StepOf = fn(Method, Wrapper) -> Step;
+
+impl Measuring<'_> {
+    /// Builds `wrapper` on the tree and measures its tightness (up to
+    /// [`Options::tightness_max_n`] primitives) and, for boxes and spheres, its query cost,
+    /// telling `progress` each step and checking the stop request before it.
+    fn wrapper(
+        &self,
+        wrapper: Wrapper,
+        progress: &mut dyn FnMut(StepOf),
+    ) -> Result<WrapperMeasure> {
+        let (scene, opts, tree) = (self.scene, self.opts, self.tree);
+        let (hulls, hull_s) = self.hulls;
+        let mut spheres: Vec<Sphere> = Vec::new();
+        let mut obbs = Vec::new();
+        self.stop.check()?;
+        progress(Step::Wrapper);
+        let seconds = match wrapper {
+            Wrapper::Box => 0.0,
+            Wrapper::Hull => *hull_s,
+            Wrapper::Sphere(m) => {
+                let (s, t) = best_of(opts.repeat, || timed(|| sphere_tree(tree, scene, m)));
+                spheres = s;
+                t
+            }
+            Wrapper::Obb => {
+                let (o, t) = best_of(opts.repeat, || timed(|| obb_tree(tree, scene, None)));
+                obbs = o;
+                t
+            }
+        };
+        let view = match wrapper {
+            Wrapper::Box => WrapperTree::Boxes(&tree.aabb),
+            Wrapper::Hull => WrapperTree::Hulls(hulls),
+            Wrapper::Sphere(_) => WrapperTree::Spheres(&spheres),
+            Wrapper::Obb => WrapperTree::Obbs(&obbs),
+        };
+        let (mut tightness_value, mut tightness_levels) = (None, Vec::new());
+        if scene.len() <= opts.tightness_max_n {
+            self.stop.check()?;
+            progress(Step::Tightness);
+            let how = (opts.samples, opts.tightness_nodes, opts.seed);
+            let (t, l) = tightness(tree, scene, view, hulls, how);
+            (tightness_value, tightness_levels) = (Some(t), l);
         }
-        Wrapper::Obb => {
-            let (o, t) = best_of(opts.repeat, || timed(|| obb_tree(tree, scene, None)));
-            obbs = o;
-            t
-        }
-    };
-    let view = match wrapper {
-        Wrapper::Box => WrapperTree::Boxes(&tree.aabb),
-        Wrapper::Hull => WrapperTree::Hulls(hulls),
-        Wrapper::Sphere(_) => WrapperTree::Spheres(&spheres),
-        Wrapper::Obb => WrapperTree::Obbs(&obbs),
-    };
-    let measure_tightness = scene.len() <= opts.tightness_max_n;
-    let tight = measure_tightness.then(|| tightness(tree, scene, view, hulls, opts.samples));
-    let (tightness, tightness_levels) = match tight {
-        Some((t, l)) => (Some(t), l),
-        None => (None, Vec::new()),
-    };
-    let query = match wrapper {
-        Wrapper::Box => Some(query::measure(tree, scene, Bv::Aabb, workload)),
-        Wrapper::Sphere(_) => Some(query::measure(tree, scene, Bv::Sphere(&spheres), workload)),
-        _ => None,
-    };
-    WrapperMeasure {
-        seconds,
-        tightness,
-        tightness_levels,
-        query,
+        let bv = match wrapper {
+            Wrapper::Box => Some(Bv::Aabb),
+            Wrapper::Sphere(_) => Some(Bv::Sphere(&spheres)),
+            _ => None,
+        };
+        let query = match bv {
+            Some(bv) => {
+                self.stop.check()?;
+                progress(Step::Query);
+                Some(query::measure(tree, scene, bv, self.workload))
+            }
+            None => None,
+        };
+        Ok(WrapperMeasure {
+            seconds,
+            tightness: tightness_value,
+            tightness_levels,
+            query,
+        })
     }
 }
 

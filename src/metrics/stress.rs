@@ -7,9 +7,11 @@
 //! its node's wrapper), time, depth, and for groupings k = eligible pairs per body (the paper's
 //! k of §2.3) and candidates examined per body.
 //!
-//! A case runs on its own thread. Groupings get a stop flag set when the budget runs out (they
-//! return within one merge or scan block); other builders cannot be stopped, so a case past its
-//! budget is a timeout and its thread is left to finish in the background. The sweeps run
+//! A case runs on its own thread. Groupings get a stop flag set when the budget runs out or a
+//! [`Stop`] is requested (they return within one merge or scan block); other builders cannot
+//! be stopped, so a case past its budget is a timeout and its thread is left to finish in the
+//! background. A requested [`Stop`] ends the run after the case at hand, without a report.
+//! The sweeps run
 //! against the aspect ratio at fixed N (`spaghetti.{svg,png}`) and against N at aspect 64
 //! (`spaghetti-n.{svg,png}`); their rows are also in `stress.csv`.
 
@@ -19,6 +21,7 @@ use crate::output::write_atomic;
 use crate::peers;
 use crate::scene::pathological::{self, Layout};
 use crate::scene::{Scene, split};
+use crate::stop::{Interrupted, Stop};
 use crate::wrap::{
     HULL_TOL_REL, SphereMethod, WrapperTree, containment_excess, hull_tree, obb_tree, sphere_tree,
 };
@@ -67,9 +70,11 @@ enum Outcome<T> {
 }
 
 /// Runs `f` on a thread; `Timeout` if it takes longer than `budget` (after setting `stop`, if
-/// given, and allowing the run another second to notice it).
+/// given, and allowing the run another second to notice it). A request of `halt` counts as the
+/// budget running out; the caller then checks `halt` itself.
 fn on_thread<T: Send + 'static>(
     budget: Duration,
+    halt: &Stop,
     stop: Option<Arc<AtomicBool>>,
     f: impl FnOnce() -> T + Send + 'static,
 ) -> Outcome<T> {
@@ -79,7 +84,15 @@ fn on_thread<T: Send + 'static>(
         let r = f();
         let _ = tx.send((r, t.elapsed().as_secs_f64()));
     });
-    let got = match rx.recv_timeout(budget) {
+    let deadline = Instant::now() + budget;
+    let first = loop {
+        let left = deadline.saturating_duration_since(Instant::now());
+        match rx.recv_timeout(left.min(Duration::from_millis(100))) {
+            Err(mpsc::RecvTimeoutError::Timeout) if !left.is_zero() && !halt.is_requested() => {}
+            r => break r,
+        }
+    };
+    let got = match first {
         Err(mpsc::RecvTimeoutError::Timeout) => match &stop {
             Some(s) => {
                 s.store(true, Ordering::Relaxed);
@@ -137,6 +150,7 @@ fn group_case(
     pset: PSet,
     split_r: Option<f64>,
     budget: Duration,
+    halt: &Stop,
 ) -> (Row, Option<Grouping>) {
     let name = match pset {
         PSet::Aabb => "group-aabb",
@@ -156,7 +170,7 @@ fn group_case(
     .resolve(scene);
     let stop = Arc::new(AtomicBool::new(false));
     let (s, flag) = (Arc::clone(scene), Arc::clone(&stop));
-    let out = on_thread(budget, Some(stop), move || {
+    let out = on_thread(budget, halt, Some(stop), move || {
         grouping::group_until(&s, &params, (), &flag)
     });
     let n = scene.len() as f64;
@@ -253,14 +267,17 @@ fn wrapper_excess(kind: &str, tree: &SubsetTree, scene: &Scene) -> f64 {
 
 /// Every case on one scene: both groupings, the split grouping, the wrappers on the AABB
 /// grouping's tree and the peers.
-fn scene_cases(scene: Scene, r: f64, budget: Duration) -> Vec<Row> {
+fn scene_cases(scene: Scene, r: f64, budget: Duration, halt: &Stop) -> Result<Vec<Row>> {
     let scene = Arc::new(scene);
     let mut rows = Vec::new();
-    let (row, g) = group_case(&scene, PSet::Aabb, None, budget);
+    let (row, g) = group_case(&scene, PSet::Aabb, None, budget, halt);
+    halt.check()?;
     rows.push(row);
-    rows.push(group_case(&scene, PSet::Hull, None, budget).0);
+    rows.push(group_case(&scene, PSet::Hull, None, budget, halt).0);
+    halt.check()?;
     let (s, _) = split::split_aspect(&scene, r);
-    rows.push(group_case(&Arc::new(s), PSet::Aabb, Some(r), budget).0);
+    rows.push(group_case(&Arc::new(s), PSet::Aabb, Some(r), budget, halt).0);
+    halt.check()?;
     if let Some(g) = g {
         let tree = Arc::new(g.tree);
         for kind in WRAPPERS {
@@ -272,7 +289,9 @@ fn scene_cases(scene: Scene, r: f64, budget: Duration) -> Vec<Row> {
                 depth: Some(tree.depth_max()),
                 ..Row::default()
             };
-            match on_thread(budget, None, move || wrapper_excess(kind, &t, &s)) {
+            let out = on_thread(budget, halt, None, move || wrapper_excess(kind, &t, &s));
+            halt.check()?;
+            match out {
                 Outcome::Done(ex, secs) => {
                     row.finished = true;
                     row.seconds = Some(secs);
@@ -295,9 +314,11 @@ fn scene_cases(scene: Scene, r: f64, budget: Duration) -> Vec<Row> {
             method: m.name().into(),
             ..Row::default()
         };
-        match on_thread(budget, None, move || {
+        let out = on_thread(budget, halt, None, move || {
             peers::build(m, &s, &Params::default())
-        }) {
+        });
+        halt.check()?;
+        match out {
             Outcome::Done(Ok(b), _) => {
                 row.finished = true;
                 row.seconds = Some(b.seconds);
@@ -309,7 +330,7 @@ fn scene_cases(scene: Scene, r: f64, budget: Duration) -> Vec<Row> {
         }
         rows.push(row);
     }
-    rows
+    Ok(rows)
 }
 
 /// Groups every `(x, scene)` with the AABB p-set, as it is and split at aspect `r`.
@@ -317,17 +338,19 @@ fn sweep(
     cases: Vec<(f64, Scene)>,
     r: f64,
     budget: Duration,
+    halt: &Stop,
     progress: &mut dyn FnMut(Step<'_>),
-) -> Vec<(f64, Row)> {
+) -> Result<Vec<(f64, Row)>, Interrupted> {
     let mut out = Vec::new();
     for (x, scene) in cases {
         progress(Step::Sweep(&scene));
         let (split, _) = split::split_aspect(&scene, r);
         for (sc, r) in [(scene, None), (split, Some(r))] {
-            out.push((x, group_case(&Arc::new(sc), PSet::Aabb, r, budget).0));
+            out.push((x, group_case(&Arc::new(sc), PSet::Aabb, r, budget, halt).0));
+            halt.check()?;
         }
     }
-    out
+    Ok(out)
 }
 
 /// The files `stress` writes into its output directory.
@@ -371,8 +394,13 @@ pub struct StressReport {
 
 /// Runs every builder on every pathological scene and both spaghetti sweeps; `progress` hears
 /// of each scene before it runs. Err: a budget that is not a finite duration > 0 or a split
-/// limit below [`split::MIN_ASPECT_LIMIT`] (named as the flags `--budget`, `--split`).
-pub fn run(opts: &StressOptions, progress: &mut dyn FnMut(Step<'_>)) -> Result<StressReport> {
+/// limit below [`split::MIN_ASPECT_LIMIT`] (named as the flags `--budget`, `--split`), or
+/// [`Interrupted`] once `halt` is requested (after the case at hand).
+pub fn run(
+    opts: &StressOptions,
+    halt: &Stop,
+    progress: &mut dyn FnMut(Step<'_>),
+) -> Result<StressReport> {
     if opts.budget.is_zero() {
         bail!("--budget must be a finite number > 0, got 0");
     }
@@ -396,15 +424,16 @@ pub fn run(opts: &StressOptions, progress: &mut dyn FnMut(Step<'_>)) -> Result<S
         let n = if kind == "ngons" { n / 30 } else { n };
         let scene = pathological::by_name(kind, Some(n), 1).expect("a known kind");
         progress(Step::Scene(&scene));
-        rows.extend(scene_cases(scene, opts.split, budget));
+        rows.extend(scene_cases(scene, opts.split, budget, halt)?);
     }
     let parallel = |n, a| pathological::spaghetti(n, a, Layout::Parallel, 1);
     let by_aspect = sweep(
         aspects.iter().map(|&a| (a, parallel(n, a))).collect(),
         opts.split,
         budget,
+        halt,
         progress,
-    );
+    )?;
     let by_n = sweep(
         sizes
             .iter()
@@ -412,8 +441,9 @@ pub fn run(opts: &StressOptions, progress: &mut dyn FnMut(Step<'_>)) -> Result<S
             .collect(),
         opts.split,
         budget,
+        halt,
         progress,
-    );
+    )?;
     rows.extend(by_aspect.iter().chain(&by_n).map(|(_, r)| r.clone()));
     Ok(StressReport {
         rows,

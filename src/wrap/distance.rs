@@ -40,12 +40,31 @@ pub fn point_node(
     p: &P3,
     stack: &mut Vec<u32>,
 ) -> f64 {
+    point_node_within(tree, scene, node, p, stack, usize::MAX)
+}
+
+/// [`point_node`] that stops after `max_visits` node visits, once some primitive has been
+/// reached: the distance to the nearest primitive found by then (the nearer child is searched
+/// first, so usually the exact distance; never less than it).
+pub fn point_node_within(
+    tree: &SubsetTree,
+    scene: &Scene,
+    node: u32,
+    p: &P3,
+    stack: &mut Vec<u32>,
+    max_visits: usize,
+) -> f64 {
     let mut best = f64::INFINITY;
+    let mut visits = 0usize;
     stack.clear();
     stack.push(node);
     while let Some(x) = stack.pop() {
         if point_aabb(p, &tree.aabb[x as usize]) >= best {
             continue;
+        }
+        visits += 1;
+        if visits > max_visits && best.is_finite() {
+            break;
         }
         match tree.children_of(x) {
             None => best = best.min(point_prim(scene, x as usize, p)),

@@ -31,5 +31,6 @@ pub use obb::{Obb, obb_tree};
 pub use order::LeafOrder;
 pub use sphere::{SphereMethod, sphere_tree};
 pub use tightness::{
-    DEFAULT_SAMPLES, LevelStats, NodeStats, containment_excess, level_tightness, node_tightness,
+    DEFAULT_SAMPLES, DepthSample, LevelStats, MAX_VISITS, NODES_PER_DEPTH, NodeStats,
+    containment_excess, level_tightness, node_tightness, nodes_tightness,
 };

@@ -13,18 +13,32 @@
 //! evenly spaced on segment hulls. Each sample's distance to the node's primitives is exact in
 //! `f64` (point–triangle), found by descending the Subset Tree with AABB bounds, so the cost is
 //! a fixed number of tree queries per node. Sampling can only under-estimate the true maximum.
+//!
+//! Measuring every node costs far more than building the tree, so summaries over a whole tree
+//! ([`DepthSample`]) measure at most [`NODES_PER_DEPTH`] interior nodes per depth, drawn by a
+//! seeded hash of their ids, each query stopping after [`MAX_VISITS`] node visits: a bounded
+//! cost, and the same result for any thread count (`docs/benchmarks.md`, "What is measured",
+//! gives the error against measuring every node).
 
-use super::distance::point_node;
+use super::distance::point_node_within;
 use super::hull::{BOX_TRIANGLES, Hull};
 use super::kind::WrapperTree;
 use super::obb::Obb;
 use crate::geom::{P3, Sphere, V3};
 use crate::grouping::SubsetTree;
 use crate::scene::Scene;
+use rayon::prelude::*;
 use std::cmp::Ordering::Greater;
 
 /// Surface samples per wrapper for the error measure.
 pub const DEFAULT_SAMPLES: usize = 64;
+
+/// Interior nodes per depth whose error a [`DepthSample`] measures.
+pub const NODES_PER_DEPTH: usize = 64;
+
+/// Node visits after which one sample's distance query of a [`DepthSample`] measurement keeps
+/// the nearest primitive found so far (an upper bound, nearly always the exact distance).
+pub const MAX_VISITS: usize = 4096;
 
 /// Tightness of one level's cut.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -67,30 +81,125 @@ pub fn node_tightness(
     hulls: &[Hull],
     samples: usize,
 ) -> Vec<NodeStats> {
-    let mut pts = Vec::with_capacity(samples);
-    let mut stack = Vec::new();
-    (0..tree.len() as u32)
-        .map(|x| {
-            let i = x as usize;
-            pts.clear();
-            let volume = surface_samples(w, i, samples, &mut pts);
-            let error = pts
-                .iter()
-                .map(|p| point_node(tree, scene, x, p, &mut stack))
-                .fold(0.0, f64::max);
-            let h = &hulls[i];
-            let reference_volume = if h.dim == 3 {
-                h.volume()
-            } else {
-                tree.aabb[i].volume()
-            };
-            NodeStats {
-                volume,
-                reference_volume,
-                error,
-            }
-        })
+    let all: Vec<u32> = (0..tree.len() as u32).collect();
+    nodes_tightness(tree, scene, w, hulls, samples, &all, usize::MAX)
+}
+
+/// Tightness of the nodes `nodes` of `w`, in that order, each sample's query stopping after
+/// `max_visits` node visits (see [`point_node_within`]); the nodes are measured in parallel,
+/// with the same result for any thread count.
+pub fn nodes_tightness(
+    tree: &SubsetTree,
+    scene: &Scene,
+    w: WrapperTree<'_>,
+    hulls: &[Hull],
+    samples: usize,
+    nodes: &[u32],
+    max_visits: usize,
+) -> Vec<NodeStats> {
+    nodes
+        .par_iter()
+        .map_init(
+            || (Vec::with_capacity(samples), Vec::new()),
+            |(pts, stack), &x| {
+                let i = x as usize;
+                pts.clear();
+                let volume = surface_samples(w, i, samples, pts);
+                let error = pts
+                    .iter()
+                    .map(|p| point_node_within(tree, scene, x, p, stack, max_visits))
+                    .fold(0.0, f64::max);
+                let h = &hulls[i];
+                let reference_volume = if h.dim == 3 {
+                    h.volume()
+                } else {
+                    tree.aabb[i].volume()
+                };
+                NodeStats {
+                    volume,
+                    reference_volume,
+                    error,
+                }
+            },
+        )
         .collect()
+}
+
+/// The interior nodes a sampled tightness measurement visits, depth by depth: at each depth
+/// every interior node when there are at most `per_depth`, else the `per_depth` whose
+/// seeded hash of the id is smallest. The depths are the strata of a stratified estimate: a
+/// mean over all interior nodes is the depths' sample means weighted by [`DepthSample::interior`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct DepthSample {
+    /// Interior nodes at each depth (index = depth).
+    pub interior: Vec<usize>,
+    /// The sampled interior nodes at each depth, ascending ids.
+    pub nodes: Vec<Vec<u32>>,
+}
+
+impl DepthSample {
+    /// Draws the sample of `tree` with `per_depth` nodes per depth and `seed`.
+    pub fn new(tree: &SubsetTree, per_depth: usize, seed: u64) -> DepthSample {
+        let depths = tree.depth_max() as usize + 1;
+        let mut by_depth: Vec<Vec<u32>> = vec![Vec::new(); depths];
+        for x in tree.leaves() as u32..tree.len() as u32 {
+            by_depth[tree.depth[x as usize] as usize].push(x);
+        }
+        let interior = by_depth.iter().map(Vec::len).collect();
+        let nodes = by_depth
+            .into_iter()
+            .map(|mut ids| {
+                if ids.len() > per_depth {
+                    ids.sort_unstable_by_key(|&x| (mix(seed ^ u64::from(x)), x));
+                    ids.truncate(per_depth);
+                    ids.sort_unstable();
+                }
+                ids
+            })
+            .collect();
+        DepthSample { interior, nodes }
+    }
+
+    /// Every sampled node, depth by depth.
+    pub fn flat(&self) -> Vec<u32> {
+        self.nodes.concat()
+    }
+
+    /// `values` (one per node of [`DepthSample::flat`], `None` where a node has no value)
+    /// summarised: the stratified mean over all interior nodes, and each depth's sample mean
+    /// (0 for a depth without values).
+    pub fn means(&self, values: &[Option<f64>]) -> (f64, Vec<f64>) {
+        let mut rest = values;
+        let (mut sum, mut weight) = (0.0, 0.0);
+        let per_depth = self
+            .nodes
+            .iter()
+            .zip(&self.interior)
+            .map(|(ids, &count)| {
+                let (here, next) = rest.split_at(ids.len());
+                rest = next;
+                let got: Vec<f64> = here.iter().flatten().copied().collect();
+                if got.is_empty() {
+                    return 0.0;
+                }
+                let mean = got.iter().sum::<f64>() / got.len() as f64;
+                // Nodes without a value are as frequent among the unsampled ones.
+                let w = count as f64 * got.len() as f64 / ids.len() as f64;
+                sum += w * mean;
+                weight += w;
+                mean
+            })
+            .collect();
+        (if weight > 0.0 { sum / weight } else { 0.0 }, per_depth)
+    }
+}
+
+/// splitmix64: a well-mixed 64-bit hash of `x`.
+fn mix(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
 }
 
 /// Tightness of the cuts at depths 0..=depth max (see the [module docs](self)).
