@@ -181,7 +181,7 @@ pub struct GroupArgs {
     #[arg(long, value_name = "E")]
     pub chunk_epsilon: Option<f64>,
     /// Partitioned schedule: ranges of at most N primitives are cut where binned SAH on the
-    /// longest axis of their centres puts the cut, not at a Morton bit (which runs through
+    /// best axis of their centres puts the cut, not at a Morton bit (which runs through
     /// clusters); 0 = Morton cuts throughout [default: 256].
     #[arg(long, value_name = "N")]
     pub chunk_sah: Option<u32>,

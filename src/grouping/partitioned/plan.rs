@@ -19,7 +19,7 @@ pub struct Chunking {
     /// subproblem (the exact schedule's step) starts from about `top` bodies; 0 = AAC's f alone.
     /// A scene of at most 1.5 × `top` primitives is one subproblem (see [`Chunking::whole`]).
     pub top: u32,
-    /// Ranges of at most this many primitives are cut by binned SAH on the longest axis of
+    /// Ranges of at most this many primitives are cut by binned SAH on the best axis of
     /// their centres instead of at their highest differing Morton bit (`split`); 0 = Morton
     /// cuts throughout.
     pub sah_below: u32,
