@@ -25,6 +25,17 @@ use crate::grouping::sah;
 use crate::grouping::{Event, Observer, SubsetTree};
 use work::WorkTree;
 
+/// The fast path's refinement (`--fast`, bench method `fast`), after the partitioned grouping
+/// with [`Chunking::FAST`](crate::grouping::partitioned::Chunking::FAST): the default's treelet
+/// pass, then 2 reinsertion passes instead of 3, so its work stays proportional to the tree's
+/// size with a smaller constant.
+pub const FAST: RefineParams = RefineParams {
+    passes: 2,
+    batch: 0.1,
+    treelet: 7,
+    treelet_passes: 1,
+};
+
 /// Knobs of a refinement run that recordings do not name (so `record --refine` and
 /// `replay --verify` always use [`Tuning::default`]); for measuring variants
 /// (`examples/refine_cost.rs`) through [`refine_tuned`].

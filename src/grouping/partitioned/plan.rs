@@ -37,6 +37,16 @@ impl Chunking {
         sah_below: 256,
     };
 
+    /// The fast path's split (`--fast`, bench method `fast`): the default's with a root share
+    /// of 256 bodies, so that scenes of 10^3–10^5 primitives are grouped in small subproblems
+    /// (by brute force, in parallel) and the root step is small. Its trees are further from the
+    /// exact schedule's than the default's; the fast path's refinement (`refine::FAST`) takes
+    /// their SAH back down.
+    pub const FAST: Chunking = Chunking {
+        top: 256,
+        ..Chunking::DEFAULT
+    };
+
     /// Whether a scene of `n` primitives is grouped as one subproblem, the exact schedule's
     /// step: when `n` ≤ 1.5 × `top`. The root step alone on about `top` bodies costs about what
     /// the exact schedule costs on all of them, so below this size the split would only
