@@ -160,7 +160,8 @@ pub struct GroupArgs {
     #[arg(long, value_enum, default_value_t = Schedule::Exact)]
     pub schedule: Schedule,
     /// The fast path: the partitioned schedule with small subproblems (root share 256; the
-    /// --chunk-* flags still apply); `record --refine --refine-passes 2` adds its refinement.
+    /// --chunk-* flags still apply); with `record`, `--refine --refine-treelet-passes 0` adds
+    /// its refinement.
     #[arg(long, conflicts_with = "schedule")]
     pub fast: bool,
     /// Components grouped on their own first: none, objects (the file's o/g), connected

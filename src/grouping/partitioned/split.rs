@@ -84,8 +84,10 @@ pub(super) struct Zone<'z> {
     perm: Vec<u32>,
     /// Doubled centre (min + max) of each primitive, by position on entry.
     cen: Vec<[f64; 3]>,
-    /// Bin or side of each primitive of the range being cut, and the partition's buffer.
+    /// Bin or side of each primitive of the range being cut (on the axis being tried, and on
+    /// the best axis so far), and the partition's buffer.
     bin: Vec<u8>,
+    best_bin: Vec<u8>,
     tmp: Vec<u32>,
 }
 
@@ -179,6 +181,7 @@ impl<'z> Zone<'z> {
             perm: (0..m as u32).collect(),
             cen,
             bin: Vec::with_capacity(m),
+            best_bin: Vec::with_capacity(m),
             tmp: Vec::with_capacity(m),
         }
     }
@@ -205,34 +208,29 @@ impl<'z> Zone<'z> {
             cb.hi[1] - cb.lo[1],
             cb.hi[2] - cb.lo[2],
         ];
-        // Every axis with a span is tried; the cheapest cut wins (ties to the lower axis).
-        let mut best: Option<(f64, usize)> = None;
+        // Every axis with a span is tried; the cheapest cut wins (ties to the lower axis), its
+        // sides kept in `best_bin`. Bins from `cut` on are the right side.
+        let mut best: Option<(f64, usize, u8)> = None;
         for axis in 0..3 {
             let w = e[axis];
             // NaN or zero span: no length to cut along.
             if !(w > 0.0 && w.is_finite()) {
                 continue;
             }
-            let cost = if len <= SWEEP {
-                self.sweep(start, len, axis).map(|(c, _)| c)
+            let found = if len <= SWEEP {
+                self.sweep(start, len, axis).map(|(c, nl)| (c, nl, 1))
             } else {
                 self.binned(start, len, axis, cb.lo[axis], w)
-                    .map(|(c, _, _)| c)
             };
-            if let Some(c) = cost
-                && best.is_none_or(|(b, _)| c < b)
+            if let Some((c, nl, cut)) = found
+                && best.is_none_or(|(b, _, _)| c < b)
             {
-                best = Some((c, axis));
+                best = Some((c, nl, cut));
+                std::mem::swap(&mut self.bin, &mut self.best_bin);
             }
         }
-        let (_, axis) = best?;
-        // Bins from `cut` on are the right side.
-        let (nl, cut) = if len <= SWEEP {
-            (self.sweep(start, len, axis)?.1, 1)
-        } else {
-            let (_, nl, cut) = self.binned(start, len, axis, cb.lo[axis], e[axis])?;
-            (nl, cut)
-        };
+        let (_, nl, cut) = best?;
+        std::mem::swap(&mut self.bin, &mut self.best_bin);
         // A stable partition of the positions (side 0 first), without branches.
         self.tmp.resize(len, 0);
         let part = &mut self.perm[start..start + len];
