@@ -417,6 +417,41 @@ mod tests {
     }
 
     #[test]
+    fn the_cut_is_on_the_axis_of_least_cost_not_the_longest_span_of_the_centres() {
+        // Two rows of slivers 10 long in x, 2 apart in y; their centres spread 3 in x, 2.1 in
+        // y. Any cut in x leaves both rows on both sides; the cut in y parts the rows.
+        for m in [64u32, 12] {
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+            let leaves: Vec<Body> = (0..m)
+                .map(|i| {
+                    let (x, y) = (3.5 + rng.random_range(0.0..3.0), f64::from(i % 2) * 2.0);
+                    let y = y + rng.random_range(0.0..0.1);
+                    let aabb = Aabb {
+                        min: P3::new(x - 5.0, y, 0.0),
+                        max: P3::new(x + 5.0, y + 0.01, 0.01),
+                    };
+                    Body {
+                        id: i,
+                        first_round: 0,
+                        aabb,
+                        diameter: aabb.diameter(),
+                    }
+                })
+                .collect();
+            let (nl, _, leaves) = cut_once(leaves);
+            assert_eq!(nl, m as usize / 2, "{m} leaves");
+            assert!(
+                leaves[..nl].iter().all(|l| l.aabb.min.y < 1.0),
+                "{m} leaves"
+            );
+            assert!(
+                leaves[nl..].iter().all(|l| l.aabb.min.y > 1.0),
+                "{m} leaves"
+            );
+        }
+    }
+
+    #[test]
     fn without_a_span_or_a_balanced_boundary_the_morton_cut_applies() {
         // Every centre at one point: the highest differing bit of the codes (0, 3, …, 21).
         let same: Vec<Body> = (0..8).map(|i| leaf(i, [1.0, 1.0, 1.0], 0.5)).collect();
