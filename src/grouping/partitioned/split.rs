@@ -211,8 +211,7 @@ impl<'z> Zone<'z> {
         // Every axis with a span is tried; the cheapest cut wins (ties to the lower axis), its
         // sides kept in `best_bin`. Bins from `cut` on are the right side.
         let mut best: Option<(f64, usize, u8)> = None;
-        for axis in 0..3 {
-            let w = e[axis];
+        for (axis, &w) in e.iter().enumerate() {
             // NaN or zero span: no length to cut along.
             if !(w > 0.0 && w.is_finite()) {
                 continue;
