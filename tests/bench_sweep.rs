@@ -85,7 +85,7 @@ fn bench_writes_one_row_per_method_and_wrapper_with_charts_and_rrd() {
         assert!(refine <= build, "{row:?}");
         assert_eq!(
             refine > 0.0,
-            row[col("method")].ends_with("+refine"),
+            Method::parse(row[col("method")]).unwrap().is_refined(),
             "{row:?}"
         );
         let query = row[col("node_tests_per_query")];

@@ -170,6 +170,11 @@ pub struct GroupArgs {
     /// of a Morton split, bottom-up, in parallel).
     #[arg(long, value_enum, default_value_t = Schedule::Exact)]
     pub schedule: Schedule,
+    /// The fast path: the partitioned schedule with small subproblems (root share 256; the
+    /// --chunk-* flags still apply); with `record`, `--refine --refine-treelet-passes 0` adds
+    /// its refinement.
+    #[arg(long, conflicts_with = "schedule")]
+    pub fast: bool,
     /// Components grouped on their own first: none, objects (the file's o/g), connected
     /// (primitives sharing welded vertices).
     #[arg(long, value_enum, default_value_t = Pregroup::None)]
@@ -192,7 +197,7 @@ pub struct GroupArgs {
     #[arg(long, value_name = "E")]
     pub chunk_epsilon: Option<f64>,
     /// Partitioned schedule: ranges of at most N primitives are cut where binned SAH on the
-    /// longest axis of their centres puts the cut, not at a Morton bit (which runs through
+    /// best axis of their centres puts the cut, not at a Morton bit (which runs through
     /// clusters); 0 = Morton cuts throughout [default: 256].
     #[arg(long, value_name = "N")]
     pub chunk_sah: Option<u32>,
@@ -213,7 +218,7 @@ impl GroupArgs {
     /// into [`Params`].
     pub fn params(&self) -> Result<Params> {
         self.threads()?;
-        let params = Params {
+        let mut params = Params {
             weights: Weights {
                 a: self.a,
                 b: self.b,
@@ -233,15 +238,24 @@ impl GroupArgs {
                 chunk_sah: self.chunk_sah.unwrap_or(Mode::default().chunk_sah),
             },
         };
+        if self.fast {
+            let fast = params.mode.fast();
+            params.mode = Mode {
+                chunk_top: self.chunk_top.unwrap_or(fast.chunk_top),
+                chunk_epsilon: self.chunk_epsilon.unwrap_or(fast.chunk_epsilon),
+                chunk_sah: self.chunk_sah.unwrap_or(fast.chunk_sah),
+                ..fast
+            };
+        }
         let chunking = [
             (self.chunk_top.is_some(), "--chunk-top"),
             (self.chunk_epsilon.is_some(), "--chunk-epsilon"),
             (self.chunk_sah.is_some(), "--chunk-sah"),
         ];
         if let Some((_, flag)) = chunking.iter().find(|(set, _)| *set)
-            && self.schedule != Schedule::Partitioned
+            && params.mode.schedule != Schedule::Partitioned
         {
-            anyhow::bail!("{flag} needs --schedule partitioned");
+            anyhow::bail!("{flag} needs --schedule partitioned or --fast");
         }
         params.check().map_err(anyhow::Error::msg)?;
         Ok(params)

@@ -185,6 +185,20 @@ impl Default for Mode {
 }
 
 impl Mode {
+    /// This mode on the fast path: the partitioned schedule with the split of
+    /// [`Chunking::FAST`](crate::grouping::partitioned::Chunking::FAST) (its root share, ε and
+    /// SAH cuts), pre-grouping and the Cost measure kept.
+    pub fn fast(self) -> Mode {
+        let ch = crate::grouping::partitioned::Chunking::FAST;
+        Mode {
+            schedule: Schedule::Partitioned,
+            chunk_top: ch.top,
+            chunk_epsilon: ch.epsilon,
+            chunk_sah: ch.sah_below,
+            ..self
+        }
+    }
+
     /// Checks that the settings fit together with the p-set `pset`: instancing needs
     /// pre-grouping (copies are found among components), and pre-grouping needs the AABB p-set.
     /// The errors name the CLI flags.

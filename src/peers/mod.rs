@@ -5,6 +5,8 @@
 //!
 //! - [`Method::Grouping`], [`Method::GroupingHull`], [`Method::GroupingPartitioned`]: the
 //!   paper's grouping phase (§2.2) with AABB or hull p-sets, and in the partitioned schedule;
+//! - [`Method::Fast`]: the fast path, the partitioned schedule with small subproblems
+//!   ([`Method::GroupingFast`]) then a bounded refinement ([`crate::refine::FAST`]);
 //! - [`Method::GroupingPregroup`], [`Method::GroupingInstanced`], [`Method::GroupingObjects`]:
 //!   the same with the paper's §1.3 speed-ups ([`crate::grouping::pregroup`]);
 //! - [`parry_bvh`]: parry3d's `Bvh`, binned SAH or PLOC, as published;
@@ -61,12 +63,20 @@ pub enum Method {
     ObvhsPlocRefine,
     /// [`Method::GroupingPartitioned`] then the refinement pass.
     GroupingPartitionedRefine,
+    /// The partitioned schedule with the fast path's split
+    /// ([`Chunking::FAST`](crate::grouping::partitioned::Chunking::FAST)).
+    GroupingFast,
+    /// The fast path: [`Method::GroupingFast`] then the refinement with
+    /// [`crate::refine::FAST`].
+    Fast,
 }
 
 impl Method {
     /// Every method, ours first.
-    pub const ALL: [Method; 16] = [
+    pub const ALL: [Method; 18] = [
         Method::Grouping,
+        Method::Fast,
+        Method::GroupingFast,
         Method::GroupingRefine,
         Method::GroupingHull,
         Method::GroupingPartitioned,
@@ -103,6 +113,8 @@ impl Method {
             Method::ParryBinnedRefine => "parry-binned+refine",
             Method::ObvhsPlocRefine => "obvhs-ploc+refine",
             Method::GroupingPartitionedRefine => "grouping-partitioned+refine",
+            Method::GroupingFast => "grouping-fast",
+            Method::Fast => "fast",
         }
     }
 
@@ -129,6 +141,8 @@ impl Method {
                 | Method::GroupingObjects
                 | Method::GroupingPartitioned
                 | Method::GroupingPartitionedRefine
+                | Method::GroupingFast
+                | Method::Fast
         )
     }
 
@@ -144,6 +158,7 @@ impl Method {
             Method::ParryBinnedRefine => Method::ParryBinned,
             Method::ObvhsPlocRefine => Method::ObvhsPloc,
             Method::GroupingPartitionedRefine => Method::GroupingPartitioned,
+            Method::Fast => Method::GroupingFast,
             m => m,
         }
     }
@@ -183,7 +198,12 @@ pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, St
     let mut built = build_base(base, scene, params)?;
     if method.is_refined() {
         let t = Instant::now();
-        let r = refine::refine(&built.tree, &RefineParams::default(), ());
+        let rp = if method == Method::Fast {
+            refine::FAST
+        } else {
+            RefineParams::default()
+        };
+        let r = refine::refine(&built.tree, &rp, ());
         built.refine_seconds = t.elapsed().as_secs_f64();
         built.seconds += built.refine_seconds;
         built.tree = r.tree;
@@ -225,6 +245,10 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
         if method == Method::GroupingPartitioned {
             p.pset = PSet::Aabb;
             p.mode.schedule = Schedule::Partitioned;
+        }
+        if method == Method::GroupingFast {
+            p.pset = PSet::Aabb;
+            p.mode = p.mode.fast();
         }
         if p.pset == PSet::Aabb && pregroup == Pregroup::None {
             // Like the peers', from the primitives' boxes, computed untimed (with room for
@@ -283,11 +307,13 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
         | Method::GroupingPregroup
         | Method::GroupingInstanced
         | Method::GroupingObjects
-        | Method::GroupingPartitioned => unreachable!("handled above"),
+        | Method::GroupingPartitioned
+        | Method::GroupingFast => unreachable!("handled above"),
         Method::GroupingRefine
         | Method::ParryBinnedRefine
         | Method::ObvhsPlocRefine
-        | Method::GroupingPartitionedRefine => {
+        | Method::GroupingPartitionedRefine
+        | Method::Fast => {
             unreachable!("refined methods are built from their base")
         }
     };

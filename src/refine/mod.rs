@@ -25,6 +25,19 @@ use crate::grouping::sah;
 use crate::grouping::{Event, Observer, SubsetTree};
 use work::WorkTree;
 
+/// The fast path's refinement (`--fast`, bench method `fast`), after the partitioned grouping
+/// with [`Chunking::FAST`](crate::grouping::partitioned::Chunking::FAST): the default's
+/// reinsertion passes without its treelet pass. Pass k searches a fixed share of the nodes, so
+/// the work stays proportional to the tree's size; the treelet pass cost about as much again
+/// and, on the fast path's trees, raised the node tests per query of some scenes (a CAD chair,
+/// lamps) while lowering their SAH (`docs/benchmarks.md`, "The fast path").
+pub const FAST: RefineParams = RefineParams {
+    passes: 3,
+    batch: 0.1,
+    treelet: 7,
+    treelet_passes: 0,
+};
+
 /// Knobs of a refinement run that recordings do not name (so `record --refine` and
 /// `replay --verify` always use [`Tuning::default`]); for measuring variants
 /// (`examples/refine_cost.rs`) through [`refine_tuned`].

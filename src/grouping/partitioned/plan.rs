@@ -19,7 +19,7 @@ pub struct Chunking {
     /// subproblem (the exact schedule's step) starts from about `top` bodies; 0 = AAC's f alone.
     /// A scene of at most 1.5 × `top` primitives is one subproblem (see [`Chunking::whole`]).
     pub top: u32,
-    /// Ranges of at most this many primitives are cut by binned SAH on the longest axis of
+    /// Ranges of at most this many primitives are cut by binned SAH on the best axis of
     /// their centres instead of at their highest differing Morton bit (`split`); 0 = Morton
     /// cuts throughout.
     pub sah_below: u32,
@@ -35,6 +35,16 @@ impl Chunking {
         epsilon: 0.5,
         top: 8192,
         sah_below: 256,
+    };
+
+    /// The fast path's split (`--fast`, bench method `fast`): the default's with a root share
+    /// of 256 bodies, so that scenes of 10^3–10^5 primitives are grouped in small subproblems
+    /// (by brute force, in parallel) and the root step is small. Its trees are further from the
+    /// exact schedule's than the default's; the fast path's refinement (`refine::FAST`) takes
+    /// their SAH back down.
+    pub const FAST: Chunking = Chunking {
+        top: 256,
+        ..Chunking::DEFAULT
     };
 
     /// Whether a scene of `n` primitives is grouped as one subproblem, the exact schedule's

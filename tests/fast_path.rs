@@ -1,0 +1,108 @@
+//! The fast path (`--fast`, bench method `fast`): a valid tree over every primitive, the same
+//! tree on 1 and 2 threads, a refinement that never raises the SAH of its grouping, and the
+//! flag's parsing.
+
+mod common;
+
+use common::wraptree;
+use wraptree::grouping::partitioned::Chunking;
+use wraptree::grouping::{Params, SubsetTree, sah};
+use wraptree::peers::{Method, build};
+use wraptree::scene::{LoadOptions, Scene, generate, load_path};
+
+/// `method`'s tree of `scene` in a rayon pool of `threads` threads.
+fn tree_on(threads: usize, method: Method, scene: &Scene) -> SubsetTree {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(|| build(method, scene, &Params::default()).unwrap().tree)
+}
+
+/// Every primitive a leaf once, every interior box covering its children's, one root.
+fn check_cover(tree: &SubsetTree, scene: &Scene) {
+    let n = scene.len();
+    assert_eq!(tree.leaves(), n);
+    assert_eq!(tree.children.len(), n - 1);
+    let mut seen = vec![0u32; tree.len()];
+    for (i, &[a, b]) in tree.children.iter().enumerate() {
+        seen[a as usize] += 1;
+        seen[b as usize] += 1;
+        let x = n + i;
+        assert!(tree.aabb[x].contains_aabb(&tree.aabb[a as usize], 0.0));
+        assert!(tree.aabb[x].contains_aabb(&tree.aabb[b as usize], 0.0));
+    }
+    for (i, b) in tree.aabb[..n].iter().enumerate() {
+        assert!(b.contains_aabb(&scene.prim_aabb(i), 0.0), "leaf {i}");
+    }
+    let roots: Vec<usize> = (0..tree.len()).filter(|&x| seen[x] == 0).collect();
+    assert_eq!(roots, vec![tree.root() as usize]);
+    assert!(seen.iter().all(|&s| s <= 1));
+}
+
+fn scenes() -> Vec<Scene> {
+    let bunny = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/stanford-bunny.obj");
+    vec![
+        generate::soup(5_000, 3),
+        generate::replicate(&generate::robot_base(), 6, 2),
+        load_path(&bunny, &LoadOptions::default()).unwrap().scene,
+    ]
+}
+
+#[test]
+fn the_fast_path_is_a_valid_tree_and_the_same_on_1_and_2_threads() {
+    for scene in scenes() {
+        // Split into many subproblems (not grouped whole).
+        assert!(!Chunking::FAST.whole(scene.len()), "{}", scene.name);
+        for m in [Method::GroupingFast, Method::Fast] {
+            let one = tree_on(1, m, &scene);
+            let two = tree_on(2, m, &scene);
+            check_cover(&one, &scene);
+            assert_eq!(one.children, two.children, "{} {}", scene.name, m.name());
+            assert_eq!(one.aabb, two.aabb, "{} {}", scene.name, m.name());
+        }
+        let grouped = tree_on(2, Method::GroupingFast, &scene);
+        let fast = tree_on(2, Method::Fast, &scene);
+        assert!(sah(&fast) <= sah(&grouped), "{}", scene.name);
+    }
+}
+
+#[test]
+fn the_fast_flag_groups_partitioned_with_the_fast_split_and_parses_like_the_others() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut obj = Vec::new();
+    generate::soup(2_000, 6).write_obj(&mut obj).unwrap();
+    std::fs::write(dir.path().join("s.obj"), obj).unwrap();
+    let out = wraptree(&["group", "s.obj", "--fast", "--threads", "1"], dir.path());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("Partitioned on 1 thread"), "{text}");
+    assert!(text.contains("root share 256"), "{text}");
+    // The --chunk-* flags apply on the fast path.
+    let out = wraptree(
+        &["group", "s.obj", "--fast", "--chunk-top", "512"],
+        dir.path(),
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && text.contains("root share 512"),
+        "{text}"
+    );
+    let out = wraptree(
+        &["group", "s.obj", "--fast", "--schedule", "exact"],
+        dir.path(),
+    );
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--fast") && err.contains("--schedule"),
+        "{err}"
+    );
+    // The bench method by name.
+    assert_eq!(Method::parse("fast"), Ok(Method::Fast));
+    assert_eq!(Method::parse("grouping-fast"), Ok(Method::GroupingFast));
+}
