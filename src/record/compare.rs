@@ -8,7 +8,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::grouping::{Merge, SubsetTree};
+use crate::grouping::{Merge, SubsetTree, sah};
 use crate::output::{Pending, with_ext};
 use crate::scene::Scene;
 
@@ -30,6 +30,87 @@ pub fn divergence(a: &[Merge], b: &[Merge]) -> Option<usize> {
         (Some(x), Some(y)) => !same(x, y),
         _ => true,
     })
+}
+
+/// The earliest merge where a run diverges from the first run, if any.
+pub fn earliest_divergence(runs: &[CompareRun<'_>]) -> Option<usize> {
+    let reference = runs.first()?.merges;
+    runs.iter()
+        .filter_map(|r| divergence(reference, r.merges))
+        .min()
+}
+
+/// One line of a comparison's log.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LogLine {
+    /// The merge tick it belongs to.
+    pub merge: usize,
+    /// Whether it is a warning (the divergence).
+    pub warn: bool,
+    /// Its text.
+    pub text: String,
+}
+
+/// The log of a comparison, in tick order: each run (tick 0), each run's first divergence from
+/// the first run (at its merge), each run's finish (SAH and depth) at its last merge.
+pub fn log_lines(runs: &[CompareRun<'_>]) -> Vec<LogLine> {
+    let line = |merge: usize, warn: bool, text: String| LogLine { merge, warn, text };
+    let mut lines: Vec<LogLine> = runs
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            line(
+                0,
+                false,
+                format!("run {i}: {}, {} merges", r.label, r.merges.len()),
+            )
+        })
+        .collect();
+    let pair = |m: Option<&Merge>| {
+        m.map_or("no merge".into(), |m| {
+            format!("bodies {} + {} (Cost {:.6e})", m.a, m.b, m.cost)
+        })
+    };
+    let first = &runs[..runs.len().min(1)];
+    for (i, r) in runs.iter().enumerate().skip(1) {
+        let reference = first[0].merges;
+        lines.push(match divergence(reference, r.merges) {
+            Some(k) => line(
+                k,
+                true,
+                format!(
+                    "first divergence at merge {k}: run 0 ({}) merges {}, run {i} ({}) merges {}",
+                    first[0].label,
+                    pair(reference.get(k)),
+                    r.label,
+                    pair(r.merges.get(k)),
+                ),
+            ),
+            None => line(
+                0,
+                false,
+                format!("run {i} ({}) makes the same merges as run 0", r.label),
+            ),
+        });
+    }
+    for (i, r) in runs.iter().enumerate() {
+        let text = match r.tree {
+            Some(t) => format!(
+                "run {i} ({}) finished: SAH {:.4}, depth {}",
+                r.label,
+                sah(t),
+                t.depth_max()
+            ),
+            None => format!(
+                "run {i} ({}) stopped after {} merges",
+                r.label,
+                r.merges.len()
+            ),
+        };
+        lines.push(line(r.merges.len().saturating_sub(1), false, text));
+    }
+    lines.sort_by_key(|l| l.merge);
+    lines
 }
 
 /// Writes `PREFIX.rrd` and `PREFIX.mcap`, the comparison of `runs` (at least two) over `scene`

@@ -16,12 +16,11 @@ use foxglove::Encode;
 use foxglove::messages::{Log, SceneUpdate, Timestamp};
 
 use super::messages::MergeEvent;
-use super::scene_msgs::{self, SceneMesh};
+use super::scene_msgs;
 use super::{CHUNK_SIZE, LIBRARY, PROFILE, ZSTD_LEVEL};
-use crate::grouping::{Merge, sah};
 use crate::output::Pending;
 use crate::record::boxes_drawn;
-use crate::record::compare::{CompareRun, divergence};
+use crate::record::compare::{CompareRun, LogLine, earliest_divergence, log_lines};
 use crate::scene::Scene;
 
 /// Magenta of the divergence's box.
@@ -93,30 +92,33 @@ fn write(file: &Pending, scene: &Scene, scene_name: &str, runs: &[CompareRun<'_>
     };
     let scene_topic = w.topic::<SceneUpdate>("/scene")?;
     let log_topic = w.topic::<Log>("/compare/log")?;
-    let mut entity = scene_msgs::entity("scene", 0);
-    let mut mesh = SceneMesh::new(scene);
-    mesh.add(0..scene.len());
-    entity
-        .triangles
-        .push(mesh.into_primitive(scene_msgs::SCENE_COLOR));
-    w.emit(scene_topic, 0, &scene_msgs::update(vec![entity]))?;
+    w.emit(scene_topic, 0, &scene_msgs::scene_update(scene))?;
 
-    let splits: Vec<Option<usize>> = runs
-        .iter()
-        .map(|r| divergence(runs[0].merges, r.merges))
-        .collect();
-    let first = splits.iter().flatten().copied().min();
+    let first = earliest_divergence(runs);
     for (i, run) in runs.iter().enumerate() {
         write_run(&mut w, i, run, scene, first)?;
     }
-    for (t, level, text) in log_lines(scene_name, runs, &splits) {
+    let heading = LogLine {
+        merge: 0,
+        warn: false,
+        text: format!("{scene_name}: {} runs", runs.len()),
+    };
+    for l in std::iter::once(heading).chain(log_lines(runs)) {
+        use foxglove::messages::log::Level;
+        // The runs' lines at 0, the others at their merge's log time.
+        let t = if l.merge == 0 && !l.warn {
+            0
+        } else {
+            at(l.merge)
+        };
+        let level = if l.warn { Level::Warning } else { Level::Info };
         let log = Log {
             timestamp: Some(Timestamp::new(
                 (t / 1_000_000_000) as u32,
                 (t % 1_000_000_000) as u32,
             )),
             level: level as i32,
-            message: text,
+            message: l.text,
             name: "wraptree compare".into(),
             file: String::new(),
             line: 0,
@@ -170,62 +172,4 @@ fn write_run<W: std::io::Write + std::io::Seek>(
         boxes.push(m.aabb);
     }
     Ok(())
-}
-
-/// The log lines, in time order: (log time, level, text).
-fn log_lines(
-    scene_name: &str,
-    runs: &[CompareRun<'_>],
-    splits: &[Option<usize>],
-) -> Vec<(u64, foxglove::messages::log::Level, String)> {
-    use foxglove::messages::log::Level;
-    let mut lines = vec![(0, Level::Info, format!("{scene_name}: {} runs", runs.len()))];
-    for (i, r) in runs.iter().enumerate() {
-        let text = format!("run {i}: {}, {} merges", r.label, r.merges.len());
-        lines.push((0, Level::Info, text));
-    }
-    let pair = |m: Option<&Merge>| {
-        m.map_or("no merge".into(), |m| {
-            format!("bodies {} + {} (Cost {:.6e})", m.a, m.b, m.cost)
-        })
-    };
-    for (i, (r, split)) in runs.iter().zip(splits).enumerate().skip(1) {
-        let line = match *split {
-            Some(k) => (
-                at(k),
-                Level::Warning,
-                format!(
-                    "first divergence at merge {k}: run 0 merges {}, run {i} ({}) merges {}",
-                    pair(runs[0].merges.get(k)),
-                    r.label,
-                    pair(r.merges.get(k))
-                ),
-            ),
-            None => (
-                0,
-                Level::Info,
-                format!("run {i} makes the same merges as run 0"),
-            ),
-        };
-        lines.push(line);
-    }
-    for (i, r) in runs.iter().enumerate() {
-        let end = at(r.merges.len().saturating_sub(1));
-        let text = match r.tree {
-            Some(t) => format!(
-                "run {i} ({}) finished: SAH {:.4}, depth {}",
-                r.label,
-                sah(t),
-                t.depth_max()
-            ),
-            None => format!(
-                "run {i} ({}) stopped after {} merges",
-                r.label,
-                r.merges.len()
-            ),
-        };
-        lines.push((end, Level::Info, text));
-    }
-    lines.sort_by_key(|l| l.0);
-    lines
 }

@@ -32,7 +32,6 @@ use anyhow::{Context, Result, anyhow};
 use foxglove::Encode;
 use foxglove::messages::SceneUpdate;
 use messages::{DormantEvent, FinishEvent, MergeEvent, PartEvent, RefineStepEvent, RoundEvent};
-use scene_msgs::SceneMesh;
 use std::collections::BTreeMap;
 use std::io::{Seek, Write};
 
@@ -303,19 +302,13 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
     }
 
     fn try_write_scene(&mut self) -> Result<()> {
-        let scene = self.info.scene;
-        let mut entity = scene_msgs::entity("scene", 0);
-        let mut mesh = SceneMesh::new(scene);
-        mesh.add(0..scene.len());
-        entity
-            .triangles
-            .push(mesh.into_primitive(scene_msgs::SCENE_COLOR));
+        let update = scene_msgs::scene_update(self.info.scene);
         emit(
             &mut self.writer,
             &mut self.buf,
             &mut self.scene_topic,
             0,
-            &scene_msgs::update(vec![entity]),
+            &update,
         )?;
         self.writer
             .attach(&mcap::Attachment {

@@ -65,6 +65,15 @@ pub fn entity(id: &str, t_ns: u64) -> SceneEntity {
     }
 }
 
+/// The `/scene` message: every primitive of `scene` in one light grey entity `scene` at 0.
+pub fn scene_update(scene: &Scene) -> SceneUpdate {
+    let mut entity = entity("scene", 0);
+    let mut mesh = SceneMesh::new(scene);
+    mesh.add(0..scene.len());
+    entity.triangles.push(mesh.into_primitive(SCENE_COLOR));
+    update(vec![entity])
+}
+
 /// A scene update replacing the given entities.
 pub fn update(entities: Vec<SceneEntity>) -> SceneUpdate {
     SceneUpdate {

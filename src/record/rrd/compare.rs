@@ -22,9 +22,9 @@ use super::blueprint::{self, Layout, Node, View, ViewKind};
 use super::mesh::PrimMesh;
 use super::{BoxF32, SCENE_GREY, file_error, rel, send_at, send_static, sink};
 use crate::geom::P3;
-use crate::grouping::{Merge, SubsetTree, sah};
+use crate::grouping::{Merge, SubsetTree};
 use crate::record::boxes_drawn;
-use crate::record::compare::{CompareRun, divergence};
+use crate::record::compare::{CompareRun, earliest_divergence, log_lines};
 use crate::scene::Scene;
 use crate::wrap::{SphereMethod, sphere_tree};
 
@@ -81,18 +81,7 @@ fn recording_id(scene_name: &str, runs: &[CompareRun<'_>]) -> String {
         h.update(r.label.as_bytes());
         h.update((r.merges.len() as u64).to_le_bytes());
     }
-    let hex: String = h.finalize()[..16]
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    format!(
-        "{}-{}-{}-{}-{}",
-        &hex[..8],
-        &hex[8..12],
-        &hex[12..16],
-        &hex[16..20],
-        &hex[20..]
-    )
+    super::uuid_text(&h.finalize())
 }
 
 fn write_all(
@@ -126,12 +115,7 @@ fn write_all(
     send_static(rec, "scene/primitives", &prims)?;
 
     let n = scene.len();
-    let reference = runs[0].merges;
-    let splits: Vec<Option<usize>> = runs
-        .iter()
-        .map(|r| divergence(reference, r.merges))
-        .collect();
-    let first = splits.iter().flatten().copied().min();
+    let first = earliest_divergence(runs);
     let mut maxima = [0.0f64; 4];
     for (i, run) in runs.iter().enumerate() {
         let color = RUN_COLORS[i % RUN_COLORS.len()];
@@ -147,7 +131,7 @@ fn write_all(
             log_levels(rec, i, tree, scene, &origin)?;
         }
     }
-    log_text(rec, runs, &splits)?;
+    log_text(rec, runs)?;
 
     let last = runs
         .iter()
@@ -318,70 +302,20 @@ fn log_levels(
     Ok(())
 }
 
-/// The log: each run's label at tick 0, the divergence, each run's finish.
-fn log_text(
-    rec: &RecordingStream,
-    runs: &[CompareRun<'_>],
-    splits: &[Option<usize>],
-) -> anyhow::Result<()> {
-    let info = rerun::TextLogLevel::INFO;
-    let line = |tick: usize, text: String, level: &str| {
+/// The log ([`log_lines`]) on `log/compare`.
+fn log_text(rec: &RecordingStream, runs: &[CompareRun<'_>]) -> anyhow::Result<()> {
+    for l in log_lines(runs) {
+        let level = if l.warn {
+            rerun::TextLogLevel::WARN
+        } else {
+            rerun::TextLogLevel::INFO
+        };
         send_at(
             rec,
             "log/compare",
-            &[("merge", tick as i64)],
-            &rerun::TextLog::new(text).with_level(level),
-        )
-    };
-    for (i, r) in runs.iter().enumerate() {
-        line(
-            0,
-            format!("run {i}: {}, {} merges", r.label, r.merges.len()),
-            info,
+            &[("merge", l.merge as i64)],
+            &rerun::TextLog::new(l.text).with_level(level),
         )?;
-    }
-    let reference = &runs[0];
-    for (i, (r, split)) in runs.iter().zip(splits).enumerate().skip(1) {
-        let Some(k) = *split else {
-            line(
-                0,
-                format!("run {i} ({}) makes the same merges as run 0", r.label),
-                info,
-            )?;
-            continue;
-        };
-        let pair = |m: Option<&Merge>| {
-            m.map_or("no merge".into(), |m| {
-                format!("bodies {} + {} (Cost {:.6e})", m.a, m.b, m.cost)
-            })
-        };
-        line(
-            k,
-            format!(
-                "first divergence at merge {k}: run 0 ({}) merges {}, run {i} ({}) merges {}",
-                reference.label,
-                pair(reference.merges.get(k)),
-                r.label,
-                pair(r.merges.get(k)),
-            ),
-            rerun::TextLogLevel::WARN,
-        )?;
-    }
-    for (i, r) in runs.iter().enumerate() {
-        let text = match r.tree {
-            Some(t) => format!(
-                "run {i} ({}) finished: SAH {:.4}, depth {}",
-                r.label,
-                sah(t),
-                t.depth_max()
-            ),
-            None => format!(
-                "run {i} ({}) stopped after {} merges",
-                r.label,
-                r.merges.len()
-            ),
-        };
-        line(r.merges.len().saturating_sub(1), text, info)?;
     }
     Ok(())
 }

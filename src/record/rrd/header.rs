@@ -20,18 +20,7 @@ pub(super) fn recording_id(info: &RunInfo<'_>) -> String {
             .unwrap_or_default()
             .as_bytes(),
     );
-    let hex: String = h.finalize()[..16]
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    format!(
-        "{}-{}-{}-{}-{}",
-        &hex[..8],
-        &hex[8..12],
-        &hex[12..16],
-        &hex[16..20],
-        &hex[20..]
-    )
+    super::uuid_text(&h.finalize())
 }
 
 impl RrdRecorder {

@@ -114,6 +114,19 @@ impl BoxF32 {
     }
 }
 
+/// The first 16 bytes of `digest` as a UUID-shaped id (`8-4-4-4-12` hex digits).
+fn uuid_text(digest: &[u8]) -> String {
+    let hex: String = digest[..16].iter().map(|b| format!("{b:02x}")).collect();
+    format!(
+        "{}-{}-{}-{}-{}",
+        &hex[..8],
+        &hex[8..12],
+        &hex[12..16],
+        &hex[16..20],
+        &hex[20..]
+    )
+}
+
 /// `p` relative to `origin`, as `f32`.
 fn rel(p: &P3, origin: &P3) -> [f32; 3] {
     let d = p - origin;

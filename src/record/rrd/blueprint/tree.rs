@@ -20,6 +20,8 @@ use rerun::external::re_sdk_types::datatypes::{TimeInt, TimeRange, TimeRangeBoun
 use rerun::{RecordingStream, RecordingStreamBuilder};
 use sha2::{Digest, Sha256};
 
+use crate::record::rrd::uuid_text;
+
 /// A 3D eye: where it stands and what it looks at (world coordinates, Z up).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Eye {
@@ -92,18 +94,6 @@ impl Ids {
         id[8] = (id[8] & 0x3f) | 0x80;
         id
     }
-}
-
-fn uuid_text(id: &[u8; 16]) -> String {
-    let hex: String = id.iter().map(|b| format!("{b:02x}")).collect();
-    format!(
-        "{}-{}-{}-{}-{}",
-        &hex[..8],
-        &hex[8..12],
-        &hex[12..16],
-        &hex[16..20],
-        &hex[20..]
-    )
 }
 
 impl Layout {
