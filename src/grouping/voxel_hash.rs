@@ -308,7 +308,7 @@ impl VoxelHash {
 
     /// Removes body `id` (which must be stored).
     ///
-    /// In a cell of at least [`KEEP_ORDER`] records, a removed record among the sorted ones
+    /// In a cell of at least 32 records, a removed record among the sorted ones
     /// stays in place with id [`DEAD`] (so the order holds), until the dead and unsorted
     /// records are half the cell and it is compacted and sorted again.
     pub fn remove(&mut self, id: u32) {
