@@ -108,3 +108,23 @@ fn query_tree_prints_the_exact_distance() {
         .unwrap();
     assert!(!bad.status.success());
 }
+
+#[test]
+fn exact_timing_prints_one_tree_hash_for_both_thread_counts() {
+    let lamp = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/lamp.obj");
+    let out = run(
+        "exact_timing",
+        &["--threads", "1,2", "--repeat", "1", lamp.to_str().unwrap()],
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<Vec<&str>> = stdout
+        .lines()
+        .filter(|l| l.starts_with("| lamp |"))
+        .map(|l| l.split('|').map(str::trim).collect())
+        .collect();
+    assert_eq!(rows.len(), 2, "{stdout}");
+    let hash = |r: &Vec<&str>| r[r.len() - 2].to_string();
+    assert_eq!(hash(&rows[0]), hash(&rows[1]), "{stdout}");
+    assert_eq!(rows[0][3], "1");
+    assert_eq!(rows[1][3], "2");
+}

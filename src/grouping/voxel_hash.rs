@@ -9,7 +9,8 @@
 //! bodies made during the round; a full cell moves to the end of the arena with twice the room.
 //! Removal swaps the body with its cell's last record (O(1), the arena position of every body is
 //! kept). At build each cell's records are sorted by their boxes' smallest x, so the round-start
-//! scan can stop early in a cell; later insertions and removals do not keep that order. Each
+//! scan can stop early in a cell; insertions append after them and a removal keeps the order only
+//! of the records before its place ([`VoxelHash::sorted_len`]). Each
 //! cell also keeps the union of the boxes, the largest box minimum and smallest box maximum
 //! corner, and the largest and smallest diameter ever stored in it this round, so callers can
 //! bound the Cost of any pair with a body of that cell.
@@ -62,16 +63,22 @@ struct Cell {
     start: u32,
     len: u32,
     cap: u32,
+    /// How many leading records are still sorted by their boxes' smallest x.
+    sorted: u32,
     bounds: CellBounds,
 }
 
 /// Voxel coordinates are clamped to `0..=MAX_COORD` so keys never alias.
 const MAX_COORD: i64 = (1 << 42) - 1;
 const NO_CELL: u32 = u32::MAX;
+/// The id of a removed record left in place ([`VoxelHash::remove`]).
+pub const DEAD: u32 = u32::MAX;
+/// Cells of at least this many records keep their sorted records in order when one is removed.
+const KEEP_ORDER: u32 = 32;
 const BLANK: Rec = Rec {
     aabb: Aabb::EMPTY,
     diameter: 0.0,
-    id: u32::MAX,
+    id: DEAD,
     slot: u32::MAX,
 };
 
@@ -85,6 +92,8 @@ pub struct VoxelHash {
     dense: Vec<u32>,
     sparse: HashMap<u128, u32, foldhash::fast::FixedState>,
     cells: Vec<Cell>,
+    /// Removed records left in place in each cell.
+    dead: Vec<u32>,
     coords: Vec<[i64; 3]>,
     recs: Vec<Rec>,
     /// Arena position and cell of every body id (valid while the body is stored).
@@ -102,6 +111,7 @@ impl Default for VoxelHash {
             dense: Vec::new(),
             sparse: HashMap::with_hasher(foldhash::fast::FixedState::with_seed(0)),
             cells: Vec::new(),
+            dead: Vec::new(),
             coords: Vec::new(),
             recs: Vec::new(),
             at: Vec::new(),
@@ -132,6 +142,7 @@ impl VoxelHash {
         // Every body made this round lies inside the union of the active boxes.
         self.origin = [all.min.x, all.min.y, all.min.z];
         self.cells.clear();
+        self.dead.clear();
         self.coords.clear();
         self.recs.clear();
         self.sparse.clear();
@@ -174,13 +185,14 @@ impl VoxelHash {
                 },
             );
         }
-        for cell in &self.cells {
+        for cell in &mut self.cells {
             let (s, e) = (cell.start as usize, (cell.start + cell.len) as usize);
             let recs = &mut self.recs[s..e];
             recs.sort_unstable_by(|a, b| a.aabb.min.x.total_cmp(&b.aabb.min.x));
             for (i, r) in recs.iter().enumerate() {
                 self.at[r.id as usize].0 = (s + i) as u32;
             }
+            cell.sorted = cell.len;
         }
     }
 
@@ -228,8 +240,10 @@ impl VoxelHash {
             start: self.recs.len() as u32,
             len: 0,
             cap: 0,
+            sorted: 0,
             bounds: EMPTY_BOUNDS,
         });
+        self.dead.push(0);
         self.coords.push(v);
         c
     }
@@ -246,7 +260,10 @@ impl VoxelHash {
             self.recs.resize(start + cell.cap as usize, BLANK);
             self.recs.copy_within(from..from + len, start);
             for i in start..start + len {
-                self.at[self.recs[i].id as usize].0 = i as u32;
+                let id = self.recs[i].id;
+                if id != DEAD {
+                    self.at[id as usize].0 = i as u32;
+                }
             }
         }
         let cell = &mut self.cells[c as usize];
@@ -267,6 +284,12 @@ impl VoxelHash {
 
     /// Adds body `id` (partner-list slot `slot`) by the centre of its box.
     pub fn insert(&mut self, id: u32, aabb: &Aabb, diameter: f64, slot: u32) {
+        self.insert_rec(id, aabb, diameter, slot);
+        let c = self.at[id as usize].1;
+        self.tidy(c);
+    }
+
+    fn insert_rec(&mut self, id: u32, aabb: &Aabb, diameter: f64, slot: u32) {
         self.version += 1;
         if self.at.len() <= id as usize {
             self.at.resize(id as usize + 1, (0, NO_CELL));
@@ -284,16 +307,54 @@ impl VoxelHash {
     }
 
     /// Removes body `id` (which must be stored).
+    ///
+    /// In a cell of at least 32 records, a removed record among the sorted ones
+    /// stays in place with id [`DEAD`] (so the order holds), until the dead and unsorted
+    /// records are half the cell and it is compacted and sorted again.
     pub fn remove(&mut self, id: u32) {
         self.version += 1;
         let (i, c) = self.at[id as usize];
+        self.at[id as usize].1 = NO_CELL;
         let cell = &mut self.cells[c as usize];
+        if cell.len >= KEEP_ORDER && i - cell.start < cell.sorted {
+            self.recs[i as usize].id = DEAD;
+            self.dead[c as usize] += 1;
+            self.tidy(c);
+            return;
+        }
         cell.len -= 1;
+        // The records before `i` keep their order.
+        cell.sorted = cell.sorted.min(i - cell.start);
         let last = (cell.start + cell.len) as usize;
         self.recs.swap(i as usize, last);
         let moved = self.recs[i as usize].id;
-        self.at[moved as usize].0 = i;
-        self.at[id as usize].1 = NO_CELL;
+        if moved != DEAD {
+            self.at[moved as usize].0 = i;
+        }
+    }
+
+    /// Compacts and sorts cell `c` once its dead and unsorted records are half of it.
+    fn tidy(&mut self, c: u32) {
+        let cell = &mut self.cells[c as usize];
+        let messy = cell.len - cell.sorted + self.dead[c as usize];
+        if cell.len < KEEP_ORDER || 2 * messy <= cell.len {
+            return;
+        }
+        let s = cell.start as usize;
+        let recs = &mut self.recs[s..s + cell.len as usize];
+        recs.sort_unstable_by(|a, b| {
+            (a.id == DEAD)
+                .cmp(&(b.id == DEAD))
+                .then(a.aabb.min.x.total_cmp(&b.aabb.min.x))
+        });
+        let live = cell.len - self.dead[c as usize];
+        for (i, r) in recs[..live as usize].iter().enumerate() {
+            self.at[r.id as usize].0 = (s + i) as u32;
+        }
+        recs[live as usize..].fill(BLANK);
+        cell.len = live;
+        cell.sorted = live;
+        self.dead[c as usize] = 0;
     }
 
     /// A number that changes whenever the stored bodies or the voxel edge change.
@@ -307,11 +368,20 @@ impl VoxelHash {
         self.cells.len() as u32
     }
 
-    /// The records stored in cell `c`.
+    /// The records stored in cell `c`; after a removal, some may be [`DEAD`] (none right after
+    /// a build).
     #[inline]
     pub fn recs(&self, c: u32) -> &[Rec] {
         let cell = &self.cells[c as usize];
         &self.recs[cell.start as usize..(cell.start + cell.len) as usize]
+    }
+
+    /// How many leading records of cell `c` ([`VoxelHash::recs`]) are sorted by their boxes'
+    /// smallest x: all of them after a build, then those before the first removal's place
+    /// (insertions append after them).
+    #[inline]
+    pub fn sorted_len(&self, c: u32) -> usize {
+        self.cells[c as usize].sorted as usize
     }
 
     /// Asks the CPU to start loading the first records of cell `c` (a no-op off x86-64), so a

@@ -6,8 +6,12 @@
 //! counts only if the union of its boxes is within GLimit ([`reachable`]). For the AABB p-set,
 //! the round-start scan visits each pair of cells once (`pairs_once`), and a single search
 //! visits cells cheapest Cost bound first ([`cost_bound`]) and stops when no cell can improve
-//! its list, which is still exactly the first partners in key order (`scan_pruned`). Other
-//! p-sets search every candidate for the single best partner, as in the paper.
+//! its list, which is still exactly the first partners in key order (`scan_pruned`); in a cell
+//! whose records are sorted by smallest x it reads them outward from the searcher and stops each
+//! way at the first record no pair with could enter the list. Where the round's cells are
+//! crowded ([`CROWDED`]), the round-start scan runs that search for each body instead and counts
+//! the eligible pairs apart (`count_pairs`). Other p-sets search every candidate for the single
+//! best partner, as in the paper.
 //!
 //! With `--cost area` the bound and the `sqrt`-free filter ([`Quick`]) do not hold, so those
 //! searches visit every reachable cell (`docs/method.md`, "The Cost in surface area").
@@ -19,7 +23,7 @@ use crate::events::Observer;
 use crate::geom::surface_area;
 use crate::geom::{Aabb, P3, V3};
 use crate::grouping::mpairs::{K_MAX, List, Top};
-use crate::grouping::voxel_hash::CellBounds;
+use crate::grouping::voxel_hash::{CellBounds, DEAD, Rec};
 use crate::grouping::{CostMeasure, Weights};
 
 /// The last AABB search: the bits of its searcher's box and diameter and the voxel hash
@@ -120,6 +124,15 @@ fn apart(a: &Aabb, b: &Aabb, g: f64) -> bool {
     m > g
 }
 
+/// Sorted records a cell needs before a search sweeps them outward from the searcher rather
+/// than reading them all.
+const SWEEP_MIN: usize = 16;
+
+/// Average cell-mates per active body (Σ cell size² / bodies) above which the round-start
+/// scan searches each body's partners one body at a time (sweeping the sorted cells) and
+/// counts the eligible pairs apart, instead of costing every eligible pair once.
+const CROWDED: usize = 64;
+
 /// A Cost filter without `sqrt` or division for A = 1, C = 0, B in [1e-40, 1e40] and scene
 /// coordinates below 1e100 in magnitude (else `None`). There the Cost of a pair with merged
 /// squared diagonal `d2` and diameter sum `sum` > 0 is B·d2/sum within a few ulps, so
@@ -141,6 +154,18 @@ impl Quick {
     fn beyond(self, d2: f64, sum: f64, bar: f64) -> bool {
         let rhs = bar * sum * (1.0 + 1e-12);
         sum > 0.0 && d2 > 1e-250 && rhs > 1e-200 && d2 * self.b > rhs
+    }
+
+    /// Whether every pair of a body of diameter `dx` > 0 with a body of diameter at most `dmax`
+    /// whose merged squared diagonal is at least `s2` is certainly costlier than `bar`: then
+    /// [`Quick::beyond`] holds for each of them (its squared diagonal is no smaller, its
+    /// diameter sum no larger and at least `dx`).
+    #[inline(always)]
+    fn beyond_all(self, s2: f64, dx: f64, dmax: f64, bar: f64) -> bool {
+        dx > 0.0
+            && s2 > 1e-250
+            && bar * dx * (1.0 + 1e-12) > 1e-200
+            && s2 * self.b > bar * (dx + dmax) * (1.0 + 1e-12)
     }
 }
 
@@ -182,6 +207,60 @@ fn cost_bound<const A: u8>(w: &Weights, xa: &Aabb, dx: f64, cb: &CellBounds) -> 
     w.cost_scaled(scale, fill, 1.0) * (1.0 - 1e-9)
 }
 
+/// Whether every box stored in a cell with bounds `a` is within L∞ gap `g` ≥ 0 of every box
+/// stored in one with bounds `b`: per axis, the largest box minimum of one minus the smallest
+/// box maximum of the other is at most `g` (as rounded, it bounds each pair's difference).
+#[inline]
+fn within(a: &CellBounds, b: &CellBounds, g: f64) -> bool {
+    (0..3).all(|k| b.max_lo[k] - a.min_hi[k] <= g && a.max_lo[k] - b.min_hi[k] <= g)
+}
+
+/// The records of `recs` (sorted by smallest x, finite) not [`apart`] from `xa`, and the number
+/// read before the rest lie beyond GLimit in x.
+#[inline]
+fn count_near(xa: &Aabb, recs: &[Rec], g: f64) -> (u64, u64) {
+    let end = recs.partition_point(|r| r.aabb.min.x - xa.max.x <= g);
+    let near = recs[..end]
+        .iter()
+        .filter(|r| !apart(xa, &r.aabb, g))
+        .count();
+    (near as u64, end as u64)
+}
+
+/// What a single search offers each record with.
+struct Searcher<'t> {
+    xa: Aabb,
+    dx: f64,
+    glimit: f64,
+    quick: Option<Quick>,
+    area: bool,
+    w: Weights,
+    wide: usize,
+    tags: &'t [u64],
+}
+
+impl Searcher<'_> {
+    /// Offers record `r` (skipped if [`DEAD`]) to `list`, whose bar is `bar`; returns the
+    /// list's bar after.
+    #[inline(always)]
+    fn visit<const A: u8>(&self, r: &Rec, bar: f64, list: &mut Top<{ K_MAX + 1 }>) -> f64 {
+        let xa = &self.xa;
+        if r.id == DEAD || apart(xa, &r.aabb, self.glimit) {
+            return bar;
+        }
+        let e = merged_extents(xa, &r.aabb);
+        if let Some(q) = self.quick
+            && q.beyond(e.norm_squared(), self.dx + r.diameter, bar)
+        {
+            return bar;
+        }
+        let (d, sx, sy) = measures(self.area, &e, xa, self.dx, &r.aabb, r.diameter);
+        let cost = pair_cost::<A>(&self.w, d, sx, sy);
+        list.offer(self.wide, cost, r.id, self.tags);
+        list.bar(self.wide)
+    }
+}
+
 /// Whether a cell may hold an eligible partner of a body with box `xa`: the L∞ gap to the
 /// union of the cell's boxes is at most GLimit (it is at most the gap to any of them, also as
 /// rounded).
@@ -210,6 +289,17 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             let a = self.params.weights.a;
             // The parallel scan computes the diameter Cost only; the area Cost scans in order.
             let area = self.params.mode.cost == CostMeasure::Area;
+            let quick = Quick::new(&self.params.weights, self.quick && !area).is_some();
+            if quick && glimit >= 0.0 && limit.budget.max_pairs.is_none() && self.crowded() {
+                let pairs = self.count_pairs(glimit);
+                for &x in order {
+                    if limit.over(0) {
+                        break;
+                    }
+                    self.search(x, glimit);
+                }
+                return pairs;
+            }
             if !area && par::worth_it(order.len(), limit) {
                 if a == 1.0 {
                     self.pairs_once_par::<1>(glimit, limit)
@@ -236,6 +326,71 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             }
             twice / 2
         }
+    }
+
+    /// Whether the round's cells are crowded ([`CROWDED`]).
+    fn crowded(&self) -> bool {
+        let hash = &self.hash;
+        let (mut bodies, mut mates) = (0usize, 0usize);
+        for c in 0..hash.cells() {
+            let n = hash.recs(c).len();
+            bodies += n;
+            mates += n * n;
+        }
+        mates > CROWDED * bodies
+    }
+
+    /// The number of eligible pairs among the stored bodies (fresh cells, finite boxes, GLimit
+    /// ≥ 0), as [`Clusterer::pairs_once`] counts them: a pair of cells whose every two boxes
+    /// are within GLimit adds the product of their sizes without reading the records.
+    fn count_pairs(&mut self, glimit: f64) -> u64 {
+        let hash = &self.hash;
+        let mut pairs = 0u64;
+        let mut candidates = 0u64;
+        let mut near: Vec<u32> = Vec::with_capacity(27);
+        for c in 0..hash.cells() {
+            let vc = hash.coords(c);
+            let recs = hash.recs(c);
+            let (mut clo, mut chi) = (
+                P3::new(f64::MAX, f64::MAX, f64::MAX),
+                P3::new(f64::MIN, f64::MIN, f64::MIN),
+            );
+            for r in recs {
+                let (lo, hi) = self.query(&r.aabb, glimit);
+                clo = clo.inf(&lo);
+                chi = chi.sup(&hi);
+            }
+            near.clear();
+            hash.for_each_cell(&clo, &chi, |cell, v| {
+                if v > vc && !apart(&hash.bounds(c).union, &hash.bounds(cell).union, glimit) {
+                    near.push(cell);
+                }
+            });
+            let n = recs.len() as u64;
+            if within(hash.bounds(c), hash.bounds(c), glimit) {
+                pairs += n * n.saturating_sub(1) / 2;
+            } else {
+                for (i, x) in recs.iter().enumerate() {
+                    let (m, seen) = count_near(&x.aabb, &recs[i + 1..], glimit);
+                    pairs += m;
+                    candidates += seen;
+                }
+            }
+            for &cell in &near {
+                let other = hash.recs(cell);
+                if within(hash.bounds(c), hash.bounds(cell), glimit) {
+                    pairs += n * other.len() as u64;
+                } else {
+                    for x in recs {
+                        let (m, seen) = count_near(&x.aabb, other, glimit);
+                        pairs += m;
+                        candidates += seen;
+                    }
+                }
+            }
+        }
+        self.stats.candidates += candidates;
+        pairs
     }
 
     /// Step 4(b) (and a used-up list): refills `x`'s partner list.
@@ -413,26 +568,57 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             &mut overflow
         };
         let quick = Quick::new(&w, self.quick && !area);
+        let me = Searcher {
+            xa,
+            dx,
+            glimit,
+            quick,
+            area,
+            w,
+            wide,
+            tags,
+        };
+        let visit = |r: &Rec, bar: f64, list: &mut Top<{ K_MAX + 1 }>| me.visit::<A>(r, bar, list);
         for &(bound, cell) in cells.iter() {
             let mut bar = list.bar(wide);
             if bound > bar {
                 break;
             }
-            for r in hash.recs(cell) {
+            let recs = hash.recs(cell);
+            let sorted = hash.sorted_len(cell);
+            let (head, tail) = match quick {
+                Some(q) if sorted >= SWEEP_MIN && dx > 0.0 => {
+                    // The sorted head, outward from `x`'s smallest x: the merged box's x extent
+                    // is at least the distance between the two smallest x (rightward) or from
+                    // the other's smallest x to `x`'s largest (leftward), and grows with each
+                    // step, so a direction ends at the first record beyond the bar.
+                    let (head, tail) = recs.split_at(sorted);
+                    let dmax = hash.bounds(cell).dmax;
+                    let at = head.partition_point(|r| r.aabb.min.x < xa.min.x);
+                    for r in &head[at..] {
+                        let s = r.aabb.min.x - xa.min.x;
+                        if q.beyond_all(s * s, dx, dmax, bar) {
+                            break;
+                        }
+                        candidates += 1;
+                        bar = visit(r, bar, &mut list);
+                    }
+                    for r in head[..at].iter().rev() {
+                        let s = xa.max.x - r.aabb.min.x;
+                        if q.beyond_all(s * s, dx, dmax, bar) {
+                            break;
+                        }
+                        candidates += 1;
+                        bar = visit(r, bar, &mut list);
+                    }
+                    (head, tail)
+                }
+                _ => (&recs[..0], recs),
+            };
+            debug_assert!(head.len() + tail.len() == recs.len());
+            for r in tail {
                 candidates += 1;
-                if apart(&xa, &r.aabb, glimit) {
-                    continue;
-                }
-                let e = merged_extents(&xa, &r.aabb);
-                if let Some(q) = quick
-                    && q.beyond(e.norm_squared(), dx + r.diameter, bar)
-                {
-                    continue;
-                }
-                let (d, sx, sy) = measures(area, &e, &xa, dx, &r.aabb, r.diameter);
-                let cost = pair_cost::<A>(&w, d, sx, sy);
-                list.offer(wide, cost, r.id, tags);
-                bar = list.bar(wide);
+                bar = visit(r, bar, &mut list);
             }
         }
         self.stats.candidates += candidates;
@@ -455,7 +641,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         hash.for_each_cell(&lo, &hi, |cell, _| {
             for r in hash.recs(cell) {
                 candidates += 1;
-                if r.id == x || apart(&xa, &r.aabb, glimit) {
+                if r.id == x || r.id == DEAD || apart(&xa, &r.aabb, glimit) {
                     continue;
                 }
                 let merged = xa.merge(&r.aabb);
