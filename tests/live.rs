@@ -458,14 +458,19 @@ fn a_missing_viewer_holds_neither_the_run_nor_the_files_up() {
         assert!(out.status.success(), "{out:?}");
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(stderr.lines().count(), 1, "{stderr}");
-        let why = if port == closed {
-            "no Rerun viewer answered at"
+        // A silent viewer either never answers the final flush, or, when the client's buffer
+        // fills first (the two layouts make a run's stream longer), stops taking messages.
+        let why: &[&str] = if port == closed {
+            &["no Rerun viewer answered at"]
         } else {
-            "did not take the stream: no answer within 10 s"
+            &[
+                "did not take the stream: no answer within 10 s",
+                "stopped taking the stream",
+            ]
         };
         assert!(
             stderr.starts_with("warning: live Rerun: ")
-                && stderr.contains(why)
+                && why.iter().any(|w| stderr.contains(w))
                 && stderr.contains("the files are complete"),
             "{stderr}"
         );
