@@ -8,16 +8,14 @@
 //! divergence, each run's finish). Merge k of every run is at log time k + 1 ms, so the runs
 //! share one timeline; the file is chunked, zstd-compressed, and the same runs give the same bytes.
 
-use std::collections::BTreeMap;
-use std::io::BufWriter;
+use std::io::{BufWriter, Seek, Write};
 
-use anyhow::{Context, Result, anyhow};
-use foxglove::Encode;
+use anyhow::{Context, Result};
 use foxglove::messages::{Log, SceneUpdate, Timestamp};
 
 use super::messages::MergeEvent;
 use super::scene_msgs;
-use super::{CHUNK_SIZE, LIBRARY, PROFILE, ZSTD_LEVEL};
+use super::{Out, Topic, ZSTD_LEVEL, add_schema, add_topic, emit, write_options};
 use crate::output::Pending;
 use crate::record::boxes_drawn;
 use crate::record::compare::{CompareRun, LogLine, earliest_divergence, log_lines};
@@ -33,38 +31,6 @@ fn at(k: usize) -> u64 {
     (k as u64 + 1) * 1_000_000
 }
 
-struct Writer<W: std::io::Write + std::io::Seek> {
-    mcap: mcap::Writer<W>,
-    seq: BTreeMap<u16, u32>,
-    buf: Vec<u8>,
-}
-
-impl<W: std::io::Write + std::io::Seek> Writer<W> {
-    fn topic<T: Encode>(&mut self, name: &str) -> Result<u16> {
-        let s = T::get_schema().ok_or_else(|| anyhow!("message type without a schema"))?;
-        let schema = self.mcap.add_schema(&s.name, &s.encoding, &s.data)?;
-        Ok(self
-            .mcap
-            .add_channel(schema, name, "protobuf", &BTreeMap::new())?)
-    }
-
-    fn emit<T: Encode>(&mut self, channel: u16, t_ns: u64, msg: &T) -> Result<()> {
-        self.buf.clear();
-        msg.encode(&mut self.buf)
-            .map_err(|e| anyhow!("encoding a message: {e}"))?;
-        let seq = self.seq.entry(channel).or_insert(0);
-        let header = mcap::records::MessageHeader {
-            channel_id: channel,
-            sequence: *seq,
-            log_time: t_ns,
-            publish_time: t_ns,
-        };
-        *seq += 1;
-        self.mcap.write_to_known_channel(&header, &self.buf)?;
-        Ok(())
-    }
-}
-
 /// Writes the `.mcap` comparison of `runs` over `scene` (named `scene_name`) into `file`.
 pub fn write_comparison_mcap(
     file: &Pending,
@@ -78,25 +44,35 @@ pub fn write_comparison_mcap(
 }
 
 fn write(file: &Pending, scene: &Scene, scene_name: &str, runs: &[CompareRun<'_>]) -> Result<()> {
-    let options = mcap::WriteOptions::new()
-        .compression(Some(mcap::Compression::Zstd))
-        .compression_level(ZSTD_LEVEL)
-        .chunk_size(Some(CHUNK_SIZE))
-        .use_chunks(true)
-        .profile(PROFILE)
-        .library(LIBRARY);
-    let mut w = Writer {
+    let options = write_options(Some(mcap::Compression::Zstd), ZSTD_LEVEL);
+    let mut w = Out {
         mcap: options.create(BufWriter::new(file.file()?))?,
-        seq: BTreeMap::new(),
-        buf: Vec::new(),
+        live: None,
     };
-    let scene_topic = w.topic::<SceneUpdate>("/scene")?;
-    let log_topic = w.topic::<Log>("/compare/log")?;
-    w.emit(scene_topic, 0, &scene_msgs::scene_update(scene))?;
+    let buf = &mut Vec::new();
+    let scene_update = add_schema::<SceneUpdate, _>(&mut w)?;
+    let mut scene_topic = add_topic(&mut w, scene_update, "/scene")?;
+    let log_schema = add_schema::<Log, _>(&mut w)?;
+    let mut log_topic = add_topic(&mut w, log_schema, "/compare/log")?;
+    emit(
+        &mut w,
+        buf,
+        &mut scene_topic,
+        0,
+        &scene_msgs::scene_update(scene),
+    )?;
 
     let first = earliest_divergence(runs);
+    let merge_schema = add_schema::<MergeEvent, _>(&mut w)?;
     for (i, run) in runs.iter().enumerate() {
-        write_run(&mut w, i, run, scene, first)?;
+        let mut topic =
+            |name: &str, schema| add_topic(&mut w, schema, &format!("/runs/{i}/{name}"));
+        let topics = [
+            topic("merge", merge_schema)?,
+            topic("bodies", scene_update)?,
+            topic("divergence", scene_update)?,
+        ];
+        write_run(&mut w, buf, topics, run, scene, first)?;
     }
     let heading = LogLine {
         merge: 0,
@@ -123,7 +99,7 @@ fn write(file: &Pending, scene: &Scene, scene_name: &str, runs: &[CompareRun<'_>
             file: String::new(),
             line: 0,
         };
-        w.emit(log_topic, t, &log)?;
+        emit(&mut w, buf, &mut log_topic, t, &log)?;
     }
     w.mcap.finish()?;
     let inner = w
@@ -135,39 +111,34 @@ fn write(file: &Pending, scene: &Scene, scene_name: &str, runs: &[CompareRun<'_>
     Ok(())
 }
 
-/// Run `i`'s merges, drawn boxes and divergence mark.
-fn write_run<W: std::io::Write + std::io::Seek>(
-    w: &mut Writer<W>,
-    i: usize,
+/// A run's merges, drawn boxes and divergence mark, on its `[merge, bodies, divergence]`
+/// topics.
+fn write_run<W: Write + Seek>(
+    w: &mut Out<W>,
+    buf: &mut Vec<u8>,
+    [mut merge_topic, mut bodies_topic, mut divergence_topic]: [Topic; 3],
     run: &CompareRun<'_>,
     scene: &Scene,
     first: Option<usize>,
 ) -> Result<()> {
-    let merge_topic = w.topic::<MergeEvent>(&format!("/runs/{i}/merge"))?;
-    let bodies_topic = w.topic::<SceneUpdate>(&format!("/runs/{i}/bodies"))?;
-    let divergence_topic = w.topic::<SceneUpdate>(&format!("/runs/{i}/divergence"))?;
     let n = scene.len();
     let mut boxes: Vec<_> = (0..n).map(|p| scene.prim_aabb(p)).collect();
     for (k, m) in run.merges.iter().enumerate() {
-        w.emit(merge_topic, at(k), &MergeEvent::from(m))?;
+        emit(w, buf, &mut merge_topic, at(k), &MergeEvent::from(m))?;
         let near = first.is_some_and(|f| k.abs_diff(f) <= AROUND);
         if let (true, Some(a), Some(b)) = (
             boxes_drawn(m.step, n) || near,
             boxes.get(m.a as usize),
             boxes.get(m.b as usize),
         ) {
-            let mut e = scene_msgs::entity("merge", at(k));
-            e.cubes = vec![
-                scene_msgs::cube(a, scene_msgs::PAIR_COLOR),
-                scene_msgs::cube(b, scene_msgs::PAIR_COLOR),
-                scene_msgs::cube(&m.aabb, scene_msgs::NEW_COLOR),
-            ];
-            w.emit(bodies_topic, at(k), &scene_msgs::update(vec![e]))?;
+            let update = scene_msgs::merge_boxes(a, b, &m.aabb, at(k));
+            emit(w, buf, &mut bodies_topic, at(k), &update)?;
         }
         if first == Some(k) {
             let mut e = scene_msgs::entity("divergence", at(k));
             e.cubes = vec![scene_msgs::cube(&m.aabb, DIVERGENCE_COLOR)];
-            w.emit(divergence_topic, at(k), &scene_msgs::update(vec![e]))?;
+            let update = scene_msgs::update(vec![e]);
+            emit(w, buf, &mut divergence_topic, at(k), &update)?;
         }
         boxes.push(m.aabb);
     }

@@ -172,6 +172,25 @@ fn add_topic<W: Write + Seek>(w: &mut Out<W>, schema: u16, name: &str) -> Result
     Ok(Topic { id, seq: 0 })
 }
 
+/// The options of every `.mcap` this crate writes: chunks of [`CHUNK_SIZE`] compressed as
+/// given, every CRC on, written front to back.
+fn write_options(compression: Option<mcap::Compression>, level: u32) -> mcap::WriteOptions {
+    mcap::WriteOptions::new()
+        .compression(compression)
+        .compression_level(level)
+        .chunk_size(Some(CHUNK_SIZE))
+        .use_chunks(true)
+        // Each chunk is built in memory and then appended: the file is written front to
+        // back, never rewound (so it can bypass the page cache, `record::direct`).
+        .disable_seeking(true)
+        .profile(PROFILE)
+        .library(LIBRARY)
+        .calculate_chunk_crcs(true)
+        .calculate_data_section_crc(true)
+        .calculate_summary_section_crc(true)
+        .calculate_attachment_crcs(true)
+}
+
 /// Encodes `msg` into `buf` and writes it on `topic` at `t_ns`.
 fn emit<T: Encode, W: Write + Seek>(
     w: &mut Out<W>,
@@ -230,20 +249,7 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             Compression::Lz4 => (Some(mcap::Compression::Lz4), LZ4_LEVEL),
             Compression::Zstd => (Some(mcap::Compression::Zstd), ZSTD_LEVEL),
         };
-        let options = mcap::WriteOptions::new()
-            .compression(compression)
-            .compression_level(level)
-            .chunk_size(Some(CHUNK_SIZE))
-            .use_chunks(true)
-            // Each chunk is built in memory and then appended: the file is written front to
-            // back, never rewound (so it can bypass the page cache, `record::direct`).
-            .disable_seeking(true)
-            .profile(PROFILE)
-            .library(LIBRARY)
-            .calculate_chunk_crcs(true)
-            .calculate_data_section_crc(true)
-            .calculate_summary_section_crc(true)
-            .calculate_attachment_crcs(true);
+        let options = write_options(compression, level);
         let mcap = options.create(writer).context("starting the MCAP file")?;
         let mut w = Out { mcap, live };
         let scene_update = add_schema::<SceneUpdate, W>(&mut w)?;
@@ -448,14 +454,9 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
         self.bodies[new] = m.aabb;
         let drawn = crate::record::boxes_drawn(m.step, self.info.scene.len());
         if let Some(bodies_topic) = self.topics.bodies.as_mut().filter(|_| drawn) {
-            let mut e = scene_msgs::entity("merge", t);
             let get = |id: u32| self.bodies.get(id as usize).copied().unwrap_or(Aabb::EMPTY);
-            e.cubes = vec![
-                scene_msgs::cube(&get(m.a), scene_msgs::PAIR_COLOR),
-                scene_msgs::cube(&get(m.b), scene_msgs::PAIR_COLOR),
-                scene_msgs::cube(&m.aabb, scene_msgs::NEW_COLOR),
-            ];
-            emit(w, buf, bodies_topic, t, &scene_msgs::update(vec![e]))?;
+            let update = scene_msgs::merge_boxes(&get(m.a), &get(m.b), &m.aabb, t);
+            emit(w, buf, bodies_topic, t, &update)?;
         }
         Ok(())
     }

@@ -74,6 +74,17 @@ pub fn scene_update(scene: &Scene) -> SceneUpdate {
     update(vec![entity])
 }
 
+/// One merge at `t_ns` as entity `merge`: the merged pair's boxes `a`, `b` and the new body's.
+pub fn merge_boxes(a: &Aabb, b: &Aabb, new: &Aabb, t_ns: u64) -> SceneUpdate {
+    let mut e = entity("merge", t_ns);
+    e.cubes = vec![
+        cube(a, PAIR_COLOR),
+        cube(b, PAIR_COLOR),
+        cube(new, NEW_COLOR),
+    ];
+    update(vec![e])
+}
+
 /// A scene update replacing the given entities.
 pub fn update(entities: Vec<SceneEntity>) -> SceneUpdate {
     SceneUpdate {

@@ -41,14 +41,14 @@ const PAIR_ORANGE: u32 = 0xFF8C00FF;
 /// Green of the new body's box.
 const NEW_GREEN: u32 = 0x2EB82EFF;
 
-/// Logs the static colours and line widths of the per-merge boxes: the pair's two, then the new
-/// body's (Rerun pairs the i-th colour and radius with the i-th box of each row).
-pub(super) fn log_styles(rec: &RecordingStream) -> anyhow::Result<()> {
+/// Logs at `path` the static colours and line widths of the per-merge boxes: the pair's two,
+/// then the new body's (Rerun pairs the i-th colour and radius with the i-th box of each row).
+pub(super) fn log_styles(rec: &RecordingStream, path: &str) -> anyhow::Result<()> {
     use rerun::components::{FillMode, Radius};
     let (pair, new) = (Radius::new_ui_points(2.0), Radius::new_ui_points(2.5));
     super::send_static(
         rec,
-        "grouping/merge",
+        path,
         &rerun::Boxes3D::update_fields()
             .with_colors([PAIR_ORANGE, PAIR_ORANGE, NEW_GREEN])
             .with_radii([pair, pair, new])

@@ -19,8 +19,9 @@ use rerun::RecordingStream;
 use rerun::components::FillMode;
 
 use super::blueprint::{self, Layout, Node, View, ViewKind};
+use super::levels::level_spheres;
 use super::mesh::PrimMesh;
-use super::{BoxF32, SCENE_GREY, file_error, rel, send_at, send_static, sink};
+use super::{BoxF32, SCENE_GREY, columns, file_error, origin_of, send_at, send_static, sink};
 use crate::geom::P3;
 use crate::grouping::{Merge, SubsetTree};
 use crate::record::boxes_drawn;
@@ -32,12 +33,8 @@ use crate::wrap::{SphereMethod, sphere_tree};
 const RUN_COLORS: [u32; 6] = [
     0x1F77B4FF, 0xFF7F0EFF, 0x2CA02CFF, 0xD62728FF, 0x9467BDFF, 0x8C564BFF,
 ];
-/// Orange of a merged pair, green of the new body, magenta of the divergence.
-const PAIR_ORANGE: u32 = 0xFF8C00FF;
-const NEW_GREEN: u32 = 0x2EB82EFF;
+/// Magenta of the divergence.
 const DIVERGENCE: u32 = 0xFF00FFFF;
-/// Translucent blue of the level spheres.
-const SPHERE_BLUE: u32 = 0x1E90FF40;
 /// Merges drawn before and after the first divergence, besides the last [`BODIES_CAP`](crate::record::BODIES_CAP).
 const AROUND: u32 = 256;
 
@@ -92,12 +89,7 @@ fn write_all(
     id: &str,
 ) -> anyhow::Result<()> {
     let bbox = scene.aabb();
-    let c = bbox.center();
-    let origin = if c.iter().all(|x| x.is_finite()) {
-        c
-    } else {
-        P3::origin()
-    };
+    let origin = origin_of(&bbox);
     let labels: Vec<&str> = runs.iter().map(|r| r.label.as_str()).collect();
     rec.send_recording_name(format!("{scene_name}: {}", labels.join(" vs ")))?;
     send_static(rec, "/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
@@ -105,14 +97,12 @@ fn write_all(
         rerun::Transform3D::from_translation([origin.x, origin.y, origin.z].map(|v| v as f32));
     send_static(rec, "scene", &shift)?;
     send_static(rec, "runs", &shift)?;
-    let mesh = PrimMesh::new(scene, &origin);
-    let mut prims = rerun::Mesh3D::new(mesh.positions.iter().copied())
-        .with_vertex_normals(mesh.normals.iter().copied())
-        .with_albedo_factor(SCENE_GREY);
-    if !mesh.sequential() {
-        prims = prims.with_triangle_indices(mesh.all_tris().iter().copied());
-    }
-    send_static(rec, "scene/primitives", &prims)?;
+    let prims = PrimMesh::new(scene, &origin).to_mesh3d();
+    send_static(
+        rec,
+        "scene/primitives",
+        &prims.with_albedo_factor(SCENE_GREY),
+    )?;
 
     let n = scene.len();
     let first = earliest_divergence(runs);
@@ -222,18 +212,7 @@ fn log_merges(
         boxes.push(new);
     }
     let path = format!("runs/{i}/merge");
-    let (pair, grown) = (
-        rerun::components::Radius::new_ui_points(2.0),
-        rerun::components::Radius::new_ui_points(2.5),
-    );
-    send_static(
-        rec,
-        &path,
-        &rerun::Boxes3D::update_fields()
-            .with_colors([PAIR_ORANGE, PAIR_ORANGE, NEW_GREEN])
-            .with_radii([pair, pair, grown])
-            .with_fill_mode(FillMode::MajorWireframe),
-    )?;
+    columns::log_styles(rec, &path)?;
     if merge.is_empty() {
         return Ok(());
     }
@@ -285,18 +264,9 @@ fn log_levels(
     let spheres = sphere_tree(tree, scene, SphereMethod::default());
     let path = format!("runs/{i}/levels/spheres");
     for d in 0..=tree.depth_max() {
-        let (centers, radii): (Vec<_>, Vec<_>) = tree
-            .level(d)
-            .into_iter()
-            .filter(|&x| !tree.is_leaf(x))
-            .map(|x| {
-                let s = &spheres[x as usize];
-                (rel(&s.center, origin), s.radius as f32)
-            })
-            .unzip();
-        let arch = rerun::Ellipsoids3D::from_centers_and_radii(centers, radii)
-            .with_colors([SPHERE_BLUE])
-            .with_fill_mode(FillMode::TransparentFillMajorWireframe);
+        let mut interior = tree.level(d);
+        interior.retain(|&x| !tree.is_leaf(x));
+        let arch = level_spheres(&interior, &spheres, origin);
         send_at(rec, &path, &[("level", i64::from(d))], &arch)?;
     }
     Ok(())

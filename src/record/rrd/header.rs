@@ -45,7 +45,7 @@ impl RrdRecorder {
             send_static(rec, path, &lines)?;
         }
         if self.detail.merges() {
-            columns::log_styles(rec)?;
+            columns::log_styles(rec, "grouping/merge")?;
             send_static(
                 rec,
                 "grouping/active",
@@ -122,14 +122,7 @@ fn send_run_properties(rec: &RecordingStream, info: &RunInfo<'_>) -> anyhow::Res
 /// component.
 fn scene_primitives(info: &RunInfo<'_>, mesh: &PrimMesh) -> rerun::Mesh3D {
     let scene = info.scene;
-    let primitives = rerun::Mesh3D::new(mesh.positions.iter().copied())
-        .with_vertex_normals(mesh.normals.iter().copied());
-    // Without indices the viewer reads each three positions as a triangle.
-    let primitives = if mesh.sequential() {
-        primitives
-    } else {
-        primitives.with_triangle_indices(mesh.all_tris().iter().copied())
-    };
+    let primitives = mesh.to_mesh3d();
     match info.params.mode.pregroup {
         Pregroup::None => primitives.with_albedo_factor(SCENE_GREY),
         Pregroup::Objects => {

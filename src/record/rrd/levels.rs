@@ -195,7 +195,11 @@ fn leaves_by_depth(tree: &SubsetTree) -> Vec<Vec<u32>> {
 }
 
 /// The cut's `interior` nodes as translucent spheres (none when `spheres` is empty).
-fn level_spheres(interior: &[u32], spheres: &[Sphere], origin: &P3) -> rerun::Ellipsoids3D {
+pub(super) fn level_spheres(
+    interior: &[u32],
+    spheres: &[Sphere],
+    origin: &P3,
+) -> rerun::Ellipsoids3D {
     let (centers, radii): (Vec<_>, Vec<_>) = interior
         .iter()
         .filter(|_| !spheres.is_empty())

@@ -123,6 +123,19 @@ impl PrimMesh {
     }
 
     /// Triangles of primitive `i`.
+    /// The whole mesh as one shaded `Mesh3D` (positions, normals, and the triangles unless
+    /// they are the positions in order), without colour.
+    pub(super) fn to_mesh3d(&self) -> rerun::Mesh3D {
+        let mesh = rerun::Mesh3D::new(self.positions.iter().copied())
+            .with_vertex_normals(self.normals.iter().copied());
+        // Without indices the viewer reads each three positions as a triangle.
+        if self.sequential() {
+            mesh
+        } else {
+            mesh.with_triangle_indices(self.all_tris().iter().copied())
+        }
+    }
+
     pub(super) fn prim_tris(&self, i: u32) -> &[[u32; 3]] {
         &self.tris[self.tri_start[i as usize] as usize..self.tri_start[i as usize + 1] as usize]
     }

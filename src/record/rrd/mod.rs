@@ -127,6 +127,17 @@ fn uuid_text(digest: &[u8]) -> String {
     )
 }
 
+/// Where positions are measured from: the centre of the scene's box `bbox`, or the world origin
+/// when it is not finite (an empty scene).
+fn origin_of(bbox: &Aabb) -> P3 {
+    let c = bbox.center();
+    if c.iter().all(|x| x.is_finite()) {
+        c
+    } else {
+        P3::origin()
+    }
+}
+
 /// `p` relative to `origin`, as `f32`.
 fn rel(p: &P3, origin: &P3) -> [f32; 3] {
     let d = p - origin;
@@ -222,12 +233,7 @@ impl RrdRecorder {
             .spawn(move || layout.send(&bp_rec, &seed))
             .map_err(|e| file_error(name, "cannot start the blueprint thread", e))?;
 
-        let center = bbox.center();
-        let origin = if center.iter().all(|c| c.is_finite()) {
-            center
-        } else {
-            P3::origin()
-        };
+        let origin = origin_of(&bbox);
         let boxes = if info.detail.merges() {
             let mut b = Vec::with_capacity(2 * scene.len());
             b.extend((0..scene.len()).map(|i| BoxF32::new(&scene.prim_aabb(i), &origin)));
