@@ -2,18 +2,10 @@
 
 mod common;
 
-use common::wraptree;
+use common::{scene, wraptree};
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn scene(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
-        .join(name)
-        .display()
-        .to_string()
-}
 
 #[test]
 fn group_json_has_the_tree() {

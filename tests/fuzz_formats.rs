@@ -14,7 +14,7 @@
 
 mod common;
 
-use common::mutate::{at, lines, number_tokens};
+use common::mutate::{at, delete_or_duplicate_line, number_tokens};
 
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
@@ -168,17 +168,8 @@ fn apply(text: &mut Vec<u8>, m: &Mutation, seeds: &[(&str, Vec<u8>)]) {
             }
         }
         Mutation::DeleteLine(k) | Mutation::DuplicateLine(k) => {
-            let ls = lines(text);
-            if ls.is_empty() {
-                return;
-            }
-            let (a, b) = ls[k % ls.len()];
-            if matches!(m, Mutation::DeleteLine(_)) {
-                text.drain(a..b);
-            } else {
-                let copy = text[a..b].to_vec();
-                text.splice(b..b, copy);
-            }
+            let delete = matches!(m, Mutation::DeleteLine(_));
+            delete_or_duplicate_line(text, k, delete);
         }
     }
 }

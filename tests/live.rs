@@ -19,15 +19,8 @@ use std::process::{Child, Command, Output, Stdio};
 use std::sync::mpsc::{Receiver, channel};
 use std::time::{Duration, Instant};
 
+use common::scene;
 use sha2::{Digest, Sha256};
-
-fn scene(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
-        .join(name)
-        .display()
-        .to_string()
-}
 
 /// A port nobody listens on right now.
 fn free_port() -> u16 {
@@ -238,21 +231,28 @@ fn primitives(dir: &Path, scene: &str) -> u64 {
     v["primitives"].as_u64().expect("primitives")
 }
 
-#[test]
-fn connect_streams_to_a_rerun_receiver_the_recording_the_file_holds() {
-    let dir = tempfile::tempdir().unwrap();
-    let port = free_port();
-    let received = dir.path().join("received.rrd");
-    let mut receiver = Proc::start(
+/// A viewer-less `rerun` listening on `port` that saves what it receives to `received`, once it
+/// accepts connections.
+fn save_receiver(port: u16, received: &Path) -> Proc {
+    let receiver = Proc::start(
         "rerun --save",
         Command::new(rerun_exe())
             .args(["--port", &port.to_string(), "--save"])
-            .arg(&received)
+            .arg(received)
             .stdin(Stdio::null())
             .stdout(Stdio::null())
             .stderr(Stdio::null()),
     );
     wait_for_port(port, Duration::from_secs(30));
+    receiver
+}
+
+#[test]
+fn connect_streams_to_a_rerun_receiver_the_recording_the_file_holds() {
+    let dir = tempfile::tempdir().unwrap();
+    let port = free_port();
+    let received = dir.path().join("received.rrd");
+    let mut receiver = save_receiver(port, &received);
     let url = format!("--connect=rerun+http://127.0.0.1:{port}/proxy");
     let lamp = scene("lamp.obj");
     let out = wraptree(dir.path(), &["record", &lamp, "-o", "live", &url]);
@@ -637,16 +637,7 @@ fn replay_reweighting_streams_its_run_too() {
     assert!(out.status.success(), "{out:?}");
     let port = free_port();
     let received = dir.path().join("received.rrd");
-    let mut receiver = Proc::start(
-        "rerun --save",
-        Command::new(rerun_exe())
-            .args(["--port", &port.to_string(), "--save"])
-            .arg(&received)
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(Stdio::null()),
-    );
-    wait_for_port(port, Duration::from_secs(30));
+    let mut receiver = save_receiver(port, &received);
     let url = format!("--connect=rerun+http://127.0.0.1:{port}/proxy");
     let out = wraptree(
         dir.path(),

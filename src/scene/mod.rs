@@ -181,3 +181,14 @@ impl Scene {
         Ok(())
     }
 }
+
+/// `bytes` as UTF-8 text; Err: the 1-based line of the first byte that is not.
+fn utf8_text(bytes: &[u8]) -> Result<&str, usize> {
+    std::str::from_utf8(bytes).map_err(|e| {
+        bytes[..e.valid_up_to()]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count()
+            + 1
+    })
+}

@@ -72,12 +72,7 @@ fn parse(
         kind,
         problem,
     };
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        let line = bytes[..e.valid_up_to()]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count()
-            + 1;
+    let text = super::utf8_text(bytes).map_err(|line| {
         err(
             LoadErrorKind::Malformed,
             format!("not a valid OBJ file (line {line}: not UTF-8 text)"),

@@ -93,14 +93,7 @@ fn triangles(data: &[u8], object: u32, faces: &mut Faces) -> Result<(), String> 
 
 /// Reads every `solid … endsolid` block of the ASCII STL `bytes`, each one object.
 fn read_ascii(bytes: &[u8], stem: &str, faces: &mut Faces) -> Result<(), String> {
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        let line = bytes[..e.valid_up_to()]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count()
-            + 1;
-        format!("line {line}: not ASCII text")
-    })?;
+    let text = super::utf8_text(bytes).map_err(|line| format!("line {line}: not ASCII text"))?;
     let mut lines = text.lines().enumerate();
     let mut solids = 0;
     // Each `solid` line; blank lines between solids are skipped.

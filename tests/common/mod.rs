@@ -12,6 +12,15 @@ use wraptree::geom::P3;
 use wraptree::grouping::{EventLog, Grouping, Params, SubsetTree, group};
 use wraptree::scene::{PrimitiveKind, Scene};
 
+/// The path of the bundled scene `name` (under `scenes/`), as a string argument.
+pub fn scene(name: &str) -> String {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
+        .display()
+        .to_string()
+}
+
 /// Runs the `wraptree` binary with `args` in `dir` and returns its output.
 pub fn wraptree(args: &[&str], dir: &std::path::Path) -> std::process::Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_wraptree"))

@@ -38,3 +38,19 @@ pub fn lines(text: &[u8]) -> Vec<(usize, usize)> {
     }
     out
 }
+
+/// Deletes (`delete`) or duplicates the line at index `k` (modulo the line count) of `text`;
+/// nothing when it has no line.
+pub fn delete_or_duplicate_line(text: &mut Vec<u8>, k: usize, delete: bool) {
+    let ls = lines(text);
+    if ls.is_empty() {
+        return;
+    }
+    let (a, b) = ls[k % ls.len()];
+    if delete {
+        text.drain(a..b);
+    } else {
+        let copy = text[a..b].to_vec();
+        text.splice(b..b, copy);
+    }
+}
