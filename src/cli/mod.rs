@@ -170,7 +170,7 @@ pub struct GroupArgs {
     /// of a Morton split, bottom-up, in parallel).
     #[arg(long, value_enum, default_value_t = Schedule::Exact)]
     pub schedule: Schedule,
-    /// The fast path: the partitioned schedule with small subproblems (root share 256; the
+    /// The fast path: the partitioned schedule with small subproblems (root share 32; the
     /// --chunk-* flags still apply); with `record`, `--refine --refine-treelet-passes 0` adds
     /// its refinement.
     #[arg(long, conflicts_with = "schedule")]

@@ -38,12 +38,14 @@ impl Chunking {
     };
 
     /// The fast path's split (`--fast`, bench method `fast`): the default's with a root share
-    /// of 256 bodies, so that scenes of 10^3–10^5 primitives are grouped in small subproblems
-    /// (by brute force, in parallel) and the root step is small. Its trees are further from the
-    /// exact schedule's than the default's; the fast path's refinement (`refine::FAST`) takes
-    /// their SAH back down.
+    /// of 32 bodies, so that scenes of 10^2–10^5 primitives are grouped in small subproblems (by
+    /// brute force) under a root step of about 32 bodies, and only scenes of at most 48
+    /// primitives are grouped whole. Its trees are further from the exact schedule's than the
+    /// default's; the fast path's refinement (`refine::FAST`) takes their SAH back down. Root
+    /// shares of 16–256 gave the same SAH and node tests after the refinement on 37 scenes, the
+    /// smaller ones in less time (`docs/benchmarks.md`, "The fast path").
     pub const FAST: Chunking = Chunking {
-        top: 256,
+        top: 32,
         ..Chunking::DEFAULT
     };
 

@@ -69,6 +69,90 @@ pub(super) fn morton_order(boxes: &[Aabb]) -> Vec<(u64, u32)> {
     super::sort::sorted(codes, 63)
 }
 
+/// Batcher's odd–even merge sort of 16 keys: its first 5 comparators sort keys 0..4, its first
+/// 19 keys 0..8.
+const NETWORK: [(u8, u8); 63] = [
+    (0, 1),
+    (2, 3),
+    (0, 2),
+    (1, 3),
+    (1, 2),
+    (4, 5),
+    (6, 7),
+    (4, 6),
+    (5, 7),
+    (5, 6),
+    (0, 4),
+    (2, 6),
+    (2, 4),
+    (1, 5),
+    (3, 7),
+    (3, 5),
+    (1, 2),
+    (3, 4),
+    (5, 6),
+    (8, 9),
+    (10, 11),
+    (8, 10),
+    (9, 11),
+    (9, 10),
+    (12, 13),
+    (14, 15),
+    (12, 14),
+    (13, 15),
+    (13, 14),
+    (8, 12),
+    (10, 14),
+    (10, 12),
+    (9, 13),
+    (11, 15),
+    (11, 13),
+    (9, 10),
+    (11, 12),
+    (13, 14),
+    (0, 8),
+    (4, 12),
+    (4, 8),
+    (2, 10),
+    (6, 14),
+    (6, 10),
+    (2, 4),
+    (6, 8),
+    (10, 12),
+    (1, 9),
+    (5, 13),
+    (5, 9),
+    (3, 11),
+    (7, 15),
+    (7, 11),
+    (3, 5),
+    (7, 9),
+    (11, 13),
+    (1, 2),
+    (3, 4),
+    (5, 6),
+    (7, 8),
+    (9, 10),
+    (11, 12),
+    (13, 14),
+];
+
+/// Sorts the first `len` (at most 16) of `keys`, the rest being `u64::MAX`, without branches:
+/// the sweep's keys are random, so an insertion sort mispredicts most of its steps.
+#[inline(always)]
+fn sort_keys(keys: &mut [u64; SWEEP], len: usize) {
+    let n = match len {
+        0..=4 => 5,
+        5..=8 => 19,
+        _ => NETWORK.len(),
+    };
+    for &(i, j) in &NETWORK[..n] {
+        let (a, b) = (keys[i as usize], keys[j as usize]);
+        keys[i as usize] = a.min(b);
+        keys[j as usize] = a.max(b);
+    }
+}
+
 /// Ranges of at most this many primitives are cut by an exact sweep over their sorted centres
 /// instead of bins (the bins' fixed cost would dominate).
 const SWEEP: usize = 16;
@@ -88,6 +172,8 @@ pub(super) struct Zone<'z> {
     /// the best axis so far), and the partition's buffer.
     bin: Vec<u8>,
     best_bin: Vec<u8>,
+    /// Bins of each primitive of the range being cut on the three axes (binned cuts).
+    bins: Vec<[u8; 3]>,
     tmp: Vec<u32>,
 }
 
@@ -182,6 +268,7 @@ impl<'z> Zone<'z> {
             cen,
             bin: Vec::with_capacity(m),
             best_bin: Vec::with_capacity(m),
+            bins: Vec::with_capacity(m),
             tmp: Vec::with_capacity(m),
         }
     }
@@ -210,23 +297,18 @@ impl<'z> Zone<'z> {
         ];
         // Every axis with a span is tried; the cheapest cut wins (ties to the lower axis), its
         // sides kept in `best_bin`. Bins from `cut` on are the right side.
+        let spans = e.map(|w| w > 0.0 && w.is_finite());
         let mut best: Option<(f64, usize, u8)> = None;
-        for (axis, &w) in e.iter().enumerate() {
-            // NaN or zero span: no length to cut along.
-            if !(w > 0.0 && w.is_finite()) {
-                continue;
-            }
-            let found = if len <= SWEEP {
-                self.sweep(start, len, axis).map(|(c, nl)| (c, nl, 1))
-            } else {
-                self.binned(start, len, axis, cb.lo[axis], w)
-            };
-            if let Some((c, nl, cut)) = found
-                && best.is_none_or(|(b, _, _)| c < b)
-            {
+        if len > SWEEP {
+            // One pass bins the centres on all three axes at once.
+            if let Some((c, nl, cut, axis)) = self.binned(start, len, &cb.lo, &e, spans) {
                 best = Some((c, nl, cut));
-                std::mem::swap(&mut self.bin, &mut self.best_bin);
+                self.best_bin.clear();
+                self.best_bin.extend(self.bins.iter().map(|b| b[axis]));
             }
+        } else if let Some((c, nl)) = self.sweep(start, len, spans) {
+            best = Some((c, nl, 1));
+            std::mem::swap(&mut self.bin, &mut self.best_bin);
         }
         let (_, nl, cut) = best?;
         std::mem::swap(&mut self.bin, &mut self.best_bin);
@@ -245,50 +327,64 @@ impl<'z> Zone<'z> {
         Some(nl)
     }
 
-    /// The exact cut of a range of at most [`SWEEP`]: the primitives sorted by centre on
-    /// `axis`, ties (and centres within 16 units in the last place) in range order (a NaN centre
-    /// first, −0 as 0), the boundary of least SAH leaving a quarter on each side; sets `bin` to
-    /// each primitive's side.
-    fn sweep(&mut self, start: usize, len: usize, axis: usize) -> Option<(f64, usize)> {
+    /// The exact cut of a range of at most [`SWEEP`]: on each axis that `spans`, the primitives
+    /// sorted by centre on it, ties (and centres within 16 units in the last place) in range
+    /// order (a NaN centre first, −0 as 0), and the boundary of least SAH leaving a quarter on
+    /// each side; of those the cheapest (ties to the lower axis). The boxes are gathered once
+    /// for the three axes. Sets `bin` to each primitive's side.
+    fn sweep(&mut self, start: usize, len: usize, spans: [bool; 3]) -> Option<(f64, usize)> {
         let (leaves, cen) = (&*self.leaves, &self.cen);
         let part = &self.perm[start..start + len];
         let least = (len / 4).max(1);
-        // The centre's order bits with the position in the low 4: one integer compare per step.
-        let mut keys = [0u64; SWEEP];
-        for (i, &p) in part.iter().enumerate() {
-            let c = cen[p as usize][axis];
-            let c = if c.is_nan() {
-                f64::NEG_INFINITY
-            } else {
-                c + 0.0
-            };
-            keys[i] = order_bits(c) & !0xF | i as u64;
+        let mut boxes = [Bounds::EMPTY; SWEEP];
+        for (b, &p) in boxes.iter_mut().zip(part) {
+            b.add(&leaves[p as usize].aabb);
         }
-        keys[..len].sort_unstable();
-        let mut order = [0u8; SWEEP];
-        for (o, k) in order.iter_mut().zip(&keys[..len]) {
-            *o = (k & 0xF) as u8;
-        }
-        let aabb = |i: usize| &leaves[part[order[i] as usize] as usize].aabb;
-        let mut right = [Bounds::EMPTY; SWEEP];
-        let mut acc = Bounds::EMPTY;
-        for i in (1..len).rev() {
-            acc.add(aabb(i));
-            right[i] = acc;
-        }
-        let mut best: Option<(f64, usize)> = None;
-        let mut left = Bounds::EMPTY;
-        for (i, r) in right.iter().enumerate().take(len).skip(1) {
-            left.add(aabb(i - 1));
-            if i < least || len - i < least {
-                continue;
+        let mut best: Option<(f64, usize, [u8; SWEEP])> = None;
+        for axis in (0..3).filter(|&a| spans[a]) {
+            // The centre's order bits with the position in the low 4: one integer compare per
+            // step.
+            let mut keys = [u64::MAX; SWEEP];
+            for (i, &p) in part.iter().enumerate() {
+                let c = cen[p as usize][axis];
+                let c = if c.is_nan() {
+                    f64::NEG_INFINITY
+                } else {
+                    c + 0.0
+                };
+                keys[i] = order_bits(c) & !0xF | i as u64;
             }
-            let cost = left.area() * i as f64 + r.area() * (len - i) as f64;
-            if best.is_none_or(|(c, _)| cost < c) {
-                best = Some((cost, i));
+            sort_keys(&mut keys, len);
+            let mut order = [0u8; SWEEP];
+            for (o, k) in order.iter_mut().zip(&keys[..len]) {
+                *o = (k & 0xF) as u8;
+            }
+            // Areas of the right sides that leave a quarter on each side.
+            let mut right = [0.0f64; SWEEP];
+            let mut acc = Bounds::EMPTY;
+            for i in (least..len).rev() {
+                acc = acc.join(&boxes[order[i] as usize]);
+                right[i] = acc.area();
+            }
+            let mut left = Bounds::EMPTY;
+            for &o in &order[..least - 1] {
+                left = left.join(&boxes[o as usize]);
+            }
+            let mut here: Option<(f64, usize)> = None;
+            for i in least..=len - least {
+                left = left.join(&boxes[order[i - 1] as usize]);
+                let cost = left.area() * i as f64 + right[i] * (len - i) as f64;
+                if here.is_none_or(|(c, _)| cost < c) {
+                    here = Some((cost, i));
+                }
+            }
+            if let Some((cost, nl)) = here
+                && best.is_none_or(|(b, _, _)| cost < b)
+            {
+                best = Some((cost, nl, order));
             }
         }
-        let (cost, nl) = best?;
+        let (cost, nl, order) = best?;
         self.bin.clear();
         self.bin.resize(len, 1);
         for &o in &order[..nl] {
@@ -297,61 +393,67 @@ impl<'z> Zone<'z> {
         Some((cost, nl))
     }
 
-    /// The binned cut of a longer range: centres in [`BINS`] equal bins of `c0..c0 + w` on
-    /// `axis`, the bin boundary of least SAH leaving a quarter on each side; sets `bin` to each
-    /// primitive's bin and returns the left side's length and the right side's first bin.
+    /// The binned cut of a longer range: centres in [`BINS`] equal bins of `lo..lo + e` on each
+    /// axis that `spans`, all three binned in one pass over the range; on each axis the bin
+    /// boundary of least SAH leaving a quarter on each side, and of those the cheapest (ties to
+    /// the lower axis). Sets `bins` to each primitive's bins and returns the cost, the left
+    /// side's length, the right side's first bin and the axis.
     fn binned(
         &mut self,
         start: usize,
         len: usize,
-        axis: usize,
-        c0: f64,
-        w: f64,
-    ) -> Option<(f64, usize, u8)> {
+        lo: &[f64; 3],
+        e: &[f64; 3],
+        spans: [bool; 3],
+    ) -> Option<(f64, usize, u8, usize)> {
         let (leaves, cen) = (&*self.leaves, &self.cen);
         let part = &self.perm[start..start + len];
         let least = (len / 4).max(1);
-        let scale = BINS as f64 / w;
-        let mut counts = [0usize; BINS];
-        self.bin.clear();
-        self.bin.resize(len, 0);
-        for (k, &p) in self.bin.iter_mut().zip(part) {
+        // An axis without a span bins everything in bin 0 (its cuts are never taken).
+        let scale = [0, 1, 2].map(|k| if spans[k] { BINS as f64 / e[k] } else { 0.0 });
+        let mut counts = [[0usize; BINS]; 3];
+        let mut boxes = [[Bounds::EMPTY; BINS]; 3];
+        self.bins.clear();
+        self.bins.extend(part.iter().map(|&p| {
+            let c = &cen[p as usize];
+            let b = &leaves[p as usize].aabb;
             // A NaN centre goes to bin 0 (`as` saturates), the same on every run.
-            let b = (((cen[p as usize][axis] - c0) * scale) as usize).min(BINS - 1);
-            *k = b as u8;
-            counts[b] += 1;
-        }
-        // Two banks of bins, for even and odd positions: neighbours (often in one bin) then
-        // grow different boxes.
-        let mut banks = [[Bounds::EMPTY; BINS]; 2];
-        for (i, (&k, &p)) in self.bin.iter().zip(part).enumerate() {
-            banks[i & 1][k as usize].add(&leaves[p as usize].aabb);
-        }
-        let mut boxes = banks[0];
-        for (b, o) in boxes.iter_mut().zip(&banks[1]) {
-            *b = b.join(o);
-        }
-        let mut right = [(Bounds::EMPTY, 0usize); BINS];
-        let mut acc = (Bounds::EMPTY, 0usize);
-        for k in (1..BINS).rev() {
-            acc = (acc.0.join(&boxes[k]), acc.1 + counts[k]);
-            right[k] = acc;
-        }
-        let mut best: Option<(f64, usize, usize)> = None;
-        let mut left = (Bounds::EMPTY, 0usize);
-        for cut in 1..BINS {
-            left = (left.0.join(&boxes[cut - 1]), left.1 + counts[cut - 1]);
-            let (rb, rn) = right[cut];
-            if left.1 < least || rn < least {
-                continue;
+            let k = [0, 1, 2].map(|a| (((c[a] - lo[a]) * scale[a]) as usize).min(BINS - 1));
+            for a in 0..3 {
+                counts[a][k[a]] += 1;
+                boxes[a][k[a]].add(b);
             }
-            let cost = left.0.area() * left.1 as f64 + rb.area() * rn as f64;
-            if best.is_none_or(|(c, _, _)| cost < c) {
-                best = Some((cost, cut, left.1));
+            k.map(|x| x as u8)
+        }));
+        let mut best: Option<(f64, usize, u8, usize)> = None;
+        for axis in (0..3).filter(|&a| spans[a]) {
+            let (boxes, counts) = (&boxes[axis], &counts[axis]);
+            let mut right = [(Bounds::EMPTY, 0usize); BINS];
+            let mut acc = (Bounds::EMPTY, 0usize);
+            for k in (1..BINS).rev() {
+                acc = (acc.0.join(&boxes[k]), acc.1 + counts[k]);
+                right[k] = acc;
+            }
+            let mut left = (Bounds::EMPTY, 0usize);
+            let mut here: Option<(f64, usize, usize)> = None;
+            for cut in 1..BINS {
+                left = (left.0.join(&boxes[cut - 1]), left.1 + counts[cut - 1]);
+                let (rb, rn) = right[cut];
+                if left.1 < least || rn < least {
+                    continue;
+                }
+                let cost = left.0.area() * left.1 as f64 + rb.area() * rn as f64;
+                if here.is_none_or(|(c, _, _)| cost < c) {
+                    here = Some((cost, cut, left.1));
+                }
+            }
+            if let Some((cost, cut, nl)) = here
+                && best.is_none_or(|(b, _, _, _)| cost < b)
+            {
+                best = Some((cost, nl, cut as u8, axis));
             }
         }
-        let (cost, cut, nl) = best?;
-        Some((cost, nl, cut as u8))
+        best
     }
 
     /// Reorders the codes and leaves into the planned order.
@@ -447,6 +549,24 @@ mod tests {
                 leaves[nl..].iter().all(|l| l.aabb.min.y > 1.0),
                 "{m} leaves"
             );
+        }
+    }
+
+    #[test]
+    fn the_sorting_network_sorts_every_length_up_to_sixteen() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        for len in 0..=SWEEP {
+            for _ in 0..200 {
+                let mut keys = [u64::MAX; SWEEP];
+                // Few distinct values, so that ties occur.
+                for k in &mut keys[..len] {
+                    *k = rng.random_range(0..8u64) << 4 | rng.random_range(0..16u64);
+                }
+                let mut want = keys[..len].to_vec();
+                want.sort_unstable();
+                sort_keys(&mut keys, len);
+                assert_eq!(&keys[..len], &want[..], "{len} keys");
+            }
         }
     }
 
