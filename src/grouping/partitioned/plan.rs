@@ -43,7 +43,7 @@ impl Chunking {
     /// primitives are grouped whole. Its trees are further from the exact schedule's than the
     /// default's; the fast path's refinement (`refine::FAST`) takes their SAH back down. Root
     /// shares of 16–256 gave the same SAH and node tests after the refinement on 37 scenes, the
-    /// smaller ones in less time (`docs/benchmarks.md`, "The fast path").
+    /// smaller ones in less time (`docs/benchmarks.md`, "Users' sizes").
     pub const FAST: Chunking = Chunking {
         top: 32,
         ..Chunking::DEFAULT
