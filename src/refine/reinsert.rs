@@ -214,6 +214,6 @@ pub fn candidates(w: &WorkTree, count: usize) -> Vec<u32> {
     tied.sort_unstable();
     tied.truncate(count - ids.len());
     ids.extend(tied);
-    ids.sort_unstable();
+    ids.par_sort_unstable();
     ids
 }

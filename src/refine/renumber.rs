@@ -3,7 +3,7 @@
 //! wherever it still holds — among the slots whose children are all numbered, the smallest
 //! input id comes next. An unmoved tree keeps every id.
 
-use super::work::WorkTree;
+use super::work::{WorkTree, tabulate};
 use crate::grouping::SubsetTree;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -65,19 +65,17 @@ pub fn subset_tree(w: &WorkTree, input: &SubsetTree) -> Result<SubsetTree, Strin
             new_id[(c as usize) - n]
         }
     };
-    let mut aabb = w.aabb[..n].to_vec();
-    let mut diameter = input.diameter[..n].to_vec();
-    let mut children = Vec::with_capacity(slots);
-    for &i in &order {
-        let x = n + i as usize;
-        aabb.push(w.aabb[x]);
-        diameter.push(if w.changed[i as usize] {
+    // The arrays in the new order (on rayon's threads for large trees).
+    let node = |k: usize| if k < n { k } else { n + order[k - n] as usize };
+    let aabb = tabulate(n + slots, |k| w.aabb[node(k)]);
+    let diameter = tabulate(n + slots, |k| {
+        let x = node(k);
+        if x >= n && w.changed[x - n] {
             w.aabb[x].diameter()
         } else {
             input.diameter[x]
-        });
-        let [a, b] = w.children[i as usize];
-        children.push([id(a), id(b)]);
-    }
+        }
+    });
+    let children = tabulate(slots, |k| w.children[order[k] as usize].map(id));
     SubsetTree::new(aabb, diameter, children)
 }

@@ -8,6 +8,7 @@
 use crate::geom::Aabb;
 use crate::geom::area;
 use crate::grouping::{NONE, SubsetTree};
+use rayon::prelude::*;
 
 /// What [`WorkTree::reinsert`] changed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -18,6 +19,19 @@ pub struct Moved {
     pub old_grandparent: u32,
     /// The parent slot, now the parent of the node and its target.
     pub parent: u32,
+}
+
+/// Trees of at least this many nodes have their arrays built on rayon's threads.
+pub const PARALLEL_COPY: usize = 1 << 16;
+
+/// `f(0), f(1), …, f(len − 1)`: on rayon's threads from [`PARALLEL_COPY`] items, where the
+/// fresh pages and the copies cost more than handing out the work.
+pub fn tabulate<U: Send>(len: usize, f: impl Fn(usize) -> U + Sync + Send) -> Vec<U> {
+    if len >= PARALLEL_COPY {
+        (0..len).into_par_iter().map(f).collect()
+    } else {
+        (0..len).map(f).collect()
+    }
 }
 
 /// A tree under refinement.
@@ -48,14 +62,18 @@ pub struct WorkTree {
 
 impl WorkTree {
     /// The working form of `tree`.
+    ///
+    /// Large trees' arrays are copied on rayon's threads ([`tabulate`]: at 10^6 leaves the
+    /// copies and their fresh pages are most of the setup); the interior sum is taken in id
+    /// order, so it is the same for any number of threads.
     pub fn of(tree: &SubsetTree) -> WorkTree {
-        let area: Vec<f64> = tree.aabb.iter().map(area).collect();
+        let area: Vec<f64> = tabulate(tree.len(), |i| area(&tree.aabb[i]));
         let n = tree.leaves();
         WorkTree {
             n: n as u32,
-            parent: tree.parent.clone(),
-            children: tree.children.clone(),
-            aabb: tree.aabb.clone(),
+            parent: tabulate(tree.len(), |i| tree.parent[i]),
+            children: tabulate(tree.children.len(), |i| tree.children[i]),
+            aabb: tabulate(tree.len(), |i| tree.aabb[i]),
             interior: area[n..].iter().sum(),
             area,
             root: tree.root(),
