@@ -176,7 +176,7 @@ fn refinement_is_deterministic_and_thread_count_independent() {
     // Large enough that the first passes search in parallel (`reinsert::PARALLEL_MIN`) and
     // that the tree's arrays are built in parallel (`work::PARALLEL_COPY` nodes).
     let scene = generate::soup(33_000, 7);
-    assert!(2 * scene.len() - 1 >= wraptree::refine::work::PARALLEL_COPY);
+    assert!(2 * scene.len() > wraptree::refine::work::PARALLEL_COPY);
     let g = group(&scene, &Params::default(), ());
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
