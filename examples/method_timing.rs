@@ -12,10 +12,10 @@
 use std::path::Path;
 use std::time::Instant;
 use wraptree::grouping::{Params, group_boxes, sah};
-use wraptree::peers::{Built, Method, build};
-use wraptree::refine;
 use wraptree::metrics::compare::query_values;
+use wraptree::peers::{Built, Method, build};
 use wraptree::query::{Bv, Workload, measure};
+use wraptree::refine;
 use wraptree::scene::{LoadOptions, Scene, load_path};
 
 /// The environment variable `name` parsed, if set.
@@ -79,7 +79,10 @@ fn main() -> anyhow::Result<()> {
         .num_threads(threads)
         .build()?;
     let params = Params::default();
-    if let Some(secs) = std::env::var("LOOP").ok().and_then(|s| s.parse::<f64>().ok()) {
+    if let Some(secs) = std::env::var("LOOP")
+        .ok()
+        .and_then(|s| s.parse::<f64>().ok())
+    {
         let scene = load_path(Path::new(&files[0]), &LoadOptions::default())?.scene;
         let t = Instant::now();
         let mut runs = 0u64;
