@@ -315,19 +315,42 @@ fn triangle_samples(v: &[P3], tris: &[[u32; 3]], n: usize, out: &mut Vec<P3>) {
 /// How far the farthest vertex below each node lies outside its wrapper (≤ 0 when all are
 /// inside; spheres and boxes report distance beyond the surface, hulls the largest face-plane
 /// excess, see [`Hull::excess`]).
+///
+/// Hulls test each distinct vertex once per node (a vertex shared by several primitives counts
+/// once), as their test costs a pass over the faces.
 pub fn containment_excess(tree: &SubsetTree, scene: &Scene, w: WrapperTree<'_>) -> Vec<f64> {
     let order = super::order::LeafOrder::new(tree, scene);
+    let max = |pts: &mut dyn Iterator<Item = &P3>, f: &dyn Fn(&P3) -> f64| {
+        pts.map(f).fold(f64::NEG_INFINITY, f64::max)
+    };
     (0..tree.len() as u32)
-        .map(|x| {
-            let i = x as usize;
-            let pts = order.node_points(x);
-            let f = |p: &P3| match w {
-                WrapperTree::Spheres(s) => (p - s[i].center).norm() - s[i].radius,
-                WrapperTree::Hulls(h) => h[i].excess(p),
-                WrapperTree::Boxes(b) => Obb::from_aabb(&b[i]).excess(p),
-                WrapperTree::Obbs(b) => b[i].excess(p),
-            };
-            pts.iter().map(f).fold(f64::NEG_INFINITY, f64::max)
-        })
+        .into_par_iter()
+        .map_init(
+            || vec![u32::MAX; scene.points.len()],
+            |seen, x| {
+                let i = x as usize;
+                let mut pts = order.node_points(x).iter();
+                match w {
+                    WrapperTree::Spheres(s) => {
+                        max(&mut pts, &|p| (p - s[i].center).norm() - s[i].radius)
+                    }
+                    WrapperTree::Hulls(h) => {
+                        let test = h[i].excess_test();
+                        let mut distinct = order
+                            .node_leaves(x)
+                            .iter()
+                            .flat_map(|&leaf| scene.prim(leaf as usize))
+                            .filter(|&&k| std::mem::replace(&mut seen[k as usize], x) != x)
+                            .map(|&k| &scene.points[k as usize]);
+                        max(&mut distinct, &|p| test.excess(p))
+                    }
+                    WrapperTree::Boxes(b) => {
+                        let b = Obb::from_aabb(&b[i]);
+                        max(&mut pts, &|p| b.excess(p))
+                    }
+                    WrapperTree::Obbs(b) => max(&mut pts, &|p| b[i].excess(p)),
+                }
+            },
+        )
         .collect()
 }
