@@ -8,7 +8,7 @@ use wraptree::geom::distance::{segment_segment, segment_triangle, triangle_trian
 use wraptree::grouping::{Params, SubsetTree, group};
 use wraptree::query::{
     Bv, Counts, Hierarchy, Workload, measure, moved, moved_spheres, overlap, point_distance,
-    reference, scene_distance,
+    reference, scene_distance, scene_distance_within,
 };
 use wraptree::scene::{Scene, generate};
 use wraptree::wrap::{SphereMethod, sphere_tree};
@@ -407,10 +407,64 @@ fn workload_is_seeded_and_measured() {
         (256, 8, 16)
     );
     assert_eq!(cost.overlapping, 8);
+    assert_eq!(cost.capped(), 0);
     for m in [cost.point, cost.distance, cost.overlap] {
         assert!(m.bv_tests > 0.0 && m.prim_tests > 0.0);
         assert_eq!(m.cost, m.bv_tests + m.prim_tests);
     }
+}
+
+/// A scene of 300 coincident copies of one triangle against itself: every primitive pair
+/// touches, and the search ends at the first one instead of testing all 90,000.
+#[test]
+fn scene_distance_ends_at_the_first_touching_pair() {
+    let s = wraptree::scene::pathological::coincident(300);
+    let tree = pairing_tree(&s);
+    let h = Hierarchy {
+        tree: &tree,
+        scene: &s,
+        bv: Bv::Aabb,
+    };
+    let mut c = Counts::default();
+    assert_eq!(scene_distance(&h, &h, &mut c), 0.0);
+    assert!(c.prim_tests <= 2 && c.bv_tests <= 64, "{c:?}");
+}
+
+/// Stacked coincident copies tie every scene–copy pair: the workload's queries stop at their
+/// test cap, are counted as capped, and a capped distance is never below the true one.
+#[test]
+fn workload_queries_stop_at_the_cap_on_coincident_copies() {
+    let s = wraptree::scene::pathological::coincident(400);
+    let tree = pairing_tree(&s);
+    let mut w = Workload::standard(&s, 1);
+    assert!(w.max_tests >= wraptree::query::MIN_MAX_TESTS);
+    w.max_tests = 20_000;
+    let cost = measure(&tree, &s, Bv::Aabb, &w);
+    // 400² = 160,000 tied pairs per near pose.
+    assert_eq!(cost.distance.capped, 8);
+    assert!(cost.capped() >= 8);
+    for m in [cost.point, cost.distance, cost.overlap] {
+        assert!(m.bv_tests + m.prim_tests <= 20_002.0, "{m:?}");
+    }
+    let h = Hierarchy {
+        tree: &tree,
+        scene: &s,
+        bv: Bv::Aabb,
+    };
+    let (t2, s2) = moved(&tree, &s, &w.poses_near[0]);
+    let copy = Hierarchy {
+        tree: &t2,
+        scene: &s2,
+        bv: Bv::Aabb,
+    };
+    let mut c = Counts::default();
+    let got = scene_distance_within(&h, &copy, 1_000, &mut c);
+    let want = reference::scene_distance(&s, &s2);
+    assert!(c.capped == 1 && c.bv_tests + c.prim_tests <= 1_002, "{c:?}");
+    assert!(
+        got.is_finite() && got >= want * (1.0 - 1e-12),
+        "{got} < {want}"
+    );
 }
 
 /// Prints the workload cost on the 12,144-polygon scene and one brute-force scene–scene

@@ -1,14 +1,18 @@
 //! A requested [`Stop`] ends `bench` and `stress` early without their output, and the sampled
-//! tightness of `bench` is deterministic for any thread count and near the value over every
-//! node.
+//! tightness of `bench` and `wrap` is deterministic for any thread count and near the value over
+//! every node.
 
+use wraptree::grouping::{Params, group};
 use wraptree::metrics::compare::{Options, Row, Step, Wrapper, evaluate};
 use wraptree::metrics::report::write_bench;
 use wraptree::metrics::stress::{self, StressOptions};
 use wraptree::peers::Method;
 use wraptree::scene::{Scene, generate};
 use wraptree::stop::{Stop, is_interrupted};
-use wraptree::wrap::SphereMethod;
+use wraptree::wrap::{
+    LevelStats, SphereMethod, WrapperKind, Wrappers, hull_tree, level_tightness,
+    level_tightness_sampled,
+};
 
 fn options(tightness_nodes: usize) -> Options {
     Options {
@@ -98,5 +102,66 @@ fn sampled_tightness_is_deterministic_and_near_every_node() {
             (s - f).abs() <= 0.15 * f,
             "{case}: sampled {s}, every node {f}"
         );
+    }
+}
+
+/// `wrap`'s sampled levels: with 0 nodes per depth exactly the every-node levels; with a sample
+/// as large as every depth the same up to rounding; with a small one the same volumes and
+/// counts, the error means near the every-node ones, and the same for 1 and 2 threads.
+#[test]
+fn wrap_levels_sampled_match_every_node() {
+    let on = |threads: usize, f: &(dyn Fn() -> Vec<Vec<LevelStats>> + Sync)| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(f)
+    };
+    for (scene, per_depth) in [(generate::lamp(), 1 << 20), (scene(), 64)] {
+        let tree = group(&scene, &Params::default(), ()).tree;
+        let hulls = hull_tree(&tree, &scene);
+        let w = Wrappers::build(&tree, &scene, &WrapperKind::ALL, SphereMethod::AabbCenter);
+        let levels = |per_depth: usize| {
+            w.trees()
+                .into_iter()
+                .map(|t| level_tightness_sampled(&tree, &scene, t, &hulls, 16, (per_depth, 1)))
+                .collect::<Vec<_>>()
+        };
+        let every: Vec<_> = w
+            .trees()
+            .into_iter()
+            .map(|t| level_tightness(&tree, &scene, t, &hulls, 16))
+            .collect();
+        assert_eq!(levels(0), every);
+        let sampled = on(1, &|| levels(per_depth));
+        assert_eq!(sampled, on(2, &|| levels(per_depth)), "1 and 2 threads");
+        for (ks, ke) in sampled.iter().zip(&every) {
+            // Over the levels: near the every-node means (each level alone: within a half).
+            let sum = |l: &[LevelStats]| l.iter().map(|x| x.error_mean).sum::<f64>();
+            let (s_all, e_all) = (sum(ks), sum(ke));
+            assert!((s_all - e_all).abs() <= 0.1 * e_all, "{s_all} vs {e_all}");
+            for (s, e) in ks.iter().zip(ke) {
+                let same = (s.depth, s.nodes, s.interior, s.volume, s.reference_volume);
+                assert_eq!(
+                    same,
+                    (e.depth, e.nodes, e.interior, e.volume, e.reference_volume)
+                );
+                assert_eq!(s.volume_ratio, e.volume_ratio);
+                let tol = if per_depth > 64 { 1e-9 } else { 0.5 };
+                let at = format!("{} depth {}", scene.name, s.depth);
+                assert!(
+                    (s.error_mean - e.error_mean).abs() <= tol * e.error_mean + 1e-12,
+                    "{at}: mean {} vs {}",
+                    s.error_mean,
+                    e.error_mean
+                );
+                if per_depth > 64 {
+                    assert!(
+                        (s.error_max - e.error_max).abs() <= 1e-9 * e.error_max,
+                        "{at}"
+                    );
+                }
+            }
+        }
     }
 }

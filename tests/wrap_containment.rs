@@ -8,8 +8,8 @@ use wraptree::geom::P3;
 use wraptree::grouping::{Params, SubsetTree, group};
 use wraptree::scene::{PrimitiveKind, Scene, generate};
 use wraptree::wrap::{
-    HULL_TOL_REL, SphereMethod, WrapperKind, WrapperTree, Wrappers, containment_excess, hull_tree,
-    sphere_tree,
+    HULL_TOL_REL, LeafOrder, SphereMethod, WrapperKind, WrapperTree, Wrappers, containment_excess,
+    hull_tree, sphere_tree,
 };
 
 const METHODS: [SphereMethod; 4] = [
@@ -25,6 +25,26 @@ fn check(scene: &Scene) {
     let tree = &g.tree;
     let diag = scene.aabb().diameter().max(1e-300);
     let w = Wrappers::build(tree, scene, &WrapperKind::ALL, SphereMethod::Minimum);
+    // Hulls test each distinct vertex once, with their planes computed once: the same values
+    // as every vertex reference through `Hull::excess`.
+    if let Some(WrapperTree::Hulls(h)) = w
+        .trees()
+        .into_iter()
+        .find(|t| t.kind() == WrapperKind::Hull)
+    {
+        let order = LeafOrder::new(tree, scene);
+        let naive: Vec<f64> = (0..tree.len() as u32)
+            .map(|x| {
+                let pts = order.node_points(x).iter();
+                pts.map(|p| h[x as usize].excess(p))
+                    .fold(f64::NEG_INFINITY, f64::max)
+            })
+            .collect();
+        assert_eq!(
+            containment_excess(tree, scene, WrapperTree::Hulls(h)),
+            naive
+        );
+    }
     for t in w.trees() {
         let ex = containment_excess(tree, scene, t);
         for (x, e) in ex.iter().enumerate() {

@@ -54,34 +54,66 @@ impl Hull {
     /// How far `p` lies outside (≤ 0 inside). For solids: the largest signed distance to the
     /// planes of the well-shaped faces (twice the area ≥ 1e-3 × the longest edge²; slivers
     /// have ill-defined planes) when that is ≤ 0, else the distance to the surface. For flat hulls,
-    /// segments and points: the distance to them.
+    /// segments and points: the distance to them. [`Hull::excess_test`] answers the same for
+    /// many points, the face planes computed once.
     pub fn excess(&self, p: &P3) -> f64 {
+        self.excess_test().excess(p)
+    }
+
+    /// [`Hull::excess`] for many points: the well-shaped faces' unit normals and corners,
+    /// computed once.
+    pub fn excess_test(&self) -> ExcessTest<'_> {
         let v = |i: u32| &self.vertices[i as usize];
+        let planes = match self.dim {
+            3 => self
+                .triangles
+                .iter()
+                .filter_map(|t| {
+                    let [a, b, c] = t.map(v);
+                    let n = (b - a).cross(&(c - a));
+                    let e = [b - a, c - b, a - c].map(|e| e.norm());
+                    let longest = e[0].max(e[1]).max(e[2]);
+                    let shortest = e[0].min(e[1]).min(e[2]);
+                    (n.norm() >= 1e-3 * longest * longest && shortest > 0.0)
+                        .then(|| (n.normalize(), *a))
+                })
+                .collect(),
+            _ => Vec::new(),
+        };
+        ExcessTest { hull: self, planes }
+    }
+}
+
+/// A hull with its face planes ready for [`ExcessTest::excess`] ([`Hull::excess_test`]).
+#[derive(Clone, Debug)]
+pub struct ExcessTest<'a> {
+    hull: &'a Hull,
+    /// Unit normal and a corner of each well-shaped face (solids only).
+    planes: Vec<(V3, P3)>,
+}
+
+impl ExcessTest<'_> {
+    /// How far `p` lies outside the hull, exactly as [`Hull::excess`].
+    pub fn excess(&self, p: &P3) -> f64 {
+        let h = self.hull;
+        let v = |i: u32| &h.vertices[i as usize];
         let surface = || {
-            self.triangles
+            h.triangles
                 .iter()
                 .map(|t| super::distance::point_triangle(p, v(t[0]), v(t[1]), v(t[2])))
                 .fold(f64::INFINITY, f64::min)
         };
-        match self.dim {
+        match h.dim {
             3 => {
                 let planes = self
-                    .triangles
+                    .planes
                     .iter()
-                    .filter_map(|t| {
-                        let [a, b, c] = t.map(v);
-                        let n = (b - a).cross(&(c - a));
-                        let e = [b - a, c - b, a - c].map(|e| e.norm());
-                        let longest = e[0].max(e[1]).max(e[2]);
-                        let shortest = e[0].min(e[1]).min(e[2]);
-                        (n.norm() >= 1e-3 * longest * longest && shortest > 0.0)
-                            .then(|| n.normalize().dot(&(p - a)))
-                    })
+                    .map(|(n, a)| n.dot(&(p - a)))
                     .fold(f64::NEG_INFINITY, f64::max);
                 if planes <= 0.0 { planes } else { surface() }
             }
             2 => surface(),
-            _ => match self.vertices.as_slice() {
+            _ => match h.vertices.as_slice() {
                 [a, b] => super::distance::point_segment(p, a, b),
                 [a] => (p - a).norm(),
                 _ => f64::INFINITY,

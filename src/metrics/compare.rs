@@ -378,7 +378,13 @@ impl Measuring<'_> {
             Some(bv) => {
                 self.stop.check()?;
                 progress(Step::Query);
-                Some(query::measure(tree, scene, bv, self.workload))
+                Some(query::measure_until(
+                    tree,
+                    scene,
+                    bv,
+                    self.workload,
+                    self.stop,
+                )?)
             }
             None => None,
         };

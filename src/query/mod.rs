@@ -10,10 +10,13 @@
 //! - [`fn@moved`] ([`mod@moved`]) — a rigidly moved copy of a tree and scene;
 //! - [`mod@reference`] — brute force over all primitives, the exact answers the tests compare
 //!   with;
-//! - [`Workload`] and [`measure`] ([`workload`]) — a seeded standard workload and its mean cost.
+//! - [`Workload`] and [`measure`] ([`workload`]) — a seeded standard workload and its mean cost
+//!   ([`measure_until`] also obeys a stop request between queries).
 //!
 //! Primitives are their surfaces ([`prim`]); bounds are lowered by a slack ([`SLACK_ULPS`]), so
-//! rounding never prunes the true answer.
+//! rounding never prunes the true answer. The `…_within` forms stop a query after a number of
+//! tests ([`MAX_TESTS_PER_PRIM`] per primitive in the workload) and count it in [`Counts::capped`]: exact ties (stacked
+//! coincident copies of a part) make a scene–scene query test every tied pair, up to `n²`.
 
 pub mod moved;
 pub mod pair;
@@ -23,9 +26,12 @@ pub mod reference;
 pub mod workload;
 
 pub use moved::{moved, moved_spheres};
-pub use pair::{overlap, scene_distance};
-pub use point::point_distance;
-pub use workload::{C_P, C_V, MeanCost, QueryCost, Workload, measure};
+pub use pair::{overlap, overlap_within, scene_distance, scene_distance_within};
+pub use point::{point_distance, point_distance_within};
+pub use workload::{
+    C_P, C_V, MAX_TESTS_PER_PRIM, MIN_MAX_TESTS, MeanCost, QueryCost, Workload, measure,
+    measure_until,
+};
 
 use crate::geom::{Aabb, P3};
 use crate::grouping::SubsetTree;
@@ -81,6 +87,9 @@ pub struct Counts {
     pub bv_tests: u64,
     /// Primitive tests (point–primitive or primitive–primitive distances evaluated).
     pub prim_tests: u64,
+    /// Queries stopped at their test cap (the `…_within` forms) before their answer was
+    /// proven: a distance is then an upper bound, an overlap `false` unproven.
+    pub capped: u64,
 }
 
 impl Counts {
@@ -88,6 +97,12 @@ impl Counts {
     pub fn add(&mut self, o: &Counts) {
         self.bv_tests += o.bv_tests;
         self.prim_tests += o.prim_tests;
+        self.capped += o.capped;
+    }
+
+    /// BV and primitive tests together.
+    pub fn tests(&self) -> u64 {
+        self.bv_tests + self.prim_tests
     }
 
     /// Eq. (1): `N_v·c_v + N_p·c_p`.

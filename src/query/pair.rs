@@ -24,9 +24,23 @@ fn split(a: &Hierarchy, x: u32, b: &Hierarchy, y: u32) -> Option<[(u32, u32); 2]
 ///
 /// Best-first branch and bound over the BVTT: node pairs are expanded smallest bound first
 /// (ties: deeper pair first) and pruned when their bound reaches the best primitive distance
-/// found. Each pair bound evaluated is one BV test (the root pair included), each leaf pair
-/// reached one primitive test.
+/// found; the search ends at the first touching primitive pair (0 cannot be beaten). Each pair
+/// bound evaluated is one BV test (the root pair included), each leaf pair reached one
+/// primitive test.
 pub fn scene_distance(a: &Hierarchy, b: &Hierarchy, counts: &mut Counts) -> f64 {
+    scene_distance_within(a, b, u64::MAX, counts)
+}
+
+/// [`scene_distance`] that stops once it has made `max_tests` tests and reached a primitive
+/// pair: the smallest primitive distance found by then (never less than the true distance),
+/// the stop counted in [`Counts::capped`].
+pub fn scene_distance_within(
+    a: &Hierarchy,
+    b: &Hierarchy,
+    max_tests: u64,
+    counts: &mut Counts,
+) -> f64 {
+    let start = counts.tests();
     let slack = a.slack() + b.slack();
     let (ra, rb) = (a.tree.root(), b.tree.root());
     let mut heap = BinaryHeap::new();
@@ -39,7 +53,11 @@ pub fn scene_distance(a: &Hierarchy, b: &Hierarchy, counts: &mut Counts) -> f64 
         b: rb,
     });
     while let Some(e) = heap.pop() {
-        if e.bound >= best {
+        if e.bound >= best || best == 0.0 {
+            break;
+        }
+        if counts.tests() - start >= max_tests && best.is_finite() {
+            counts.capped += 1;
             break;
         }
         match split(a, e.a, b, e.b) {
@@ -71,6 +89,13 @@ pub fn scene_distance(a: &Hierarchy, b: &Hierarchy, counts: &mut Counts) -> f64 
 /// Depth-first over the BVTT, skipping pairs whose BVs are apart (bound above 0 after slack),
 /// and returning at the first touching primitive pair. Counted as in [`scene_distance`].
 pub fn overlap(a: &Hierarchy, b: &Hierarchy, counts: &mut Counts) -> bool {
+    overlap_within(a, b, u64::MAX, counts)
+}
+
+/// [`overlap`] that gives up once it has made `max_tests` tests without finding a touching
+/// pair: `false` (unproven), the stop counted in [`Counts::capped`].
+pub fn overlap_within(a: &Hierarchy, b: &Hierarchy, max_tests: u64, counts: &mut Counts) -> bool {
+    let start = counts.tests();
     let slack = a.slack() + b.slack();
     let (ra, rb) = (a.tree.root(), b.tree.root());
     counts.bv_tests += 1;
@@ -79,6 +104,10 @@ pub fn overlap(a: &Hierarchy, b: &Hierarchy, counts: &mut Counts) -> bool {
     }
     let mut stack = vec![(ra, rb)];
     while let Some((x, y)) = stack.pop() {
+        if counts.tests() - start >= max_tests {
+            counts.capped += 1;
+            return false;
+        }
         match split(a, x, b, y) {
             None => {
                 counts.prim_tests += 1;

@@ -12,6 +12,14 @@ use std::collections::BinaryHeap;
 /// Every node whose bound is evaluated is one BV test (the root included); every leaf reached
 /// is one primitive test.
 pub fn point_distance(h: &Hierarchy, p: &P3, counts: &mut Counts) -> f64 {
+    point_distance_within(h, p, u64::MAX, counts)
+}
+
+/// [`point_distance`] that stops once it has made `max_tests` tests and reached a primitive:
+/// the distance to the nearest primitive found by then (never less than the true distance),
+/// the stop counted in [`Counts::capped`].
+pub fn point_distance_within(h: &Hierarchy, p: &P3, max_tests: u64, counts: &mut Counts) -> f64 {
+    let start = counts.tests();
     let slack = h.slack();
     let tree = h.tree;
     let root = tree.root();
@@ -26,6 +34,10 @@ pub fn point_distance(h: &Hierarchy, p: &P3, counts: &mut Counts) -> f64 {
     });
     while let Some(e) = heap.pop() {
         if e.bound >= best {
+            break;
+        }
+        if counts.tests() - start >= max_tests && best.is_finite() {
+            counts.capped += 1;
             break;
         }
         match tree.children_of(e.a) {

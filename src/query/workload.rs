@@ -3,11 +3,15 @@
 //! ([`Workload::standard`]), run by [`measure`]. `docs/benchmarks.md` ("What is measured")
 //! describes it as the benchmarks use it.
 
-use super::{Bv, Counts, Hierarchy, moved, moved_spheres, overlap, point_distance, scene_distance};
+use super::{
+    Bv, Counts, Hierarchy, moved, moved_spheres, overlap_within, point_distance_within,
+    scene_distance_within,
+};
 use crate::geom::{P3, V3};
 use crate::grouping::SubsetTree;
 use crate::scene::Scene;
 use crate::scene::generate::random_rotation;
+use crate::stop::{Interrupted, Stop};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -18,6 +22,18 @@ pub const C_V: f64 = 1.0;
 /// Cost of one primitive test in eq. (1) as [`measure`] reports it.
 pub const C_P: f64 = 1.0;
 
+/// Tests (BV and primitive) per primitive of the scene after which a query of
+/// [`Workload::standard`] stops ([`Counts::capped`]), with at least [`MIN_MAX_TESTS`]. The cap
+/// is at least twice the most any query of the workload makes on the bundled and reference
+/// meshes (1.4·10^7 = 110·n, a scene–copy distance with sphere BVs on the 124,705-polygon
+/// monastery; at most 230·n and 8.2·10^6 on the others), so only exact ties reach it: `k`
+/// stacked coincident copies of a part make a scene–copy query test `k²` tied pairs (up to
+/// `n²`).
+pub const MAX_TESTS_PER_PRIM: u64 = 256;
+
+/// The least per-query test cap of [`Workload::standard`]: 2^24 ≈ 1.7·10^7 tests, about 2 s.
+pub const MIN_MAX_TESTS: u64 = 1 << 24;
+
 /// Query points and poses of a copy of the scene (see [`Workload::standard`]).
 #[derive(Clone, Debug)]
 pub struct Workload {
@@ -27,6 +43,8 @@ pub struct Workload {
     pub poses_near: Vec<Isometry3<f64>>,
     /// Poses whose copy overlaps the scene partially.
     pub poses_touching: Vec<Isometry3<f64>>,
+    /// Tests after which one query stops, counted as capped ([`MAX_TESTS_PER_PRIM`]).
+    pub max_tests: u64,
 }
 
 /// A uniform random unit vector.
@@ -60,6 +78,9 @@ impl Workload {
     ///   centroid of a random triangle of the copy on the centroid of a random triangle of the
     ///   original (a random vertex when the scene has no triangles). The two triangles then
     ///   cross there, so the copy overlaps the original partially.
+    ///
+    /// Each query stops after [`MAX_TESTS_PER_PRIM`] tests per primitive of the scene (at least
+    /// [`MIN_MAX_TESTS`]).
     pub fn standard(scene: &Scene, seed: u64) -> Workload {
         assert!(!scene.is_empty(), "the workload needs a non-empty scene");
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -104,6 +125,7 @@ impl Workload {
             points,
             poses_near,
             poses_touching,
+            max_tests: (MAX_TESTS_PER_PRIM * scene.len() as u64).max(MIN_MAX_TESTS),
         }
     }
 }
@@ -121,6 +143,9 @@ pub struct MeanCost {
     pub cost: f64,
     /// Wall seconds for all queries of this kind.
     pub seconds: f64,
+    /// Queries stopped at [`Workload::max_tests`] (their tests are a lower bound of the
+    /// exact query's).
+    pub capped: u64,
 }
 
 impl MeanCost {
@@ -132,6 +157,7 @@ impl MeanCost {
             prim_tests,
             cost: bv_tests * C_V + prim_tests * C_P,
             seconds,
+            capped: total.capped,
         }
     }
 }
@@ -151,16 +177,38 @@ pub struct QueryCost {
     pub seconds: f64,
 }
 
+impl QueryCost {
+    /// Queries of every kind stopped at [`Workload::max_tests`].
+    pub fn capped(&self) -> u64 {
+        self.point.capped + self.distance.capped + self.overlap.capped
+    }
+}
+
 /// Runs the whole workload on `tree` over `scene` with `bv` (sphere BVs are moved with each
 /// copy by [`moved_spheres`]): all 256 point queries, a scene–copy distance query per near pose,
-/// and an overlap query per near and per touching pose (8 answers false, 8 true); moving the
-/// copies is not timed.
+/// and an overlap query per near and per touching pose (8 answers false, 8 true), each stopping
+/// after [`Workload::max_tests`] tests; moving the copies is not timed.
 pub fn measure(tree: &SubsetTree, scene: &Scene, bv: Bv, workload: &Workload) -> QueryCost {
+    match measure_until(tree, scene, bv, workload, &Stop::new()) {
+        Ok(cost) => cost,
+        Err(Interrupted) => unreachable!("nobody holds the new stop token"),
+    }
+}
+
+/// [`measure`] that checks `stop` before each query (Err: [`Interrupted`]).
+pub fn measure_until(
+    tree: &SubsetTree,
+    scene: &Scene,
+    bv: Bv,
+    workload: &Workload,
+    stop: &Stop,
+) -> Result<QueryCost, Interrupted> {
     let h = Hierarchy { tree, scene, bv };
     let mut counts = Counts::default();
     let start = Instant::now();
     for p in &workload.points {
-        point_distance(&h, p, &mut counts);
+        stop.check()?;
+        point_distance_within(&h, p, workload.max_tests, &mut counts);
     }
     let point = MeanCost::new(
         &counts,
@@ -171,6 +219,7 @@ pub fn measure(tree: &SubsetTree, scene: &Scene, bv: Bv, workload: &Workload) ->
     let (mut dist_s, mut over_s, mut overlapping) = (0.0, 0.0, 0);
     let near = workload.poses_near.iter().map(|p| (p, true));
     for (pose, is_near) in near.chain(workload.poses_touching.iter().map(|p| (p, false))) {
+        stop.check()?;
         let (t, s) = moved(tree, scene, pose);
         let spheres = match bv {
             Bv::Aabb => Vec::new(),
@@ -187,19 +236,19 @@ pub fn measure(tree: &SubsetTree, scene: &Scene, bv: Bv, workload: &Workload) ->
         };
         if is_near {
             let start = Instant::now();
-            scene_distance(&h, &copy, &mut dist);
+            scene_distance_within(&h, &copy, workload.max_tests, &mut dist);
             dist_s += start.elapsed().as_secs_f64();
         }
         let start = Instant::now();
-        overlapping += overlap(&h, &copy, &mut over) as usize;
+        overlapping += overlap_within(&h, &copy, workload.max_tests, &mut over) as usize;
         over_s += start.elapsed().as_secs_f64();
     }
     let n_pose = workload.poses_near.len() + workload.poses_touching.len();
-    QueryCost {
+    Ok(QueryCost {
         point,
         distance: MeanCost::new(&dist, workload.poses_near.len(), dist_s),
         overlap: MeanCost::new(&over, n_pose, over_s),
         overlapping,
         seconds: point.seconds + dist_s + over_s,
-    }
+    })
 }

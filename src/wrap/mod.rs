@@ -32,5 +32,5 @@ pub use order::LeafOrder;
 pub use sphere::{SphereMethod, sphere_tree};
 pub use tightness::{
     DEFAULT_SAMPLES, DepthSample, LevelStats, MAX_VISITS, NODES_PER_DEPTH, NodeStats,
-    containment_excess, level_tightness, node_tightness, nodes_tightness,
+    containment_excess, level_tightness, level_tightness_sampled, node_tightness, nodes_tightness,
 };

@@ -1,11 +1,19 @@
 //! The report of `wraptree wrap`: each Wrapper Tree's build time, containment check (every
-//! vertex below a node inside its wrapper, within a tolerance) and per-level tightness, and
-//! the same as text ([`report_text`]) or JSON ([`report_json`]).
+//! vertex below a node inside its wrapper, within a tolerance) and per-level tightness (the
+//! error measured on a seeded sample of interior nodes per depth, or on every node), and the
+//! same as text ([`report_text`]) or JSON ([`report_json`]).
 //!
 //! ```no_run
-//! use wraptree::wrap::{DEFAULT_SAMPLES, SphereMethod, WrapperKind, report::report};
+//! use wraptree::wrap::report::{Measured, report};
+//! use wraptree::wrap::{DEFAULT_SAMPLES, NODES_PER_DEPTH, SphereMethod, WrapperKind};
 //! # fn demo(tree: &wraptree::grouping::SubsetTree, scene: &wraptree::scene::Scene) {
-//! for r in report(tree, scene, &[WrapperKind::Sphere, WrapperKind::Obb], SphereMethod::Minimum, DEFAULT_SAMPLES) {
+//! let kinds = [WrapperKind::Sphere, WrapperKind::Obb];
+//! let how = Measured {
+//!     method: SphereMethod::Minimum,
+//!     samples: DEFAULT_SAMPLES,
+//!     per_depth: NODES_PER_DEPTH,
+//! };
+//! for r in report(tree, scene, &kinds, how) {
 //!     println!("{}: containment holds: {}", r.kind.name(), r.containment.holds);
 //! }
 //! # }
@@ -13,7 +21,7 @@
 
 use super::{
     HULL_TOL_REL, Hull, LevelStats, Obb, Sphere, SphereMethod, WrapperKind, WrapperTree,
-    containment_excess, hull_tree, level_tightness, obb_tree, sphere_tree,
+    containment_excess, hull_tree, level_tightness_sampled, obb_tree, sphere_tree,
 };
 use crate::geom::Aabb;
 use crate::grouping::SubsetTree;
@@ -23,6 +31,9 @@ use std::time::Instant;
 
 /// Containment tolerance of spheres, boxes and oriented boxes, relative to the scene diagonal.
 pub const TOL_REL: f64 = 1e-9;
+
+/// Seed of the node sample whose error [`report`] measures.
+pub const SAMPLE_SEED: u64 = 1;
 
 /// The containment check of one Wrapper Tree.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -144,15 +155,22 @@ pub fn containment(tree: &SubsetTree, scene: &Scene, w: WrapperTree<'_>) -> Cont
 }
 
 /// Builds the Wrapper Trees of `kinds` (each once, in [`WrapperKind`] order) over `tree` and
-/// reports each one's build time, containment and tightness per level from `samples` surface
-/// samples per wrapper (the reference volumes are the hulls', built untimed when not asked for).
+/// reports each one's build time, containment (every node) and tightness per level from
+/// `how.samples` surface samples per wrapper, the error measured on every leaf and at most
+/// `how.per_depth` interior nodes per depth ([`level_tightness_sampled`], seed
+/// [`SAMPLE_SEED`]; 0: every node), spheres by `how.method`. The reference volumes are the
+/// hulls', built untimed when not asked for.
 pub fn report(
     tree: &SubsetTree,
     scene: &Scene,
     kinds: &[WrapperKind],
-    method: SphereMethod,
-    samples: usize,
+    how: Measured,
 ) -> Vec<KindReport> {
+    let Measured {
+        method,
+        samples,
+        per_depth,
+    } = how;
     let mut kinds = kinds.to_vec();
     kinds.sort();
     kinds.dedup();
@@ -172,7 +190,14 @@ pub fn report(
             kind: w.kind(),
             build_seconds,
             containment: containment(tree, scene, w),
-            levels: level_tightness(tree, scene, w, hulls, samples),
+            levels: level_tightness_sampled(
+                tree,
+                scene,
+                w,
+                hulls,
+                samples,
+                (per_depth, SAMPLE_SEED),
+            ),
         })
         .collect()
 }
@@ -184,23 +209,45 @@ pub fn method_name(m: SphereMethod) -> String {
         .map_or_else(|| format!("{m:?}"), |v| v.get_name().to_string())
 }
 
+/// How the report was measured: sphere method, surface samples per wrapper and interior nodes
+/// per depth whose error is measured (0: every node).
+#[derive(Clone, Copy, Debug)]
+pub struct Measured {
+    /// How spheres were computed.
+    pub method: SphereMethod,
+    /// Surface samples per wrapper.
+    pub samples: usize,
+    /// Interior nodes per depth whose error was measured (0: every node).
+    pub per_depth: usize,
+}
+
+/// Which nodes' error was measured, as the text report says it.
+fn nodes_measured(per_depth: usize) -> String {
+    match per_depth {
+        0 => "on every node".to_string(),
+        k => format!("on every leaf and at most {k} interior nodes per depth (seeded sample)"),
+    }
+}
+
 /// What `wraptree wrap` prints for `reports` of `scene`'s tree (grouped in `group_seconds`,
-/// spheres by `method`, errors from `samples` surface samples per wrapper).
+/// measured as `how` says).
 pub fn report_text(
     scene: &Scene,
     tree: &SubsetTree,
     group_seconds: f64,
-    method: SphereMethod,
-    samples: usize,
+    how: Measured,
     reports: &[KindReport],
 ) -> String {
     let mut s = format!(
-        "{}: {} primitives, depth {}, grouped in {:.3} s; error from {samples} surface samples per wrapper\n",
+        "{}: {} primitives, depth {}, grouped in {:.3} s; error from {} surface samples per wrapper {}\n",
         scene.name,
         scene.len(),
         tree.depth_max(),
-        group_seconds
+        group_seconds,
+        how.samples,
+        nodes_measured(how.per_depth)
     );
+    let method = how.method;
     for r in reports {
         s.push_str(&kind_text(r, method));
     }
@@ -242,13 +289,12 @@ fn kind_text(r: &KindReport, method: SphereMethod) -> String {
     s
 }
 
-/// The same as one JSON object (`wrap --json`).
+/// The same as one JSON object (`wrap --json`; `tightness_nodes` 0: every node measured).
 pub fn report_json(
     scene: &Scene,
     tree: &SubsetTree,
     group_seconds: f64,
-    method: SphereMethod,
-    samples: usize,
+    how: Measured,
     reports: &[KindReport],
 ) -> serde_json::Value {
     serde_json::json!({
@@ -256,8 +302,9 @@ pub fn report_json(
         "primitives": scene.len(),
         "depth_max": tree.depth_max(),
         "grouping_seconds": group_seconds,
-        "sphere_method": method_name(method),
-        "samples": samples,
+        "sphere_method": method_name(how.method),
+        "samples": how.samples,
+        "tightness_nodes": how.per_depth,
         "wrappers": reports,
     })
 }

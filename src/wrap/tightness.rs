@@ -109,15 +109,9 @@ pub fn nodes_tightness(
                     .iter()
                     .map(|p| point_node_within(tree, scene, x, p, stack, max_visits))
                     .fold(0.0, f64::max);
-                let h = &hulls[i];
-                let reference_volume = if h.dim == 3 {
-                    h.volume()
-                } else {
-                    tree.aabb[i].volume()
-                };
                 NodeStats {
                     volume,
-                    reference_volume,
+                    reference_volume: reference_volume(tree, hulls, i),
                     error,
                 }
             },
@@ -200,6 +194,84 @@ fn mix(x: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^ (z >> 31)
+}
+
+/// Volume of wrapper `i` of `w`.
+fn wrapper_volume(w: WrapperTree<'_>, i: usize) -> f64 {
+    match w {
+        WrapperTree::Spheres(s) => s[i].volume(),
+        WrapperTree::Hulls(h) => h[i].volume(),
+        WrapperTree::Boxes(b) => Obb::from_aabb(&b[i]).volume(),
+        WrapperTree::Obbs(b) => b[i].volume(),
+    }
+}
+
+/// [`level_tightness`] with the error measured on a [`DepthSample`] of at most `per_depth`
+/// interior nodes per depth (drawn with `seed`, each sample's query stopping after
+/// [`MAX_VISITS`] node visits) and on every leaf; `per_depth` 0 measures every node exactly
+/// ([`level_tightness`]). Volumes and nodes are exact; a level's error mean is the leaves' mean
+/// and its depth's sample mean weighted by their counts, its error max the largest measured.
+pub fn level_tightness_sampled(
+    tree: &SubsetTree,
+    scene: &Scene,
+    w: WrapperTree<'_>,
+    hulls: &[Hull],
+    samples: usize,
+    (per_depth, seed): (usize, u64),
+) -> Vec<LevelStats> {
+    if per_depth == 0 {
+        return level_tightness(tree, scene, w, hulls, samples);
+    }
+    let sample = DepthSample::new(tree, per_depth, seed);
+    let mut measured: Vec<u32> = (0..tree.leaves() as u32).collect();
+    measured.extend(sample.flat());
+    let stats = nodes_tightness(tree, scene, w, hulls, samples, &measured, MAX_VISITS);
+    let mut error = vec![None; tree.len()];
+    for (&x, s) in measured.iter().zip(&stats) {
+        error[x as usize] = Some(s.error);
+    }
+    let nodes: Vec<NodeStats> = (0..tree.len())
+        .map(|i| NodeStats {
+            volume: wrapper_volume(w, i),
+            reference_volume: reference_volume(tree, hulls, i),
+            error: error[i].unwrap_or(0.0),
+        })
+        .collect();
+    (0..=tree.depth_max())
+        .map(|d| {
+            let mut level = levels_of(tree, &nodes, d);
+            let cut = tree.level(d);
+            let (mut leaf_sum, mut inner_sum, mut inner_n) = (0.0, 0.0, 0usize);
+            let mut error_max = 0.0f64;
+            for &x in &cut {
+                let Some(e) = error[x as usize] else { continue };
+                error_max = error_max.max(e);
+                if tree.is_leaf(x) {
+                    leaf_sum += e;
+                } else {
+                    inner_sum += e;
+                    inner_n += 1;
+                }
+            }
+            let inner = match inner_n {
+                0 => 0.0,
+                k => level.interior as f64 * inner_sum / k as f64,
+            };
+            level.error_max = error_max;
+            level.error_mean = (leaf_sum + inner) / cut.len().max(1) as f64;
+            level
+        })
+        .collect()
+}
+
+/// The covered geometry's volume at node `i`: its hull's, or its AABB's where the hull is flat.
+fn reference_volume(tree: &SubsetTree, hulls: &[Hull], i: usize) -> f64 {
+    let h = &hulls[i];
+    if h.dim == 3 {
+        h.volume()
+    } else {
+        tree.aabb[i].volume()
+    }
 }
 
 /// Tightness of the cuts at depths 0..=depth max (see the [module docs](self)).
@@ -315,19 +387,42 @@ fn triangle_samples(v: &[P3], tris: &[[u32; 3]], n: usize, out: &mut Vec<P3>) {
 /// How far the farthest vertex below each node lies outside its wrapper (≤ 0 when all are
 /// inside; spheres and boxes report distance beyond the surface, hulls the largest face-plane
 /// excess, see [`Hull::excess`]).
+///
+/// Hulls test each distinct vertex once per node (a vertex shared by several primitives counts
+/// once), as their test costs a pass over the faces.
 pub fn containment_excess(tree: &SubsetTree, scene: &Scene, w: WrapperTree<'_>) -> Vec<f64> {
     let order = super::order::LeafOrder::new(tree, scene);
+    let max = |pts: &mut dyn Iterator<Item = &P3>, f: &dyn Fn(&P3) -> f64| {
+        pts.map(f).fold(f64::NEG_INFINITY, f64::max)
+    };
     (0..tree.len() as u32)
-        .map(|x| {
-            let i = x as usize;
-            let pts = order.node_points(x);
-            let f = |p: &P3| match w {
-                WrapperTree::Spheres(s) => (p - s[i].center).norm() - s[i].radius,
-                WrapperTree::Hulls(h) => h[i].excess(p),
-                WrapperTree::Boxes(b) => Obb::from_aabb(&b[i]).excess(p),
-                WrapperTree::Obbs(b) => b[i].excess(p),
-            };
-            pts.iter().map(f).fold(f64::NEG_INFINITY, f64::max)
-        })
+        .into_par_iter()
+        .map_init(
+            || vec![u32::MAX; scene.points.len()],
+            |seen, x| {
+                let i = x as usize;
+                let mut pts = order.node_points(x).iter();
+                match w {
+                    WrapperTree::Spheres(s) => {
+                        max(&mut pts, &|p| (p - s[i].center).norm() - s[i].radius)
+                    }
+                    WrapperTree::Hulls(h) => {
+                        let test = h[i].excess_test();
+                        let mut distinct = order
+                            .node_leaves(x)
+                            .iter()
+                            .flat_map(|&leaf| scene.prim(leaf as usize))
+                            .filter(|&&k| std::mem::replace(&mut seen[k as usize], x) != x)
+                            .map(|&k| &scene.points[k as usize]);
+                        max(&mut distinct, &|p| test.excess(p))
+                    }
+                    WrapperTree::Boxes(b) => {
+                        let b = Obb::from_aabb(&b[i]);
+                        max(&mut pts, &|p| b.excess(p))
+                    }
+                    WrapperTree::Obbs(b) => max(&mut pts, &|p| b[i].excess(p)),
+                }
+            },
+        )
         .collect()
 }

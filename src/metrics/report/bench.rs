@@ -130,7 +130,8 @@ fn sanitize(s: &str) -> String {
         .collect()
 }
 
-/// One scene's rows as a markdown table (what `bench` prints and logs).
+/// One scene's rows as a markdown table (what `bench` prints and logs); queries stopped at the
+/// test cap are counted beside their row's tests per query and explained below the table.
 pub fn bench_table(rows: &[&Row]) -> String {
     let mut md = String::from(
         "| method | wrapper | build ms | wrapper ms | SAH | depth | tightness | tests/query |\n|---|---|---|---|---|---|---|---|\n",
@@ -146,13 +147,32 @@ pub fn bench_table(rows: &[&Row]) -> String {
             r.quality.sah,
             r.quality.depth_max,
             r.tightness.map(|t| format!("{t:.4}")).unwrap_or_default(),
-            r.query
-                .as_ref()
-                .map(|q| format!("{:.1}", query_values(q)[6]))
-                .unwrap_or_default()
+            r.query.as_ref().map(tests_cell).unwrap_or_default()
+        );
+    }
+    let capped: u64 = rows
+        .iter()
+        .filter_map(|r| r.query.as_ref())
+        .map(|q| q.capped())
+        .sum();
+    if capped > 0 {
+        let _ = writeln!(
+            md,
+            "\n{capped} queries stopped at the cap of {} tests per primitive (exact ties, e.g. \
+stacked coincident copies): their rows' tests/query are lower bounds.",
+            crate::query::MAX_TESTS_PER_PRIM
         );
     }
     md
+}
+
+/// Tests per query, with the queries stopped at the cap when there are any.
+fn tests_cell(q: &crate::query::QueryCost) -> String {
+    let tests = query_values(q)[6];
+    match q.capped() {
+        0 => format!("{tests:.1}"),
+        k => format!("{tests:.1} ({k} capped)"),
+    }
 }
 
 /// Per scene: the two charts as 2D views beside the results table.

@@ -42,18 +42,21 @@ pub(super) fn opt(v: Option<f64>) -> String {
 }
 
 /// Columns of a query cost: node (BV) and primitive tests per query of each kind, the eq. (1)
-/// total per query, and seconds for the whole workload.
+/// total per query, seconds for the whole workload, and how many queries stopped at the test
+/// cap ([`crate::query::Workload::max_tests`]).
 pub(super) const QUERY_COLUMNS: &str = "point_bv,point_prim,distance_bv,distance_prim,overlap_bv,overlap_prim,\
-node_tests_per_query,query_cost,query_s";
+node_tests_per_query,query_cost,query_s,query_capped";
 
 /// The [`QUERY_COLUMNS`] fields of a query cost, all empty without one.
 pub(super) fn query_fields(q: Option<&QueryCost>) -> Vec<String> {
     match q {
         None => vec![String::new(); QUERY_COLUMNS.split(',').count()],
-        Some(q) => crate::metrics::compare::query_values(q)
-            .iter()
-            .map(|x| format!("{x:.6e}"))
-            .collect(),
+        Some(q) => {
+            let values = crate::metrics::compare::query_values(q);
+            let mut f: Vec<String> = values.iter().map(|x| format!("{x:.6e}")).collect();
+            f.push(q.capped().to_string());
+            f
+        }
     }
 }
 
