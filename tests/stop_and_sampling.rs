@@ -1,11 +1,12 @@
-//! A requested [`Stop`] ends `bench` and `stress` early without their output, and the sampled
-//! tightness of `bench` and `wrap` is deterministic for any thread count and near the value over
-//! every node.
+//! A requested [`Stop`] ends `bench` and `stress` early without their output, a `sweep` setting
+//! over its grouping limits is left out, and the sampled tightness of `bench` and `wrap` is
+//! deterministic for any thread count and near the value over every node.
 
-use wraptree::grouping::{Params, group};
+use wraptree::grouping::{CostMeasure, Limits, Params, group};
 use wraptree::metrics::compare::{Options, Row, Step, Wrapper, evaluate};
 use wraptree::metrics::report::write_bench;
 use wraptree::metrics::stress::{self, StressOptions};
+use wraptree::metrics::sweep::{SweepRuns, grid, sweep};
 use wraptree::peers::Method;
 use wraptree::scene::{Scene, generate};
 use wraptree::stop::{Stop, is_interrupted};
@@ -164,4 +165,55 @@ fn wrap_levels_sampled_match_every_node() {
             }
         }
     }
+}
+
+/// A setting whose grouping exceeds the limits is left out with the reason; the others give
+/// rows, and a requested stop ends the sweep.
+#[test]
+fn sweep_leaves_out_settings_over_their_limits() {
+    let scene = generate::lamp();
+    let settings = grid(&[1.0], &[1.0], &[0.0], &[CostMeasure::Diameter]);
+    let run = |limits: Limits, stop: &Stop| {
+        let runs = SweepRuns {
+            repeat: 1,
+            seed: 1,
+            limits,
+        };
+        let mut merges = 0;
+        let swept = sweep(
+            &scene,
+            &settings,
+            &Params::default(),
+            &runs,
+            stop,
+            |_, _, m| {
+                merges += m.len();
+                Ok(())
+            },
+        );
+        (swept, merges)
+    };
+    let (all, merges) = run(Limits::default(), &Stop::new());
+    let all = all.unwrap();
+    assert_eq!((all.rows.len(), all.left_out.len()), (1, 0));
+    assert_eq!(merges, scene.len() - 1);
+    let few = Limits {
+        max_seconds: None,
+        max_pairs: Some(1),
+    };
+    let (none, merges) = run(few, &Stop::new());
+    let none = none.unwrap();
+    assert!(none.rows.is_empty() && merges == 0);
+    assert_eq!(none.left_out.len(), 1);
+    assert!(
+        none.left_out[0].1.contains("--max-pairs 1"),
+        "{:?}",
+        none.left_out
+    );
+    let stop = Stop::new();
+    stop.request();
+    let e = run(Limits::default(), &stop)
+        .0
+        .expect_err("a requested stop ends the sweep");
+    assert!(is_interrupted(&e), "{e}");
 }

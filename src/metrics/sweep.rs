@@ -8,10 +8,13 @@
 
 use super::{Quality, quality};
 use crate::geom::Aabb;
-use crate::grouping::{self, CostMeasure, EventLog, Merge, Mode, Params, SubsetTree, Weights};
+use crate::grouping::{
+    self, CostMeasure, EventLog, Limits, Merge, Mode, Params, StopReason, SubsetTree, Weights,
+};
 use crate::query::{self, Bv, QueryCost, Workload};
 use crate::record::compare::{CompareRun, write_comparison};
 use crate::scene::Scene;
+use crate::stop::{Interrupted, Stop};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -62,21 +65,50 @@ pub fn grid(a: &[f64], b: &[f64], c: &[f64], measures: &[CostMeasure]) -> Vec<Se
     out
 }
 
+/// What [`sweep`] measured: a row per finished setting, in grid order, and the settings left
+/// out because a grouping run exceeded the limits, each with why.
+#[derive(Clone, Debug)]
+pub struct Swept {
+    /// The finished settings.
+    pub rows: Vec<SweepRow>,
+    /// The settings left out, with one line saying what stopped them.
+    pub left_out: Vec<(Setting, String)>,
+}
+
+/// How [`sweep`] runs each setting: timed repetitions, workload seed, and the limits of each
+/// grouping run.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SweepRuns {
+    /// Timed repetitions per setting (at least one).
+    pub repeat: u32,
+    /// Seed of the query workload.
+    pub seed: u64,
+    /// Limits of each grouping run; a setting whose run exceeds them is left out.
+    pub limits: Limits,
+}
+
 /// Runs the grouping phase for every setting of `settings` (each checked first) with the other
-/// parameters of `base`; `each` receives every setting's merges (for recordings).
+/// parameters of `base`; `each` receives every finished setting's merges (for recordings).
+/// Each setting is timed up to `runs.repeat` times, repeated only while its runs took under
+/// [`REPEAT_BUDGET_S`](super::compare::REPEAT_BUDGET_S) in all; a setting whose grouping
+/// exceeds `runs.limits` is left out ([`Swept::left_out`]). `stop` is checked between merges
+/// and queries (Err: [`Interrupted`]).
 pub fn sweep(
     scene: &Scene,
     settings: &[Setting],
     base: &Params,
-    repeat: u32,
-    seed: u64,
+    runs: &SweepRuns,
+    stop: &Stop,
     mut each: impl FnMut(usize, &Setting, &[Merge]) -> anyhow::Result<()>,
-) -> anyhow::Result<Vec<SweepRow>> {
+) -> anyhow::Result<Swept> {
     for s in settings {
         s.weights.check().map_err(|e| anyhow::anyhow!("{e}"))?;
     }
-    let workload = Workload::standard(scene, seed);
-    let mut rows = Vec::with_capacity(settings.len());
+    let workload = Workload::standard(scene, runs.seed);
+    let mut swept = Swept {
+        rows: Vec::with_capacity(settings.len()),
+        left_out: Vec::new(),
+    };
     for (k, setting) in settings.iter().enumerate() {
         let params = Params {
             weights: setting.weights,
@@ -85,26 +117,53 @@ pub fn sweep(
                 ..base.mode
             },
             ..base.clone()
+        }
+        .resolve(scene);
+        let group = |log: Option<&mut EventLog>| {
+            let budget = runs.limits.budget(Some(stop.flag()));
+            grouping::group_within(scene, &params, log, &budget)
         };
-        let mut build_s = f64::INFINITY;
-        for _ in 0..repeat.max(1) {
+        let (mut build_s, mut spent) = (f64::INFINITY, 0.0);
+        let mut run = Ok(());
+        for r in 0..runs.repeat.max(1) {
+            if r > 0 && spent >= super::compare::REPEAT_BUDGET_S {
+                break;
+            }
             let t = Instant::now();
-            std::hint::black_box(grouping::group(scene, &params, ()));
-            build_s = build_s.min(t.elapsed().as_secs_f64());
+            match group(None) {
+                Ok(g) => {
+                    std::hint::black_box(g);
+                }
+                Err(e) => {
+                    run = Err(e);
+                    break;
+                }
+            }
+            let s = t.elapsed().as_secs_f64();
+            (spent, build_s) = (spent + s, build_s.min(s));
         }
         let mut log = EventLog::default();
-        let g = grouping::group(scene, &params, &mut log);
+        let g = run.and_then(|()| group(Some(&mut log)));
+        let g = match g {
+            Ok(g) => g,
+            Err(s) if s.reason == StopReason::Interrupted => return Err(Interrupted.into()),
+            Err(s) => {
+                let why = runs.limits.message(&s, scene.len());
+                swept.left_out.push((*setting, why));
+                continue;
+            }
+        };
         each(k, setting, &log.merges)?;
-        rows.push(SweepRow {
+        swept.rows.push(SweepRow {
             weights: setting.weights,
             cost: setting.cost,
             build_s,
             rounds: g.rounds,
             quality: quality(&g.tree),
-            query: query::measure(&g.tree, scene, Bv::Aabb, &workload),
+            query: query::measure_until(&g.tree, scene, Bv::Aabb, &workload, stop)?,
         });
     }
-    Ok(rows)
+    Ok(swept)
 }
 
 /// Which settings the comparison shows: one per distinct merge sequence (the first setting that
