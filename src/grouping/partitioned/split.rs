@@ -168,10 +168,9 @@ pub(super) struct Zone<'z> {
     perm: Vec<u32>,
     /// Doubled centre (min + max) of each primitive, by position on entry.
     cen: Vec<[f64; 3]>,
-    /// Bin or side of each primitive of the range being cut (on the axis being tried, and on
-    /// the best axis so far), and the partition's buffer.
+    /// Bin (binned cuts, on the chosen axis) or side (sweeps) of each primitive of the range
+    /// being cut, and the partition's buffer.
     bin: Vec<u8>,
-    best_bin: Vec<u8>,
     /// Bins of each primitive of the range being cut on the three axes (binned cuts).
     bins: Vec<[u8; 3]>,
     tmp: Vec<u32>,
@@ -267,7 +266,6 @@ impl<'z> Zone<'z> {
             perm: (0..m as u32).collect(),
             cen,
             bin: Vec::with_capacity(m),
-            best_bin: Vec::with_capacity(m),
             bins: Vec::with_capacity(m),
             tmp: Vec::with_capacity(m),
         }
@@ -296,22 +294,17 @@ impl<'z> Zone<'z> {
             cb.hi[2] - cb.lo[2],
         ];
         // Every axis with a span is tried; the cheapest cut wins (ties to the lower axis), its
-        // sides kept in `best_bin`. Bins from `cut` on are the right side.
+        // sides kept in `bin`. Bins from `cut` on are the right side.
         let spans = e.map(|w| w > 0.0 && w.is_finite());
-        let mut best: Option<(f64, usize, u8)> = None;
-        if len > SWEEP {
+        let (nl, cut) = if len > SWEEP {
             // One pass bins the centres on all three axes at once.
-            if let Some((c, nl, cut, axis)) = self.binned(start, len, &cb.lo, &e, spans) {
-                best = Some((c, nl, cut));
-                self.best_bin.clear();
-                self.best_bin.extend(self.bins.iter().map(|b| b[axis]));
-            }
-        } else if let Some((c, nl)) = self.sweep(start, len, spans) {
-            best = Some((c, nl, 1));
-            std::mem::swap(&mut self.bin, &mut self.best_bin);
-        }
-        let (_, nl, cut) = best?;
-        std::mem::swap(&mut self.bin, &mut self.best_bin);
+            let (nl, cut, axis) = self.binned(start, len, &cb.lo, &e, spans)?;
+            self.bin.clear();
+            self.bin.extend(self.bins.iter().map(|b| b[axis]));
+            (nl, cut)
+        } else {
+            (self.sweep(start, len, spans)?, 1)
+        };
         // A stable partition of the positions (side 0 first), without branches.
         self.tmp.resize(len, 0);
         let part = &mut self.perm[start..start + len];
@@ -331,8 +324,9 @@ impl<'z> Zone<'z> {
     /// sorted by centre on it, ties (and centres within 16 units in the last place) in range
     /// order (a NaN centre first, −0 as 0), and the boundary of least SAH leaving a quarter on
     /// each side; of those the cheapest (ties to the lower axis). The boxes are gathered once
-    /// for the three axes. Sets `bin` to each primitive's side.
-    fn sweep(&mut self, start: usize, len: usize, spans: [bool; 3]) -> Option<(f64, usize)> {
+    /// for the three axes. Sets `bin` to each primitive's side and returns the left side's
+    /// length.
+    fn sweep(&mut self, start: usize, len: usize, spans: [bool; 3]) -> Option<usize> {
         let (leaves, cen) = (&*self.leaves, &self.cen);
         let part = &self.perm[start..start + len];
         let least = (len / 4).max(1);
@@ -384,20 +378,20 @@ impl<'z> Zone<'z> {
                 best = Some((cost, nl, order));
             }
         }
-        let (cost, nl, order) = best?;
+        let (_, nl, order) = best?;
         self.bin.clear();
         self.bin.resize(len, 1);
         for &o in &order[..nl] {
             self.bin[o as usize] = 0;
         }
-        Some((cost, nl))
+        Some(nl)
     }
 
     /// The binned cut of a longer range: centres in [`BINS`] equal bins of `lo..lo + e` on each
     /// axis that `spans`, all three binned in one pass over the range; on each axis the bin
     /// boundary of least SAH leaving a quarter on each side, and of those the cheapest (ties to
-    /// the lower axis). Sets `bins` to each primitive's bins and returns the cost, the left
-    /// side's length, the right side's first bin and the axis.
+    /// the lower axis). Sets `bins` to each primitive's bins and returns the left side's
+    /// length, the right side's first bin and the axis.
     fn binned(
         &mut self,
         start: usize,
@@ -405,7 +399,7 @@ impl<'z> Zone<'z> {
         lo: &[f64; 3],
         e: &[f64; 3],
         spans: [bool; 3],
-    ) -> Option<(f64, usize, u8, usize)> {
+    ) -> Option<(usize, u8, usize)> {
         let (leaves, cen) = (&*self.leaves, &self.cen);
         let part = &self.perm[start..start + len];
         let least = (len / 4).max(1);
@@ -453,7 +447,7 @@ impl<'z> Zone<'z> {
                 best = Some((cost, nl, cut as u8, axis));
             }
         }
-        best
+        best.map(|(_, nl, cut, axis)| (nl, cut, axis))
     }
 
     /// Reorders the codes and leaves into the planned order.
