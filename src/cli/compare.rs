@@ -26,10 +26,14 @@ pub struct CompareCmd {
 impl CompareCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
+        let status = super::progress::Status::new("compare", "reading");
         let replays = self
             .files
             .iter()
-            .map(|f| replay::open(f))
+            .map(|f| {
+                status.set_message(format!("reading {}", f.display()));
+                replay::open(f)
+            })
             .collect::<Result<Vec<Replay>>>()?;
         let mut labels: Vec<String> = replays
             .iter()
@@ -45,7 +49,9 @@ impl CompareCmd {
             .clone()
             .unwrap_or_else(|| self.files[0].with_extension("compare"));
         let refs: Vec<&Replay> = replays.iter().collect();
+        status.set_message("writing the comparison");
         let c = replay::compare(&refs, &labels, &prefix, self.force)?;
+        drop(status);
         for (i, label) in c.labels.iter().enumerate() {
             println!("run {i}: {label}");
         }

@@ -38,6 +38,33 @@ pub fn spinner(prefix: &str) -> ProgressBar {
     bar
 }
 
+/// A [`spinner`] cleared from the terminal when dropped, so that an early return with an error
+/// leaves no progress line above it.
+pub struct Status(ProgressBar);
+
+impl Status {
+    /// A spinner labelled `prefix` showing `message`.
+    pub fn new(prefix: &str, message: &str) -> Status {
+        let bar = spinner(prefix);
+        bar.set_message(message.to_string());
+        Status(bar)
+    }
+}
+
+impl std::ops::Deref for Status {
+    type Target = ProgressBar;
+
+    fn deref(&self) -> &ProgressBar {
+        &self.0
+    }
+}
+
+impl Drop for Status {
+    fn drop(&mut self) {
+        self.0.finish_and_clear();
+    }
+}
+
 /// The command's result, with a stop request turned into one line on stderr and exit code
 /// [`EXIT_INTERRUPTED`]: commands stop before writing, so nothing was written.
 pub fn or_stopped(command: &str, result: anyhow::Result<ExitCode>) -> anyhow::Result<ExitCode> {

@@ -2,6 +2,7 @@
 //! ([`wraptree::replay`]).
 
 use super::group::{BudgetArgs, Progress};
+use super::progress::Status;
 use super::record::{LiveArgs, after_run, exit_code, print_written, stop_flag};
 use anyhow::Result;
 use clap::Args;
@@ -59,13 +60,18 @@ impl ReplayCmd {
                  --b or --c"
             );
         }
+        let status = Status::new("replay", "reading the recording");
         let replay = replay::open(&self.file)?;
+        drop(status);
         let (rec, loaded) = (&replay.rec, &replay.loaded);
         let name = self.file.display().to_string();
         print!("{}", report::header(rec, &name));
         print!("{}", report::state(&replay, &name)?);
         if self.verify {
-            let v = match report::verification(&replay, &limits)? {
+            let status = Status::new("replay --verify", "re-running the grouping");
+            let v = report::verification(&replay, &limits)?;
+            drop(status);
+            let v = match v {
                 Ok(v) => v,
                 Err(s) => {
                     let msg = limits.message(&s, loaded.scene.len());

@@ -34,11 +34,14 @@ pub struct SceneCmd {
 impl SceneCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
+        let status = super::progress::Status::new("scene", "generating");
         let scene = wraptree::scene::generate::by_name(&self.kind, self.copies, self.n, self.seed)
             .map_err(|e| anyhow!(e))?;
+        status.set_message(format!("writing {}", self.output.display()));
         let mut bytes = Vec::new();
         scene.write_obj(&mut bytes)?;
         wraptree::output::write_atomic(&self.output, &bytes, self.force)?;
+        drop(status);
         eprintln!(
             "wrote {} ({} primitives)",
             self.output.display(),

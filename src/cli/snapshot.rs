@@ -79,13 +79,17 @@ impl SnapshotCmd {
     pub fn run(self) -> Result<ExitCode> {
         let stop = wraptree::stop::Stop::on_signals();
         let (scene, params, recorded) = load(&self)?;
+        let status = super::progress::Status::new("snapshot", "grouping");
         let (g, differs) = regroup(&scene, &params, recorded.as_deref())?;
         stop.check()?;
         if differs {
-            eprintln!(
-                "warning: re-grouping the recorded scene differs from the recording; drawing the re-run"
-            );
+            status.suspend(|| {
+                eprintln!(
+                    "warning: re-grouping the recorded scene differs from the recording; drawing the re-run"
+                )
+            });
         }
+        status.set_message("building wrappers and drawing the frames");
         let (az0, el0) = self.view.angles();
         let opts = SnapshotOptions {
             levels: self.levels,
@@ -97,6 +101,7 @@ impl SnapshotCmd {
             force: self.force,
         };
         let s = draw(&scene, &g.tree, &opts, &self.output)?;
+        drop(status);
         print!("{}", s.text(&scene, &g.tree));
         Ok(ExitCode::SUCCESS)
     }
