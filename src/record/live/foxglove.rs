@@ -16,7 +16,7 @@ use std::time::Duration;
 
 use anyhow::{Context as _, Result, anyhow, bail};
 use foxglove::websocket::{ChannelView, Client, ServerListener};
-use foxglove::{ChannelBuilder, ChannelId, Context, PartialMetadata, RawChannel, Schema};
+use foxglove::{ChannelBuilder, ChannelId, Context, PartialMetadata, RawChannel, Schema, SinkId};
 use foxglove::{WebSocketServer, WebSocketServerHandle};
 
 use super::queue::{Counts, Lossy, wait_while_progressing};
@@ -56,20 +56,46 @@ struct Latched {
     log_time: u64,
 }
 
-type Latest = Arc<Mutex<HashMap<ChannelId, Latched>>>;
+/// What the forwarding thread and the server's subscription callbacks share.
+///
+/// The server registers a subscription before it tells the listener, so a message logged to
+/// the whole channel in between would reach the client and then come again as the latched
+/// one. Messages therefore go to each client by its sink, and only to clients already sent
+/// the latched message: each client gets every message of a channel once and in order.
+#[derive(Default)]
+struct Shared {
+    latest: HashMap<ChannelId, Latched>,
+    clients: HashMap<ChannelId, Vec<SinkId>>,
+}
 
-/// Sends the latched message of a channel to a client that subscribes to it.
+type Latest = Arc<Mutex<Shared>>;
+
+/// Sends the latched message of a channel to a client that subscribes to it, then lets the
+/// forwarding thread send it the rest.
 struct Latch(Latest);
 
 impl ServerListener for Latch {
     fn on_subscribe(&self, client: Client, channel: ChannelView) {
-        // The lock is held while sending, as by the forwarding thread: the client gets the
-        // latched message before any later one of that channel.
-        let latest = self.0.lock().unwrap_or_else(PoisonError::into_inner);
-        if let Some(l) = latest.get(&channel.id()) {
+        let Some(sink) = client.sink_id() else {
+            return;
+        };
+        let mut shared = self.0.lock().unwrap_or_else(PoisonError::into_inner);
+        if let Some(l) = shared.latest.get(&channel.id()) {
             let meta = PartialMetadata::with_log_time(l.log_time);
-            l.channel
-                .log_with_meta_to_sink(&l.data, meta, client.sink_id());
+            l.channel.log_with_meta_to_sink(&l.data, meta, Some(sink));
+        }
+        let clients = shared.clients.entry(channel.id()).or_default();
+        if !clients.contains(&sink) {
+            clients.push(sink);
+        }
+    }
+
+    fn on_unsubscribe(&self, client: Client, channel: ChannelView) {
+        let mut shared = self.0.lock().unwrap_or_else(PoisonError::into_inner);
+        if let (Some(sink), Some(clients)) =
+            (client.sink_id(), shared.clients.get_mut(&channel.id()))
+        {
+            clients.retain(|&c| c != sink);
         }
     }
 }
@@ -198,7 +224,7 @@ fn host_port(addr: &str) -> Result<(String, u16)> {
 }
 
 /// The forwarding thread: schemas and channels registered with the server's context, messages
-/// logged to their channel and kept as its latest.
+/// sent to the channel's admitted clients and kept as its latest.
 fn forward(queue: &Lossy<Item>, ctx: &Arc<Context>, latest: &Latest) {
     let mut schemas: HashMap<(u32, u16), Schema> = HashMap::new();
     let mut channels: HashMap<(u32, u16), Arc<RawChannel>> = HashMap::new();
@@ -233,10 +259,13 @@ fn forward(queue: &Lossy<Item>, ctx: &Arc<Context>, latest: &Latest) {
             } => {
                 if let Some(ch) = channels.get(&(tee, channel)) {
                     let data: Arc<[u8]> = data.into();
-                    let mut latest = latest.lock().unwrap_or_else(PoisonError::into_inner);
-                    ch.log_with_meta(&data, PartialMetadata::with_log_time(log_time));
+                    let mut shared = latest.lock().unwrap_or_else(PoisonError::into_inner);
+                    let meta = PartialMetadata::with_log_time(log_time);
+                    for &sink in shared.clients.get(&ch.id()).into_iter().flatten() {
+                        ch.log_with_meta_to_sink(&data, meta, Some(sink));
+                    }
                     let channel = ch.clone();
-                    latest.insert(
+                    shared.latest.insert(
                         ch.id(),
                         Latched {
                             channel,
