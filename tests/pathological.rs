@@ -424,18 +424,24 @@ fn hull_wrappers_hold_their_vertices_across_12_decades() {
 /// the two live bodies of smallest tie tag (the id, unseeded) each time. The partner searches
 /// must keep that order with O(N²) candidate examinations: bodies of identical geometry that
 /// re-search between two merges share one scan, where one scan each would make it O(N³).
+/// The same holds for the hull p-set, whose bodies are their vertex sets.
 #[test]
 fn coincident_bodies_merge_smallest_ids_first_in_quadratic_work() {
-    let n = 600;
-    let s = path::coincident(n);
-    let (g, log) = common::run(&s, &Params::default());
-    common::check_tree(&s, &g, &log);
-    let mut live: std::collections::BTreeSet<u32> = (0..n as u32).collect();
-    for (i, m) in log.merges.iter().enumerate() {
-        let (a, b) = (live.pop_first().unwrap(), live.pop_first().unwrap());
-        assert_eq!((m.a, m.b), (a, b), "merge {i}");
-        live.insert(m.new);
+    for (n, params) in [(600, Params::default()), (300, hull_pset())] {
+        let s = path::coincident(n);
+        let (g, log) = common::run(&s, &params);
+        common::check_tree(&s, &g, &log);
+        let mut live: std::collections::BTreeSet<u32> = (0..n as u32).collect();
+        for (i, m) in log.merges.iter().enumerate() {
+            let (a, b) = (live.pop_first().unwrap(), live.pop_first().unwrap());
+            assert_eq!((m.a, m.b), (a, b), "{:?} merge {i}", params.pset);
+            live.insert(m.new);
+        }
+        let c = g.stats.candidates;
+        assert!(
+            c < 8 * (n * n) as u64,
+            "{:?}: {c} candidates for {n} bodies",
+            params.pset
+        );
     }
-    let c = g.stats.candidates;
-    assert!(c < 8 * (n * n) as u64, "{c} candidates for {n} bodies");
 }

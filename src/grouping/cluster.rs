@@ -100,7 +100,7 @@ struct Clusterer<P, O> {
     morton_scale: [f64; 3],
     mpairs: MPairs,
     partners: Partners,
-    /// Partner list length: several for the AABB p-set, one (the best partner) otherwise.
+    /// Partner list length.
     k: usize,
     /// Whether Cost lower bounds may skip voxels (AABB p-set, finite non-negative weights,
     /// scene coordinates far from overflow).
@@ -167,7 +167,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             morton_scale,
             mpairs: MPairs::default(),
             partners: Partners::default(),
-            k: if P::AABB { super::mpairs::K_MAX } else { 1 },
+            k: super::mpairs::K_MAX,
             prune,
             finite,
             quick: prune

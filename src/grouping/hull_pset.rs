@@ -119,7 +119,15 @@ impl HullBodies {
 
 impl PSetBodies for HullBodies {
     fn eligible(&self, x: u32, y: u32, merged: &Aabb, glimit: f64) -> Option<f64> {
-        if self.gap(x, y, &merged.center()) > glimit {
+        // GJK in f32 need not give the same distance with the bodies swapped: they go in the
+        // order of their vertices, so a pair is eligible from both of its bodies or from
+        // neither, and a body's pairs are those of any body with the same vertices.
+        let (a, b) = if self.vertices_first(x, y) {
+            (x, y)
+        } else {
+            (y, x)
+        };
+        if self.gap(a, b, &merged.center()) > glimit {
             return None;
         }
         Some(self.union_diameter(x, y))
@@ -136,9 +144,23 @@ impl PSetBodies for HullBodies {
         self.diameter.push(d);
         d
     }
+
+    fn same(&self, x: u32, y: u32) -> bool {
+        let bits = |p: &P3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+        let (a, b) = (&self.points[x as usize], &self.points[y as usize]);
+        a.len() == b.len() && a.iter().zip(b).all(|(p, q)| bits(p) == bits(q))
+    }
 }
 
 impl HullBodies {
+    /// Whether `x`'s vertices come before (or are) `y`'s, in the order of their coordinates'
+    /// bits.
+    fn vertices_first(&self, x: u32, y: u32) -> bool {
+        let bits = |p: &P3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+        let (a, b) = (&self.points[x as usize], &self.points[y as usize]);
+        a.iter().flat_map(bits).le(b.iter().flat_map(bits))
+    }
+
     fn union_diameter(&self, x: u32, y: u32) -> f64 {
         let (a, b) = (&self.points[x as usize], &self.points[y as usize]);
         let (da, db) = (self.diameter[x as usize], self.diameter[y as usize]);

@@ -16,6 +16,10 @@ pub(super) trait PSetBodies {
     fn eligible(&self, x: u32, y: u32, merged: &Aabb, glimit: f64) -> Option<f64>;
     /// Records the merge of `x` and `y` into body `new`; returns the new body's diameter.
     fn merge(&mut self, x: u32, y: u32, new: u32, merged: &Aabb) -> f64;
+    /// Whether bodies `x` and `y`, whose boxes and diameters are bit for bit the same, are
+    /// the same body for every pair they are in ([`PSetBodies::eligible`] gives them the same
+    /// answers): the searches then share one scan (`cluster::scan::Memo`).
+    fn same(&self, x: u32, y: u32) -> bool;
 }
 
 /// The AABB p-set: the diameter is the box diagonal and the L∞ box gap is the gap.
@@ -30,5 +34,9 @@ impl PSetBodies for AabbBodies {
     #[inline(always)]
     fn merge(&mut self, _: u32, _: u32, _: u32, merged: &Aabb) -> f64 {
         merged.diameter()
+    }
+    /// A body is its box.
+    fn same(&self, _: u32, _: u32) -> bool {
+        true
     }
 }

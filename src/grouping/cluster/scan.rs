@@ -22,21 +22,22 @@ use super::{Clusterer, PSetBodies, ScanLimit, fill_balance};
 use crate::events::Observer;
 use crate::geom::surface_area;
 use crate::geom::{Aabb, P3, V3};
-use crate::grouping::mpairs::{K_MAX, List, Top};
+use crate::grouping::mpairs::{K_MAX, Top};
 use crate::grouping::voxel_hash::{CellBounds, DEAD, Rec};
 use crate::grouping::{CostMeasure, Weights};
 
-/// The last AABB search: the bits of its searcher's box and diameter and the voxel hash
-/// version, and the first `K_MAX + 1` partners in key order of all stored bodies, the searcher
-/// included.
+/// The last search after a merge: its searcher, the bits of the searcher's box and diameter
+/// and the voxel hash version, and the first `K_MAX + 1` partners in key order of all stored
+/// bodies, the searcher included.
 ///
 /// With one partner more than a list holds and the searcher counted as its own candidate, the
-/// result, with the searcher dropped, serves every body of bit-identical box and diameter: their
-/// candidates' keys are the same and differ only by which body is left out. It is kept until
-/// the voxel hash changes, so N coincident bodies re-searching between two merges cost one
-/// scan, not N.
+/// result, with the searcher dropped, serves every body of bit-identical box, diameter and
+/// p-set body ([`PSetBodies::same`]): their candidates' keys are the same and differ only by
+/// which body is left out. It is kept until the voxel hash changes, so N coincident bodies
+/// re-searching between two merges cost one scan, not N.
 pub(super) struct Memo {
     key: ([u64; 6], u64, u64),
+    body: u32,
     top: Top<{ K_MAX + 1 }>,
 }
 
@@ -405,8 +406,41 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                 self.scan_pruned::<2>(x, glimit)
             }
         } else {
-            self.scan_all(x, glimit);
+            self.search_any(x, glimit);
         }
+    }
+
+    /// The memo key of body `x`: its box and diameter bits and the voxel hash version.
+    fn memo_key(&self, x: u32) -> ([u64; 6], u64, u64) {
+        let (xa, dx) = (self.aabb[x as usize], self.diameter[x as usize]);
+        let b = |p: &P3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+        let (l, h) = (b(&xa.min), b(&xa.max));
+        let key = [l[0], l[1], l[2], h[0], h[1], h[2]];
+        (key, dx.to_bits(), self.hash.version())
+    }
+
+    /// `x`'s list from the [`Memo`] of a search by a body identical to it, if there is one.
+    fn reuse_memo(&mut self, x: u32, key: &([u64; 6], u64, u64)) -> bool {
+        let Some(m) = &self.memo else {
+            return false;
+        };
+        if m.key != *key || !self.pset.same(m.body, x) {
+            return false;
+        }
+        *self.partners.get(x) = m.top.without(x, self.k);
+        true
+    }
+
+    /// The search of a body after a merge for p-sets other than AABB: [`Self::scan_all`]'s
+    /// list, served from the [`Memo`] where it can be.
+    fn search_any(&mut self, x: u32, glimit: f64) {
+        let key = self.memo_key(x);
+        if self.reuse_memo(x, &key) {
+            return;
+        }
+        let (top, _) = self.scan_list::<{ K_MAX + 1 }>(x, glimit, true);
+        *self.partners.get(x) = top.without(x, self.k);
+        self.memo = Some(Memo { key, body: x, top });
     }
 
     /// Every eligible pair once (AABB p-set); returns their number (so far, when `limit` cuts
@@ -494,20 +528,11 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         let (k, w) = (self.k, self.params.weights);
         let xa = self.aabb[x as usize];
         let dx = self.diameter[x as usize];
-        let hash = &self.hash;
-        let b = |p: &P3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
-        let (l, h) = (b(&xa.min), b(&xa.max));
-        let key = (
-            [l[0], l[1], l[2], h[0], h[1], h[2]],
-            dx.to_bits(),
-            hash.version(),
-        );
-        if let Some(m) = &self.memo
-            && m.key == key
-        {
-            *self.partners.get(x) = m.top.without(x, k);
+        let key = self.memo_key(x);
+        if self.reuse_memo(x, &key) {
             return;
         }
+        let hash = &self.hash;
         let (lo, hi) = self.query(&xa, glimit);
         let area = self.params.mode.cost == CostMeasure::Area;
         let prune = self.prune && !area;
@@ -623,32 +648,44 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         }
         self.stats.candidates += candidates;
         *self.partners.get(x) = list.without(x, k);
-        self.memo = Some(Memo { key, top: list });
+        self.memo = Some(Memo {
+            key,
+            body: x,
+            top: list,
+        });
     }
 
-    /// The best partner of `x` over every candidate (any p-set); returns the number of
-    /// eligible partners.
+    /// The first partners of `x` over every candidate (any p-set), into its list; returns the
+    /// number of eligible partners.
     fn scan_all(&mut self, x: u32, glimit: f64) -> u32 {
-        let k = self.k;
+        let (list, eligible) = self.scan_list::<K_MAX>(x, glimit, false);
+        *self.partners.get(x) = list;
+        eligible
+    }
+
+    /// The first `C` partners of `x` in key order over every candidate, `x` itself among them
+    /// when `with_self` (see [`Memo`]), and the number of eligible pairs found.
+    fn scan_list<const C: usize>(&mut self, x: u32, glimit: f64, with_self: bool) -> (Top<C>, u32) {
+        let k = self.k + usize::from(with_self);
         let xa = self.aabb[x as usize];
         let dx = self.diameter[x as usize];
         let (lo, hi) = self.query(&xa, glimit);
         let (hash, pset, tags, w) = (&self.hash, &self.pset, &self.tag, self.params.weights);
         let area = self.params.mode.cost == CostMeasure::Area;
-        let mut list = List::EMPTY;
+        let mut list = Top::<C>::EMPTY;
         let mut eligible = 0u32;
         let mut candidates = 0u64;
         hash.for_each_cell(&lo, &hi, |cell, _| {
             for r in hash.recs(cell) {
                 candidates += 1;
-                if r.id == x || r.id == DEAD || apart(&xa, &r.aabb, glimit) {
+                if (r.id == x && !with_self) || r.id == DEAD || apart(&xa, &r.aabb, glimit) {
                     continue;
                 }
                 let merged = xa.merge(&r.aabb);
                 let Some(d) = pset.eligible(x, r.id, &merged, glimit) else {
                     continue;
                 };
-                eligible += 1;
+                eligible += u32::from(r.id != x);
                 let (d, sx, sy) = if area {
                     let e = merged.max - merged.min;
                     measures(true, &e, &xa, dx, &r.aabb, r.diameter)
@@ -660,7 +697,6 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             }
         });
         self.stats.candidates += candidates;
-        *self.partners.get(x) = list;
-        eligible
+        (list, eligible)
     }
 }
