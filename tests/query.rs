@@ -431,7 +431,8 @@ fn scene_distance_ends_at_the_first_touching_pair() {
 }
 
 /// Stacked coincident copies tie every scene–copy pair: the workload's queries stop at their
-/// test cap, are counted as capped, and a capped distance is never below the true one.
+/// test cap, are counted as capped (a set's queries after the first capped one are not run),
+/// and a capped distance is never below the true one.
 #[test]
 fn workload_queries_stop_at_the_cap_on_coincident_copies() {
     let s = wraptree::scene::pathological::coincident(400);
@@ -446,6 +447,9 @@ fn workload_queries_stop_at_the_cap_on_coincident_copies() {
     for m in [cost.point, cost.distance, cost.overlap] {
         assert!(m.bv_tests + m.prim_tests <= 20_002.0, "{m:?}");
     }
+    // Once one distance query reaches the cap, the other seven are not run.
+    let d = cost.distance;
+    assert!((d.bv_tests + d.prim_tests) * 8.0 <= 20_002.0, "{d:?}");
     let h = Hierarchy {
         tree: &tree,
         scene: &s,
