@@ -438,7 +438,11 @@ fn workload_queries_stop_at_the_cap_on_coincident_copies() {
     let s = wraptree::scene::pathological::coincident(400);
     let tree = pairing_tree(&s);
     let mut w = Workload::standard(&s, 1);
-    assert!(w.max_tests >= wraptree::query::MIN_MAX_TESTS);
+    // 256·400 < 2·400² < 2^24.
+    assert_eq!(w.max_tests, 2 * 400 * 400);
+    assert_eq!(Workload::cap(10), 2560);
+    assert_eq!(Workload::cap(10_000), 1 << 24);
+    assert_eq!(Workload::cap(100_000), 25_600_000);
     w.max_tests = 20_000;
     let cost = measure(&tree, &s, Bv::Aabb, &w);
     // 400² = 160,000 tied pairs per near pose.

@@ -29,8 +29,8 @@ pub use moved::{moved, moved_spheres};
 pub use pair::{overlap, overlap_within, scene_distance, scene_distance_within};
 pub use point::{point_distance, point_distance_within};
 pub use workload::{
-    C_P, C_V, MAX_TESTS_PER_PRIM, MIN_MAX_TESTS, MeanCost, QueryCost, Workload, measure,
-    measure_until,
+    C_P, C_V, MAX_TESTS_PER_PAIR, MAX_TESTS_PER_PRIM, MIN_MAX_TESTS, MeanCost, QueryCost, Workload,
+    measure, measure_until,
 };
 
 use crate::geom::{Aabb, P3};

@@ -23,17 +23,22 @@ pub const C_V: f64 = 1.0;
 pub const C_P: f64 = 1.0;
 
 /// Tests (BV and primitive) per primitive of the scene after which a query of
-/// [`Workload::standard`] stops ([`Counts::capped`]), with at least [`MIN_MAX_TESTS`]. The cap
-/// is at least twice the most any query of the workload makes on the bundled and reference
-/// meshes (1.4·10^7 = 110·n, a scene–copy distance with sphere BVs on the 124,705-polygon
-/// monastery; at most 230·n and 8.2·10^6 on the others), so only exact ties reach it: `k`
-/// stacked coincident copies of a part make a scene–copy query test `k²` tied pairs (up to
-/// `n²`).
+/// [`Workload::standard`] stops ([`Counts::capped`]) on larger scenes ([`Workload::cap`]). The
+/// cap is at least twice the most any query of the workload makes on the bundled and reference
+/// meshes above 2,000 primitives (1.4·10^7 = 110·n, a scene–copy distance with sphere BVs on
+/// the 124,705-polygon monastery), so only exact ties reach it: `k` stacked coincident copies
+/// of a part make a scene–copy query test `k²` tied pairs (up to `n²`).
 pub const MAX_TESTS_PER_PRIM: u64 = 256;
 
-/// The least per-query test cap of [`Workload::standard`]: 2^18 ≈ 2.6·10^5 tests (a few tens
-/// of milliseconds), above the `5n²` tests of any pair query on a scene of up to 229 primitives.
-pub const MIN_MAX_TESTS: u64 = 1 << 18;
+/// Tests per pair of primitives (`n²`) below which the cap of [`Workload::standard`] does not
+/// go, up to [`MIN_MAX_TESTS`]: small scenes make more tests per primitive (0.88·n² = 559·n, a
+/// scene–copy distance with Goldsmith–Salmon's tree and merged spheres on a 636-polygon
+/// scene), and a query tests at most about `5n²`.
+pub const MAX_TESTS_PER_PAIR: u64 = 2;
+
+/// The largest floor of the per-query cap ([`Workload::cap`]): 2^24 ≈ 1.7·10^7 tests, about
+/// 2 s.
+pub const MIN_MAX_TESTS: u64 = 1 << 24;
 
 /// Query points and poses of a copy of the scene (see [`Workload::standard`]).
 #[derive(Clone, Debug)]
@@ -63,6 +68,16 @@ fn pose_about(rot: UnitQuaternion<f64>, from: &P3, to: &P3) -> Isometry3<f64> {
 }
 
 impl Workload {
+    /// The test cap of a query on a scene of `n` primitives: [`MAX_TESTS_PER_PRIM`]·n, and at
+    /// least [`MAX_TESTS_PER_PAIR`]·n² or [`MIN_MAX_TESTS`], whichever is less.
+    pub fn cap(n: usize) -> u64 {
+        let n = n as u64;
+        let floor = MAX_TESTS_PER_PAIR
+            .saturating_mul(n.saturating_mul(n))
+            .min(MIN_MAX_TESTS);
+        MAX_TESTS_PER_PRIM.saturating_mul(n).max(floor)
+    }
+
     /// The standard workload for `scene`; the same seed gives the same workload. Panics if the
     /// scene is empty.
     ///
@@ -80,8 +95,7 @@ impl Workload {
     ///   original (a random vertex when the scene has no triangles). The two triangles then
     ///   cross there, so the copy overlaps the original partially.
     ///
-    /// Each query stops after [`MAX_TESTS_PER_PRIM`] tests per primitive of the scene (at least
-    /// [`MIN_MAX_TESTS`]).
+    /// Each query stops after [`Workload::cap`] tests.
     pub fn standard(scene: &Scene, seed: u64) -> Workload {
         assert!(!scene.is_empty(), "the workload needs a non-empty scene");
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -126,7 +140,7 @@ impl Workload {
             points,
             poses_near,
             poses_touching,
-            max_tests: (MAX_TESTS_PER_PRIM * scene.len() as u64).max(MIN_MAX_TESTS),
+            max_tests: Workload::cap(scene.len()),
         }
     }
 }
