@@ -155,7 +155,10 @@ fn parse_joint(s: &str) -> Result<(String, f64), String> {
 /// Parameters of the grouping phase (§2.2).
 #[derive(Args, Debug, Clone)]
 pub struct GroupArgs {
-    /// Cost exponent A in Cost = diameter^A × (B·Fill + C·Balance).
+    /// Cost exponent A in Cost = diameter^A × (B·Fill + C·Balance) (with B = C = 0 the
+    /// bracket is 1). A = B = C = 0 makes every Cost 1, so pairs merge in id order, far from
+    /// each other's best: about 30× slower (a 2·10^5-triangle soup: 7 min; in group, record
+    /// and cover --max-seconds bounds it).
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     pub a: f64,
     /// Fill weight B.
