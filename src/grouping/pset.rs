@@ -7,9 +7,8 @@ use crate::geom::Aabb;
 pub(super) trait PSetBodies {
     /// Whether the diameter of a pair is the diagonal of the union of the two boxes (the AABB
     /// p-set). Its Cost is then a symmetric function of the two records, bounded below by the
-    /// boxes' positions, which lets the searches visit each pair once at round start, keep
-    /// several partners per body and skip voxels that cannot improve a list
-    /// (`cluster::scan`). Other p-sets search for their single best partner, as in the paper.
+    /// boxes' positions, which lets the searches visit each pair once at round start and skip
+    /// voxels that cannot improve a list (`cluster::scan`). Other p-sets read every candidate.
     const AABB: bool = false;
     /// The diameter of the body `x ∪ y` if the pair is eligible (gap ≤ `glimit`), given that
     /// their AABBs are within L∞ gap `glimit` and `merged` is the union of their AABBs.

@@ -10,8 +10,9 @@
 //! whose records are sorted by smallest x it reads them outward from the searcher and stops each
 //! way at the first record no pair with could enter the list. Where the round's cells are
 //! crowded ([`CROWDED`]), the round-start scan runs that search for each body instead and counts
-//! the eligible pairs apart (`count_pairs`). Other p-sets search every candidate for the single
-//! best partner, as in the paper.
+//! the eligible pairs apart (`count_pairs`). Other p-sets search every candidate for the first
+//! partners (`scan_all`). A search after a merge by a body identical to the last searcher (same
+//! box, diameter and p-set body, the voxel hash unchanged) reuses its result ([`Memo`]).
 //!
 //! With `--cost area` the bound and the `sqrt`-free filter ([`Quick`]) do not hold, so those
 //! searches visit every reachable cell (`docs/method.md`, "The Cost in surface area").
