@@ -145,6 +145,24 @@ fn degenerate_faces_are_dropped_with_a_warning() {
     );
 }
 
+/// A face written twice (once per winding, as double-sided exports write it) and a duplicated
+/// vertex position: the loader names the file and counts the coincident primitives.
+#[test]
+fn coincident_faces_are_counted_in_a_warning() {
+    let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 0\nv 2 0 0\nv 0 2 0\n\
+                f 1 2 3\nf 3 2 4\nf 4 5 6\n";
+    let l = load_str("double.obj", text, POLYGONS).unwrap();
+    assert_eq!(l.scene.len(), 3);
+    assert_eq!(
+        l.warnings,
+        [
+            "double.obj: 2 of 3 primitives have the same vertices as another (double-sided \
+             faces or duplicated parts); such pairs tie in every Cost and query, which slows the \
+             hull p-set and bench's queries"
+        ]
+    );
+}
+
 const CUBE: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n";
 
 #[test]

@@ -51,9 +51,9 @@ enum Command {
     Scene(scene_cmd::SceneCmd),
     /// Compare every hierarchy builder × wrapper on scenes (CSV, charts, .rrd), or print the
     /// targets table against obvhs PLOC and parry Binned. With the defaults a scene takes about
-    /// 1.5–4 ms per primitive on 2 cores (35,880 polygons: under a minute; 124,004: 4 min);
-    /// stacked coincident copies, whose queries stop at their test cap, up to about 5 s per
-    /// builder × wrapper (1,000 coincident triangles: 50 s).
+    /// 1.5–4 ms per primitive on 2 cores (35,880 polygons: under a minute; 124,004: 4 min).
+    /// Stacked coincident copies cost more: their queries test every tied pair, up to a cap
+    /// (ten coincident copies of a 3,476-triangle part: about 40 s per builder).
     Bench(bench::BenchCmd),
     /// Run the A/B/C grid of the grouping Cost on a scene: table, heat maps, the series of every
     /// setting (sweep.rrd) and the trees of the 6 best distinct settings side by side

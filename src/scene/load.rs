@@ -270,8 +270,23 @@ pub(super) fn read_file(path: &Path) -> Result<Vec<u8>, String> {
 }
 
 /// Loads `bytes` named `file_name`, with the directory of the files it refers to (`None`: it
-/// may refer to none).
+/// may refer to none), warning of coincident primitives ([`super::coincident`]).
 fn load_in(
+    file_name: &str,
+    bytes: Vec<u8>,
+    opts: &LoadOptions,
+    dir: Option<&Path>,
+    urdf_opts: &UrdfOptions,
+) -> Result<Loaded, LoadError> {
+    let mut loaded = load_format(file_name, bytes, opts, dir, urdf_opts)?;
+    loaded
+        .warnings
+        .extend(super::coincident::warning(file_name, &loaded.scene));
+    Ok(loaded)
+}
+
+/// [`load_in`] by the file's format.
+fn load_format(
     file_name: &str,
     bytes: Vec<u8>,
     opts: &LoadOptions,
