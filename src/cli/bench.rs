@@ -79,6 +79,11 @@ pub(super) fn load_spec(spec: &str) -> Result<wraptree::scene::Scene> {
 }
 
 impl BenchCmd {
+    /// The `--threads` asked for, if any.
+    pub fn threads(&self) -> Option<usize> {
+        self.threads
+    }
+
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         let threads = super::build_pool(self.threads)?;

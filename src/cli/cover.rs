@@ -41,6 +41,11 @@ pub struct CoverCmd {
 }
 
 impl CoverCmd {
+    /// The `--threads` asked for, if any.
+    pub fn threads(&self) -> Option<usize> {
+        self.group.threads
+    }
+
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         if self.budget == Some(0) {

@@ -92,6 +92,11 @@ impl Observer for Progress {
 }
 
 impl GroupCmd {
+    /// The `--threads` asked for, if any.
+    pub fn threads(&self) -> Option<usize> {
+        self.group.threads
+    }
+
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         let loaded = self.scene.load()?;

@@ -290,8 +290,21 @@ pub fn build_pool(threads: Option<usize>) -> Result<usize> {
     Ok(rayon::current_num_threads())
 }
 
-/// Runs the parsed command.
+/// Runs the parsed command, its `--threads` pool built first, so that loading and every other
+/// step before the grouping run on it too.
 pub fn run(cli: Cli) -> Result<ExitCode> {
+    let threads = match &cli.command {
+        Command::Group(c) => c.threads(),
+        Command::Record(c) => c.threads(),
+        Command::Snapshot(c) => c.threads(),
+        Command::Wrap(c) => c.threads(),
+        Command::Cover(c) => c.threads(),
+        Command::Bench(c) => c.threads(),
+        _ => None,
+    };
+    if threads.is_some() {
+        build_pool(threads)?;
+    }
     match cli.command {
         Command::Group(c) => c.run(),
         Command::Record(c) => c.run(),

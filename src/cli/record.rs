@@ -196,6 +196,11 @@ pub fn print_written(w: &Written, scene: &Scene) {
 }
 
 impl RecordCmd {
+    /// The `--threads` asked for, if any.
+    pub fn threads(&self) -> Option<usize> {
+        self.group.threads
+    }
+
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         // Installed before loading so an early Ctrl-C still ends in readable, incomplete files.

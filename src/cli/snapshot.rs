@@ -75,6 +75,11 @@ fn load(cmd: &SnapshotCmd) -> Result<(Scene, ResolvedParams, Option<Vec<Merge>>)
 }
 
 impl SnapshotCmd {
+    /// The `--threads` asked for, if any.
+    pub fn threads(&self) -> Option<usize> {
+        self.group.threads
+    }
+
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         let stop = wraptree::stop::Stop::on_signals();

@@ -40,6 +40,11 @@ pub struct WrapCmd {
 }
 
 impl WrapCmd {
+    /// The `--threads` asked for, if any.
+    pub fn threads(&self) -> Option<usize> {
+        self.group.threads
+    }
+
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         let loaded = self.scene.load()?;
