@@ -138,9 +138,15 @@ fn start_record(dir: &Path, args: &[&str]) -> (Proc, Lines) {
     (p, lines)
 }
 
+/// Runs `wraptree` with `args` in `dir`, failing the test if it takes over 2 minutes.
 fn wraptree(dir: &Path, args: &[&str]) -> Output {
-    common::wraptree(args, dir)
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_wraptree"));
+    cmd.args(args).current_dir(dir);
+    common::output_within(cmd, &format!("wraptree {}", args.join(" ")), LIMIT)
 }
+
+/// How long any one child command of these tests may take.
+const LIMIT: Duration = Duration::from_secs(120);
 
 /// The `rerun` executable itself (the venv's `bin/rerun` is a Python wrapper that runs it as a
 /// child, which a signal to the wrapper would leave running).
@@ -162,11 +168,9 @@ fn rerun_exe() -> PathBuf {
 fn same_recording(a: &Path, b: &Path) -> Result<(), String> {
     // Unordered: a file written alone holds its per-merge batches back until the levels are
     // written (`record::rrd`), a live one sends them as they fill; the data is the same.
-    let out = common::rerun()
-        .args(["rrd", "compare", "--unordered"])
-        .args([a, b])
-        .output()
-        .expect("rerun runs");
+    let mut cmd = common::rerun();
+    cmd.args(["rrd", "compare", "--unordered"]).args([a, b]);
+    let out = common::output_within(cmd, "rerun rrd compare", LIMIT);
     if out.status.success() {
         Ok(())
     } else {
@@ -210,11 +214,9 @@ for c in RrdReader(sys.argv[1]).stream():
     out[c.entity_path] = out.get(c.entity_path, 0) + c.num_rows
 print(json.dumps(out))
 "#;
-    let out = common::python()
-        .args(["-c", READER])
-        .arg(rrd)
-        .output()
-        .expect("python runs");
+    let mut cmd = common::python();
+    cmd.args(["-c", READER]).arg(rrd);
+    let out = common::output_within(cmd, "RrdReader", LIMIT);
     assert!(
         out.status.success(),
         "RrdReader on {}: {out:?}",
@@ -521,12 +523,11 @@ fn spawn_starts_the_rerun_on_path_and_streams_to_it() {
         std::env::var("PATH").unwrap_or_default()
     );
     let base = scene("robot-base.obj");
-    let out = Command::new(env!("CARGO_BIN_EXE_wraptree"))
-        .args(["record", &base, "-o", "spawned", "--spawn"])
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_wraptree"));
+    cmd.args(["record", &base, "-o", "spawned", "--spawn"])
         .current_dir(dir.path())
-        .env("PATH", path)
-        .output()
-        .expect("the binary runs");
+        .env("PATH", path);
+    let out = common::output_within(cmd, "wraptree record --spawn", LIMIT);
     let receiver_pid = std::fs::read_to_string(&pid).ok();
     let _kill = KillOnDrop(receiver_pid.as_deref().and_then(|p| p.trim().parse().ok()));
     assert!(out.status.success(), "{out:?}");
@@ -602,12 +603,11 @@ fn bad_live_flags_give_one_error_line() {
     drop(taken);
 
     // --spawn without a `rerun` on PATH.
-    let out = Command::new(env!("CARGO_BIN_EXE_wraptree"))
-        .args(["record", &base, "-o", "x", "--spawn"])
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_wraptree"));
+    cmd.args(["record", &base, "-o", "x", "--spawn"])
         .current_dir(dir.path())
-        .env("PATH", dir.path())
-        .output()
-        .expect("the binary runs");
+        .env("PATH", dir.path());
+    let out = common::output_within(cmd, "wraptree record --spawn", LIMIT);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert_eq!(

@@ -30,6 +30,59 @@ pub fn wraptree(args: &[&str], dir: &std::path::Path) -> std::process::Output {
         .expect("the binary runs")
 }
 
+/// Runs `cmd` to its end like `Command::output`, but panics (naming `what`) if it has not
+/// ended within `limit`, after killing it: a stuck child fails its test instead of holding the
+/// whole run.
+pub fn output_within(
+    mut cmd: std::process::Command,
+    what: &str,
+    limit: std::time::Duration,
+) -> std::process::Output {
+    use std::io::Read;
+    use std::process::Stdio;
+    let mut child = cmd
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap_or_else(|e| panic!("cannot start {what}: {e}"));
+    // Read on threads that hand their bytes over a channel, so that a grandchild keeping a
+    // pipe open cannot hold the caller either.
+    let drain = |mut r: Box<dyn Read + Send>| {
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let mut v = Vec::new();
+            let _ = r.read_to_end(&mut v);
+            let _ = tx.send(v);
+        });
+        rx
+    };
+    let out = drain(Box::new(child.stdout.take().expect("piped")));
+    let err = drain(Box::new(child.stderr.take().expect("piped")));
+    let start = std::time::Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("try_wait") {
+            break status;
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("{what} did not end within {limit:?}");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    let left = |rx: std::sync::mpsc::Receiver<Vec<u8>>| {
+        let wait = limit.saturating_sub(start.elapsed()) + std::time::Duration::from_secs(5);
+        rx.recv_timeout(wait)
+            .unwrap_or_else(|_| panic!("{what} ended but its output stayed open"))
+    };
+    std::process::Output {
+        status,
+        stdout: left(out),
+        stderr: left(err),
+    }
+}
+
 /// A scene of right triangles with legs `size` whose right-angle corners are `corners`.
 pub fn triangles(corners: &[[f64; 3]], size: f64) -> Scene {
     let mut s = Scene::new("triangles");

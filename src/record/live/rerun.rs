@@ -210,8 +210,8 @@ impl Forwarder {
 impl Drop for Forwarder {
     /// Ends the stream: the thread sends what is queued, then closes the connection or stops the
     /// server. After a [`Forwarder::finish`] that handed everything over it is waited for (a few
-    /// seconds at most), so that the viewer sees the stream end cleanly; otherwise not (a
-    /// vanished viewer could hold it forever).
+    /// seconds at most), so that the viewer sees the stream end cleanly; otherwise not, and the
+    /// client is dropped on a thread of its own (a vanished viewer could hold it forever).
     fn drop(&mut self) {
         self.queue.close();
         let finished = self
@@ -221,6 +221,12 @@ impl Drop for Forwarder {
         if finished.as_ref().is_some_and(|(_, whole)| *whole) {
             let ended = self.ended.get_mut().unwrap_or_else(PoisonError::into_inner);
             let _ = ended.recv_timeout(CLOSE_TIMEOUT);
+        } else if let Some(client) = self.client.take() {
+            // The SDK's client flushes without a time limit when its last handle drops, which
+            // a silent viewer never answers: that drop goes to a thread nobody waits for.
+            let _ = std::thread::Builder::new()
+                .name("rerun-close".into())
+                .spawn(move || drop(client));
         }
     }
 }
