@@ -146,9 +146,7 @@ impl PSetBodies for HullBodies {
     }
 
     fn same(&self, x: u32, y: u32) -> bool {
-        let bits = |p: &P3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
-        let (a, b) = (&self.points[x as usize], &self.points[y as usize]);
-        a.len() == b.len() && a.iter().zip(b).all(|(p, q)| bits(p) == bits(q))
+        self.vertex_bits(x).eq(self.vertex_bits(y))
     }
 }
 
@@ -156,9 +154,14 @@ impl HullBodies {
     /// Whether `x`'s vertices come before (or are) `y`'s, in the order of their coordinates'
     /// bits.
     fn vertices_first(&self, x: u32, y: u32) -> bool {
-        let bits = |p: &P3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
-        let (a, b) = (&self.points[x as usize], &self.points[y as usize]);
-        a.iter().flat_map(bits).le(b.iter().flat_map(bits))
+        self.vertex_bits(x).le(self.vertex_bits(y))
+    }
+
+    /// The coordinates' bits of body `x`'s vertices, in order.
+    fn vertex_bits(&self, x: u32) -> impl Iterator<Item = u64> + '_ {
+        self.points[x as usize]
+            .iter()
+            .flat_map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
     }
 
     fn union_diameter(&self, x: u32, y: u32) -> f64 {
