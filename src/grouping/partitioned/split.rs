@@ -69,87 +69,106 @@ pub(super) fn morton_order(boxes: &[Aabb]) -> Vec<(u64, u32)> {
     super::sort::sorted(codes, 63)
 }
 
-/// Batcher's odd–even merge sort of 16 keys: its first 5 comparators sort keys 0..4, its first
-/// 19 keys 0..8.
-const NETWORK: [(u8, u8); 63] = [
-    (0, 1),
-    (2, 3),
-    (0, 2),
-    (1, 3),
-    (1, 2),
-    (4, 5),
-    (6, 7),
-    (4, 6),
-    (5, 7),
-    (5, 6),
-    (0, 4),
-    (2, 6),
-    (2, 4),
-    (1, 5),
-    (3, 7),
-    (3, 5),
-    (1, 2),
-    (3, 4),
-    (5, 6),
-    (8, 9),
-    (10, 11),
-    (8, 10),
-    (9, 11),
-    (9, 10),
-    (12, 13),
-    (14, 15),
-    (12, 14),
-    (13, 15),
-    (13, 14),
-    (8, 12),
-    (10, 14),
-    (10, 12),
-    (9, 13),
-    (11, 15),
-    (11, 13),
-    (9, 10),
-    (11, 12),
-    (13, 14),
-    (0, 8),
-    (4, 12),
-    (4, 8),
-    (2, 10),
-    (6, 14),
-    (6, 10),
-    (2, 4),
-    (6, 8),
-    (10, 12),
-    (1, 9),
-    (5, 13),
-    (5, 9),
-    (3, 11),
-    (7, 15),
-    (7, 11),
-    (3, 5),
-    (7, 9),
-    (11, 13),
-    (1, 2),
-    (3, 4),
-    (5, 6),
-    (7, 8),
-    (9, 10),
-    (11, 12),
-    (13, 14),
-];
+/// Defines `network::<N>`, which applies the first `N` of the listed comparators to 16 keys,
+/// unrolled on a copy the compiler keeps in registers (a loop over a table of index pairs
+/// goes through memory, and each step waits on the previous one's stores).
+macro_rules! comparators {
+    ($($i:literal, $j:literal;)*) => {
+        /// The first `N` comparators of the network applied to `keys`.
+        #[inline(always)]
+        fn network<const N: usize>(keys: &mut [u64; SWEEP]) {
+            let mut k = *keys;
+            let mut step = 0usize;
+            $(
+                if step < N {
+                    let (a, b) = (k[$i], k[$j]);
+                    k[$i] = a.min(b);
+                    k[$j] = a.max(b);
+                }
+                step += 1;
+            )*
+            debug_assert!(N <= step);
+            *keys = k;
+        }
+    };
+}
+
+// Batcher's odd–even merge sort of 16 keys: its first 5 comparators sort keys 0..4, its first
+// 19 keys 0..8, all 63 keys 0..16.
+comparators! {
+    0, 1;
+    2, 3;
+    0, 2;
+    1, 3;
+    1, 2;
+    4, 5;
+    6, 7;
+    4, 6;
+    5, 7;
+    5, 6;
+    0, 4;
+    2, 6;
+    2, 4;
+    1, 5;
+    3, 7;
+    3, 5;
+    1, 2;
+    3, 4;
+    5, 6;
+    8, 9;
+    10, 11;
+    8, 10;
+    9, 11;
+    9, 10;
+    12, 13;
+    14, 15;
+    12, 14;
+    13, 15;
+    13, 14;
+    8, 12;
+    10, 14;
+    10, 12;
+    9, 13;
+    11, 15;
+    11, 13;
+    9, 10;
+    11, 12;
+    13, 14;
+    0, 8;
+    4, 12;
+    4, 8;
+    2, 10;
+    6, 14;
+    6, 10;
+    2, 4;
+    6, 8;
+    10, 12;
+    1, 9;
+    5, 13;
+    5, 9;
+    3, 11;
+    7, 15;
+    7, 11;
+    3, 5;
+    7, 9;
+    11, 13;
+    1, 2;
+    3, 4;
+    5, 6;
+    7, 8;
+    9, 10;
+    11, 12;
+    13, 14;
+}
 
 /// Sorts the first `len` (at most 16) of `keys`, the rest being `u64::MAX`, without branches:
 /// the sweep's keys are random, so an insertion sort mispredicts most of its steps.
 #[inline(always)]
 fn sort_keys(keys: &mut [u64; SWEEP], len: usize) {
-    let n = match len {
-        0..=4 => 5,
-        5..=8 => 19,
-        _ => NETWORK.len(),
-    };
-    for &(i, j) in &NETWORK[..n] {
-        let (a, b) = (keys[i as usize], keys[j as usize]);
-        keys[i as usize] = a.min(b);
-        keys[j as usize] = a.max(b);
+    match len {
+        0..=4 => network::<5>(keys),
+        5..=8 => network::<19>(keys),
+        _ => network::<63>(keys),
     }
 }
 
