@@ -122,7 +122,26 @@ pub fn refine_tuned<O: Observer>(
     tuning: &Tuning,
     mut observer: O,
 ) -> Refined {
-    let sah_before = sah(tree);
+    let root_area = area(&tree.aabb[tree.root() as usize]);
+    if tree.leaves() < 3 || !(root_area.is_finite() && root_area > 0.0) {
+        let sah_before = sah(tree);
+        observer.on_event(&Event::RefineStart {
+            params: *params,
+            sah: sah_before,
+        });
+        return Refined {
+            tree: tree.clone(),
+            sah_before,
+            sah_after: sah_before,
+            steps: 0,
+            passes: 0,
+        };
+    }
+    let w = WorkTree::of(tree);
+    // The areas and the interior sum of `sah(tree)`, in its order: the same value, one pass
+    // over the boxes fewer.
+    let leaves: f64 = w.area[..tree.leaves()].iter().sum();
+    let sah_before = w.sah(leaves, root_area);
     observer.on_event(&Event::RefineStart {
         params: *params,
         sah: sah_before,
@@ -134,13 +153,8 @@ pub fn refine_tuned<O: Observer>(
         steps: 0,
         passes,
     };
-    let root_area = area(&tree.aabb[tree.root() as usize]);
-    if tree.leaves() < 3 || !(root_area.is_finite() && root_area > 0.0) {
-        return unchanged(0);
-    }
-    let leaves: f64 = tree.aabb[..tree.leaves()].iter().map(area).sum();
     let mut run = Run {
-        w: WorkTree::of(tree),
+        w,
         leaves,
         root_area,
         min_gain: root_area * 1e-12,

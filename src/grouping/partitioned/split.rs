@@ -343,8 +343,9 @@ impl<'z> Zone<'z> {
     /// sorted by centre on it, ties (and centres within 16 units in the last place) in range
     /// order (a NaN centre first, −0 as 0), and the boundary of least SAH leaving a quarter on
     /// each side; of those the cheapest (ties to the lower axis). The boxes are gathered once
-    /// for the three axes. Sets `bin` to each primitive's side and returns the left side's
-    /// length.
+    /// for the three axes, and the three sweeps advance together (each step of one waits on its
+    /// last, so three side by side take about the time of one). Sets `bin` to each primitive's
+    /// side and returns the left side's length.
     fn sweep(&mut self, start: usize, len: usize, spans: [bool; 3]) -> Option<usize> {
         let (leaves, cen) = (&*self.leaves, &self.cen);
         let part = &self.perm[start..start + len];
@@ -353,7 +354,9 @@ impl<'z> Zone<'z> {
         for (b, &p) in boxes.iter_mut().zip(part) {
             b.add(&leaves[p as usize].aabb);
         }
-        let mut best: Option<(f64, usize, [u8; SWEEP])> = None;
+        // The order on each axis that spans (an axis that does not keeps the range order and
+        // is swept for nothing).
+        let mut order = [[0u8; SWEEP]; 3];
         for axis in (0..3).filter(|&a| spans[a]) {
             // The centre's order bits with the position in the low 4: one integer compare per
             // step.
@@ -368,39 +371,46 @@ impl<'z> Zone<'z> {
                 keys[i] = order_bits(c) & !0xF | i as u64;
             }
             sort_keys(&mut keys, len);
-            let mut order = [0u8; SWEEP];
-            for (o, k) in order.iter_mut().zip(&keys[..len]) {
+            for (o, k) in order[axis].iter_mut().zip(&keys[..len]) {
                 *o = (k & 0xF) as u8;
             }
-            // Areas of the right sides that leave a quarter on each side.
-            let mut right = [0.0f64; SWEEP];
-            let mut acc = Bounds::EMPTY;
-            for i in (least..len).rev() {
-                acc = acc.join(&boxes[order[i] as usize]);
-                right[i] = acc.area();
-            }
-            let mut left = Bounds::EMPTY;
-            for &o in &order[..least - 1] {
-                left = left.join(&boxes[o as usize]);
-            }
-            let mut here: Option<(f64, usize)> = None;
-            for i in least..=len - least {
-                left = left.join(&boxes[order[i - 1] as usize]);
-                let cost = left.area() * i as f64 + right[i] * (len - i) as f64;
-                if here.is_none_or(|(c, _)| cost < c) {
-                    here = Some((cost, i));
-                }
-            }
-            if let Some((cost, nl)) = here
-                && best.is_none_or(|(b, _, _)| cost < b)
-            {
-                best = Some((cost, nl, order));
+        }
+        // Areas of the right sides that leave a quarter on each side.
+        let mut right = [[0.0f64; 3]; SWEEP];
+        let mut acc = [Bounds::EMPTY; 3];
+        for i in (least..len).rev() {
+            for a in 0..3 {
+                acc[a] = acc[a].join(&boxes[order[a][i] as usize]);
+                right[i][a] = acc[a].area();
             }
         }
-        let (_, nl, order) = best?;
+        let mut left = [Bounds::EMPTY; 3];
+        for i in 0..least - 1 {
+            for a in 0..3 {
+                left[a] = left[a].join(&boxes[order[a][i] as usize]);
+            }
+        }
+        let mut here = [(f64::INFINITY, 0usize); 3];
+        for i in least..=len - least {
+            for a in 0..3 {
+                left[a] = left[a].join(&boxes[order[a][i - 1] as usize]);
+                let cost = left[a].area() * i as f64 + right[i][a] * (len - i) as f64;
+                if here[a].1 == 0 || cost < here[a].0 {
+                    here[a] = (cost, i);
+                }
+            }
+        }
+        let mut best: Option<(f64, usize, usize)> = None;
+        for a in (0..3).filter(|&a| spans[a]) {
+            let (cost, nl) = here[a];
+            if best.is_none_or(|(b, _, _)| cost < b) {
+                best = Some((cost, nl, a));
+            }
+        }
+        let (_, nl, axis) = best?;
         self.bin.clear();
         self.bin.resize(len, 1);
-        for &o in &order[..nl] {
+        for &o in &order[axis][..nl] {
             self.bin[o as usize] = 0;
         }
         Some(nl)
