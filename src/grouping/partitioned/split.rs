@@ -213,6 +213,17 @@ fn greater(a: f64, b: f64) -> f64 {
     if b > a { b } else { a }
 }
 
+/// The bin of a centre at `x` bin widths from the low end: a NaN or negative `x` goes to bin
+/// 0, one at or past the last bin's start to the last (what a saturating `x as usize` clamped
+/// to the last bin gives), clamped first so that the conversion needs no range checks.
+#[inline(always)]
+fn bin(x: f64) -> usize {
+    const LAST: f64 = (BINS - 1) as f64;
+    let x = if x > 0.0 { x } else { 0.0 };
+    let x = if x < LAST { x } else { LAST };
+    x as u8 as usize
+}
+
 /// A box as corner arrays, grown by plain min/max (a NaN coordinate is skipped: the corners
 /// start infinite and never become NaN).
 #[derive(Clone, Copy)]
@@ -440,8 +451,7 @@ impl<'z> Zone<'z> {
         self.bins.extend(part.iter().map(|&p| {
             let c = &cen[p as usize];
             let b = &leaves[p as usize].aabb;
-            // A NaN centre goes to bin 0 (`as` saturates), the same on every run.
-            let k = [0, 1, 2].map(|a| (((c[a] - lo[a]) * scale[a]) as usize).min(BINS - 1));
+            let k = [0, 1, 2].map(|a| bin((c[a] - lo[a]) * scale[a]));
             for a in 0..3 {
                 counts[a][k[a]] += 1;
                 boxes[a][k[a]].add(b);
