@@ -31,6 +31,24 @@ pub(super) struct RoundLimits {
 impl RoundLimits {
     /// The doubling sequence of `base` (> 0).
     pub(super) fn new(base: f64) -> RoundLimits {
+        let bits = base.to_bits();
+        let exp = (bits >> 52) & 0x7ff;
+        if base > 0.0 && exp != 0 && exp != 0x7ff {
+            // A positive normal base: each doubling adds one to the exponent field, exactly,
+            // until it would reach 2047 (infinity). Independent entries, not a chain of
+            // multiplications: the table has up to 2,047 of them, built for every run.
+            let last = 0x7ff - exp;
+            let tab = (0..=last)
+                .map(|r| {
+                    if r < last {
+                        f64::from_bits(bits + (r << 52))
+                    } else {
+                        f64::INFINITY
+                    }
+                })
+                .collect();
+            return RoundLimits { tab };
+        }
         let mut tab = vec![base];
         let mut v = base;
         while v < f64::INFINITY && tab.len() < 4096 {

@@ -451,7 +451,8 @@ impl<'z> Zone<'z> {
         self.bins.extend(part.iter().map(|&p| {
             let c = &cen[p as usize];
             let b = &leaves[p as usize].aabb;
-            let k = [0, 1, 2].map(|a| bin((c[a] - lo[a]) * scale[a]));
+            let at = |a: usize| bin((c[a] - lo[a]) * scale[a]);
+            let k = [at(0), at(1), at(2)];
             for a in 0..3 {
                 counts[a][k[a]] += 1;
                 boxes[a][k[a]].add(b);

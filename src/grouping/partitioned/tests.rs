@@ -180,6 +180,28 @@ fn brute_force_equals_the_voxel_hash_run() {
 }
 
 #[test]
+fn limits_are_the_base_doubled_up_to_the_first_infinity() {
+    for base in [
+        0.3,
+        1.0,
+        1.5,
+        1e-310,
+        5e-324,
+        1e300,
+        f64::MAX,
+        f64::MIN_POSITIVE,
+    ] {
+        let l = RoundLimits::new(base);
+        let mut v = base;
+        for r in 0..l.rounds() as u32 {
+            assert_eq!(l.at(r).to_bits(), v.to_bits(), "base {base}, round {r}");
+            assert_eq!(v.is_infinite(), r + 1 == l.rounds() as u32, "base {base}");
+            v *= 2.0;
+        }
+    }
+}
+
+#[test]
 fn limits_give_the_first_round_that_admits_a_value() {
     let l = RoundLimits::new(0.3);
     for x in [0.0, 0.3, 0.31, 0.6, 0.6000001, 1e-300, 7.5, 1e300, f64::MAX] {
