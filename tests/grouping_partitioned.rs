@@ -212,6 +212,28 @@ fn a_scene_smaller_than_a_chunk_gets_the_exact_tree() {
     }
 }
 
+#[test]
+fn the_largest_chunk_is_delta_unless_set_and_aacs_rule_still_runs() {
+    // AAC's rule (chunks of fewer than δ, how recordings without `chunk_max` were split) cuts
+    // ranges of δ, some of them 1 + 3, which gives another tree; both are valid.
+    let scene = generate::soup(3_000, 12);
+    let resolved = Params::default().resolve(&scene);
+    let run = |chunk_max| {
+        let chunking = Chunking {
+            top: 32,
+            chunk_max,
+            ..Chunking::DEFAULT
+        };
+        let mut log = EventLog::default();
+        let g = group_with(&scene, &resolved, &chunking, &mut log, &Budget::default()).unwrap();
+        check_tree(&scene, &g, &log);
+        g.tree
+    };
+    let by_delta = run(0);
+    assert_eq!(by_delta, run(Chunking::DEFAULT.delta));
+    assert_ne!(by_delta, run(Chunking::DEFAULT.delta - 1));
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
 
@@ -410,6 +432,13 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
     old.remove("chunk_sah");
     let params = wraptree::record::mcap::metadata::params(&old).unwrap();
     assert_eq!(params.mode.chunk_sah, 0);
+    // The largest chunk is recorded (0 = δ); a recording without it made chunks of fewer
+    // than δ primitives, as AAC does, and is replayed so.
+    assert_eq!(rec.metadata.get("chunk_max").map(String::as_str), Some("0"));
+    assert_eq!(rec.params.mode.chunk_max, 0);
+    old.remove("chunk_max");
+    let params = wraptree::record::mcap::metadata::params(&old).unwrap();
+    assert_eq!(params.mode.chunk_max, Chunking::DEFAULT.delta - 1);
     let out = wraptree(
         &[&args[..], &["f", "--chunk-epsilon", "0.7"]].concat(),
         dir.path(),

@@ -249,6 +249,7 @@ impl GroupArgs {
                 chunk_top: self.chunk_top.unwrap_or(Mode::default().chunk_top),
                 chunk_epsilon: self.chunk_epsilon.unwrap_or(Mode::default().chunk_epsilon),
                 chunk_sah: self.chunk_sah.unwrap_or(Mode::default().chunk_sah),
+                chunk_max: Mode::default().chunk_max,
             },
         };
         if self.fast {

@@ -167,6 +167,9 @@ pub struct Mode {
     /// ([`Chunking::sah_below`](crate::grouping::partitioned::Chunking::sah_below)); 0 =
     /// Morton cuts throughout.
     pub chunk_sah: u32,
+    /// The partitioned schedule's largest chunk
+    /// ([`Chunking::chunk_max`](crate::grouping::partitioned::Chunking::chunk_max)); 0 = δ.
+    pub chunk_max: u32,
 }
 
 impl Default for Mode {
@@ -180,6 +183,7 @@ impl Default for Mode {
             chunk_top: crate::grouping::partitioned::Chunking::DEFAULT.top,
             chunk_epsilon: crate::grouping::partitioned::Chunking::DEFAULT.epsilon,
             chunk_sah: crate::grouping::partitioned::Chunking::DEFAULT.sah_below,
+            chunk_max: crate::grouping::partitioned::Chunking::DEFAULT.chunk_max,
         }
     }
 }

@@ -27,6 +27,7 @@ fn chunking_of(params: &ResolvedParams) -> Chunking {
         top: params.mode.chunk_top,
         epsilon: params.mode.chunk_epsilon,
         sah_below: params.mode.chunk_sah,
+        chunk_max: params.mode.chunk_max,
         ..Chunking::DEFAULT
     }
 }

@@ -11,10 +11,7 @@ use rayon::prelude::*;
 /// The split's parameters: chunk size δ, the reduction function's ε (AAC §3) and the root's share.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Chunking {
-    /// Ranges of at most this many primitives are chunks. AAC stops at fewer than δ; a range of
-    /// exactly δ cut in two halves that keep all their bodies would give its node the same δ
-    /// bodies, so it is one chunk and its cut is saved (about 5 % of the fast path's time, the
-    /// same SAH and node tests on 37 scenes).
+    /// AAC's δ: chunks keep f(δ) bodies, and f is scaled by it.
     pub delta: u32,
     /// f(n) = ⌈c·n^(1/2 − ε)⌉ with c = δ^(1/2 + ε)/2.
     pub epsilon: f64,
@@ -26,6 +23,12 @@ pub struct Chunking {
     /// their centres instead of at their highest differing Morton bit (`split`); 0 = Morton
     /// cuts throughout.
     pub sah_below: u32,
+    /// Ranges of at most this many primitives are chunks; 0 = δ. AAC's chunks have fewer than
+    /// δ (δ − 1 here); a range of exactly δ cut in two halves that keep all their bodies gives
+    /// its node the same δ bodies (but for a 1 + 3 cut), so by default it is one chunk and its
+    /// cut is saved (about 5 % of the fast path's time, SAH and node tests within 0.2 % on 37
+    /// scenes).
+    pub chunk_max: u32,
 }
 
 impl Chunking {
@@ -38,6 +41,7 @@ impl Chunking {
         epsilon: 0.5,
         top: 8192,
         sah_below: 256,
+        chunk_max: 0,
     };
 
     /// The fast path's split (`--fast`, bench method `fast`): the default's with a root share
@@ -52,9 +56,15 @@ impl Chunking {
         ..Chunking::DEFAULT
     };
 
-    /// Whether a range of `size` primitives is a chunk: at most δ (and at least one).
+    /// Whether a range of `size` primitives is a chunk: at most [`Chunking::chunk_max`] (δ
+    /// when 0), and at least one.
     pub fn is_chunk(&self, size: u32) -> bool {
-        size <= self.delta.max(1)
+        let max = if self.chunk_max == 0 {
+            self.delta
+        } else {
+            self.chunk_max
+        };
+        size <= max.max(1)
     }
 
     /// Whether a scene of `n` primitives is grouped as one subproblem, the exact schedule's
@@ -421,6 +431,7 @@ pub(super) mod tests {
                 epsilon: 0.1,
                 top: 0,
                 sah_below: 0,
+                chunk_max: 7,
             },
             // SAH cuts in the parallel part of the plan too.
             Chunking {

@@ -61,9 +61,16 @@ pub const LOAD_KEYS: &[&str] = &["up"];
 
 /// Keys the `wraptree` record adds for the partitioned schedule ([`Chunking`]): its chunk size
 /// δ (informative, fixed in a build), the reduction function's ε (`--chunk-epsilon`), the
-/// root's share `top` (`--chunk-top`) and the SAH cuts' range size (`--chunk-sah`), the last
-/// three read back by `replay` (a recording without `chunk_sah` was cut at Morton bits only).
-pub const PARTITIONED_KEYS: &[&str] = &["chunk_delta", "chunk_epsilon", "chunk_top", "chunk_sah"];
+/// root's share `top` (`--chunk-top`), the SAH cuts' range size (`--chunk-sah`) and the
+/// largest chunk (0 = δ), the last four read back by `replay` (a recording without `chunk_sah`
+/// was cut at Morton bits only, one without `chunk_max` into chunks of fewer than δ).
+pub const PARTITIONED_KEYS: &[&str] = &[
+    "chunk_delta",
+    "chunk_epsilon",
+    "chunk_top",
+    "chunk_sah",
+    "chunk_max",
+];
 
 /// Keys the `wraptree` record adds when a cover is logged (`cover_budget` only for a cover
 /// asked for by budget).
@@ -204,6 +211,7 @@ pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String,
         put("chunk_epsilon", p.mode.chunk_epsilon.to_string());
         put("chunk_top", p.mode.chunk_top.to_string());
         put("chunk_sah", p.mode.chunk_sah.to_string());
+        put("chunk_max", p.mode.chunk_max.to_string());
     }
     put("detail", value_name(&info.detail));
     put("scene", info.scene.name.clone());
@@ -325,6 +333,13 @@ fn mode(m: &BTreeMap<String, String>) -> Result<Mode> {
             (true, _) => parse(m, "chunk_sah")?,
             (false, true) => 0,
             (false, false) => d.chunk_sah,
+        },
+        // A partitioned recording without `chunk_max` made its chunks of fewer than δ
+        // primitives, as AAC does.
+        chunk_max: match (m.contains_key("chunk_max"), m.contains_key("chunk_top")) {
+            (true, _) => parse(m, "chunk_max")?,
+            (false, true) => Chunking::DEFAULT.delta - 1,
+            (false, false) => d.chunk_max,
         },
     })
 }
