@@ -53,7 +53,7 @@ pub struct BenchCmd {
     /// Threads of the rayon pool the comparison uses (partitioned grouping, the exact run's
     /// scans, obvhs PLOC) [default: all cores]; the partitioned table sets 1 and 2 itself.
     #[arg(long, value_name = "N")]
-    threads: Option<usize>,
+    pub(super) threads: Option<usize>,
     /// Timed repetitions per case (the best is reported); with SCENEs a case is repeated only
     /// while its runs took under 0.1 s in all.
     #[arg(long, default_value_t = 3)]
@@ -79,11 +79,6 @@ pub(super) fn load_spec(spec: &str) -> Result<wraptree::scene::Scene> {
 }
 
 impl BenchCmd {
-    /// The `--threads` asked for, if any.
-    pub fn threads(&self) -> Option<usize> {
-        self.threads
-    }
-
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         let threads = super::build_pool(self.threads)?;

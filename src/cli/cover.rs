@@ -18,7 +18,7 @@ pub struct CoverCmd {
     #[command(flatten)]
     scene: SceneArgs,
     #[command(flatten)]
-    group: GroupArgs,
+    pub(super) group: GroupArgs,
     /// Largest allowed error per wrapper: a length in scene units, or P% of the scene diagonal.
     #[arg(long, value_parser = Tolerance::parse, allow_negative_numbers = true)]
     tolerance: Option<Tolerance>,
@@ -41,11 +41,6 @@ pub struct CoverCmd {
 }
 
 impl CoverCmd {
-    /// The `--threads` asked for, if any.
-    pub fn threads(&self) -> Option<usize> {
-        self.group.threads
-    }
-
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         if self.budget == Some(0) {

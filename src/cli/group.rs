@@ -51,7 +51,7 @@ pub struct GroupCmd {
     #[command(flatten)]
     scene: SceneArgs,
     #[command(flatten)]
-    group: GroupArgs,
+    pub(super) group: GroupArgs,
     #[command(flatten)]
     limits: BudgetArgs,
     /// Print one JSON object (with the parent array) instead of text.
@@ -92,11 +92,6 @@ impl Observer for Progress {
 }
 
 impl GroupCmd {
-    /// The `--threads` asked for, if any.
-    pub fn threads(&self) -> Option<usize> {
-        self.group.threads
-    }
-
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         let loaded = self.scene.load()?;

@@ -291,18 +291,25 @@ pub fn build_pool(threads: Option<usize>) -> Result<usize> {
     Ok(rayon::current_num_threads())
 }
 
+impl Command {
+    /// The `--threads` the command asks for, if it takes the option and was given it.
+    fn threads(&self) -> Option<usize> {
+        match self {
+            Command::Group(c) => c.group.threads,
+            Command::Record(c) => c.group.threads,
+            Command::Snapshot(c) => c.group.threads,
+            Command::Wrap(c) => c.group.threads,
+            Command::Cover(c) => c.group.threads,
+            Command::Bench(c) => c.threads,
+            _ => None,
+        }
+    }
+}
+
 /// Runs the parsed command, its `--threads` pool built first, so that loading and every other
 /// step before the grouping run on it too.
 pub fn run(cli: Cli) -> Result<ExitCode> {
-    let threads = match &cli.command {
-        Command::Group(c) => c.threads(),
-        Command::Record(c) => c.threads(),
-        Command::Snapshot(c) => c.threads(),
-        Command::Wrap(c) => c.threads(),
-        Command::Cover(c) => c.threads(),
-        Command::Bench(c) => c.threads(),
-        _ => None,
-    };
+    let threads = cli.command.threads();
     if threads.is_some() {
         build_pool(threads)?;
     }

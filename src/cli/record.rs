@@ -26,7 +26,7 @@ pub struct RecordCmd {
     #[command(flatten)]
     scene: SceneArgs,
     #[command(flatten)]
-    group: GroupArgs,
+    pub(super) group: GroupArgs,
     #[command(flatten)]
     limits: BudgetArgs,
     /// Output prefix: writes PREFIX.rrd and PREFIX.mcap [default: recordings/<scene stem>];
@@ -196,11 +196,6 @@ pub fn print_written(w: &Written, scene: &Scene) {
 }
 
 impl RecordCmd {
-    /// The `--threads` asked for, if any.
-    pub fn threads(&self) -> Option<usize> {
-        self.group.threads
-    }
-
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         // Installed before loading so an early Ctrl-C still ends in readable, incomplete files.

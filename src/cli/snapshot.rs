@@ -22,7 +22,7 @@ pub struct SnapshotCmd {
     #[command(flatten)]
     scene: SceneArgs,
     #[command(flatten)]
-    group: GroupArgs,
+    pub(super) group: GroupArgs,
     /// Tree levels to draw (depths, root = 0), e.g. 3,6,9.
     #[arg(long, value_delimiter = ',', conflicts_with = "nodes")]
     levels: Vec<u32>,
@@ -75,11 +75,6 @@ fn load(cmd: &SnapshotCmd) -> Result<(Scene, ResolvedParams, Option<Vec<Merge>>)
 }
 
 impl SnapshotCmd {
-    /// The `--threads` asked for, if any.
-    pub fn threads(&self) -> Option<usize> {
-        self.group.threads
-    }
-
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         let stop = wraptree::stop::Stop::on_signals();

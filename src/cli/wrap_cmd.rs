@@ -18,7 +18,7 @@ pub struct WrapCmd {
     #[command(flatten)]
     scene: SceneArgs,
     #[command(flatten)]
-    group: GroupArgs,
+    pub(super) group: GroupArgs,
     /// Wrapper Trees to build, comma-separated: sphere, hull, box (or aabb), obb.
     #[arg(long, default_value = "sphere,hull,box,obb", value_delimiter = ',', value_parser = WrapperKind::parse)]
     wrapper: Vec<WrapperKind>,
@@ -40,11 +40,6 @@ pub struct WrapCmd {
 }
 
 impl WrapCmd {
-    /// The `--threads` asked for, if any.
-    pub fn threads(&self) -> Option<usize> {
-        self.group.threads
-    }
-
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         let loaded = self.scene.load()?;
