@@ -12,7 +12,7 @@
 //! was solved here passes its bodies' pairs up with them (`Leftover`), so its parent evaluates only
 //! the pairs across the two halves (a pair's Cost and round depend on its two bodies alone).
 
-use super::subproblem::{Body, Counters, Leftover, MergeInfo, MergeSlots, Pairs, RunInputs};
+use super::subproblem::{Body, Counters, Leftover, MergeInfo, MergeSlots, PairList, RunInputs};
 use crate::grouping::cluster::{fill_balance, pair_cost_any, tie_tag};
 use crate::grouping::mpairs::order_bits;
 use std::cell::RefCell;
@@ -290,13 +290,13 @@ pub(super) fn leave(
     pair: impl Fn(usize, usize) -> (u64, u32),
 ) -> Leftover {
     let pairs = if export {
-        let mut v = Pairs::with_capacity(live.len() * (live.len() - 1) / 2);
+        let mut v = PairList::with_capacity(live.len() * (live.len() - 1) / 2);
         for (x, &i) in live.iter().enumerate() {
             v.extend(live[x + 1..].iter().map(|&j| pair(i, j)));
         }
         v
     } else {
-        Pairs::new()
+        PairList::new()
     };
     for (k, &i) in live.iter().enumerate() {
         body[k] = body[i];
@@ -324,7 +324,7 @@ pub(super) fn combine(
     if body.len() <= keep {
         return Leftover {
             n: body.len(),
-            pairs: Pairs::new(),
+            pairs: PairList::new(),
         };
     }
     if body.len() <= super::all_pairs::TINY {

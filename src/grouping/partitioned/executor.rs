@@ -2,7 +2,7 @@
 //! parallel, each node's own merges by brute force or with the voxel hash.
 
 use super::plan::Node;
-use super::subproblem::{Body, Counters, Leftover, MergeSlots, Pairs, RunInputs};
+use super::subproblem::{Body, Counters, Leftover, MergeSlots, PairList, RunInputs};
 use super::{brute_force, voxel_step};
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -36,7 +36,7 @@ impl Executor<'_> {
                 }
                 let part = Leftover {
                     n: arena.len(),
-                    pairs: Pairs::new(),
+                    pairs: PairList::new(),
                 };
                 ([part, Leftover::default()], out, Counters::default())
             }
@@ -89,7 +89,7 @@ impl Executor<'_> {
                 arena[..bodies.len()].copy_from_slice(&bodies);
                 Leftover {
                     n: bodies.len(),
-                    pairs: Pairs::new(),
+                    pairs: PairList::new(),
                 }
             })
         };

@@ -24,12 +24,12 @@ pub(super) struct Body {
 #[derive(Debug, Default)]
 pub(super) struct Leftover {
     pub(super) n: usize,
-    pub(super) pairs: Pairs,
+    pub(super) pairs: PairList,
 }
 
 /// The pairs a subproblem leaves: inline up to the 6 of four bodies (below the root's share
 /// every node leaves two), so that most nodes allocate nothing.
-pub(super) type Pairs = smallvec::SmallVec<[(u64, u32); 6]>;
+pub(super) type PairList = smallvec::SmallVec<[(u64, u32); 6]>;
 
 /// What a merge event needs beyond the tree.
 #[derive(Clone, Copy, Debug, Default)]

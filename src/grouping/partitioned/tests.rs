@@ -1,6 +1,6 @@
 //! The brute-force subproblems (`all_pairs`, `brute_force`) against the voxel-hash one on the same bodies.
 
-use super::subproblem::{Body, Counters, Leftover, MergeInfo, MergeSlots, Pairs, RunInputs};
+use super::subproblem::{Body, Counters, Leftover, MergeInfo, MergeSlots, PairList, RunInputs};
 use super::{brute_force, voxel_step};
 use crate::geom::Aabb;
 use crate::grouping::{Budget, Params, Weights};
@@ -16,14 +16,14 @@ type Solved = (Vec<([u32; 2], u64, u32)>, Vec<u32>);
 #[derive(Default)]
 struct Half {
     bodies: Vec<Body>,
-    pairs: Pairs,
+    pairs: PairList,
 }
 
 /// A part of bodies without pairs.
 fn part(bodies: &[Body]) -> Half {
     Half {
         bodies: bodies.to_vec(),
-        pairs: Pairs::new(),
+        pairs: PairList::new(),
     }
 }
 
