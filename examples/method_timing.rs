@@ -44,7 +44,7 @@ fn build_varied(method: Method, scene: &Scene, params: &Params) -> Built {
     let resolved = p.resolve_boxes(&boxes);
     let g = group_boxes(boxes, &resolved, ());
     let t1 = Instant::now();
-    let r = refine::refine(&g.tree, &rp, ());
+    let r = refine::refine_owned(g.tree, &rp, ());
     Built {
         method,
         tree: r.tree,

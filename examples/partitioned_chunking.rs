@@ -4,8 +4,8 @@
 //! (`docs/benchmarks.md`).
 //!
 //! `cargo run --release --example partitioned_chunking [MAX_SOUP] [DELTA:EPSILON[:TOP[:SAH]] ...]
-//! [FILE.obj ...]` — default 100000 and the default chunking and 20:0.1 (AAC's high-quality
-//! setting); OBJ files are grouped after the targets scenes (held-out scenes).
+//! [FILE ...]` — default 100000 and the default chunking and 20:0.1 (AAC's high-quality
+//! setting); scene files are grouped after the targets scenes (held-out scenes).
 
 use std::time::Instant;
 use wraptree::grouping::partitioned::{Chunking, group_with};
@@ -30,7 +30,7 @@ fn main() -> anyhow::Result<()> {
     let mut chunkings = args
         .iter()
         .skip(1)
-        .filter(|a| !a.ends_with(".obj"))
+        .filter(|a| !std::path::Path::new(a).is_file())
         .map(|a| parse(a))
         .collect::<anyhow::Result<Vec<_>>>()?;
     if chunkings.is_empty() {
@@ -46,7 +46,7 @@ fn main() -> anyhow::Result<()> {
     println!();
     let mut sums = vec![(0.0, 0.0, 0.0, 0.0); chunkings.len()];
     let mut scenes = target_scenes(max_soup)?;
-    for path in args.iter().filter(|a| a.ends_with(".obj")) {
+    for path in args.iter().filter(|a| std::path::Path::new(a).is_file()) {
         scenes.push(wraptree::scene::load_path(path.as_ref(), &Default::default())?.scene);
     }
     for scene in &scenes {

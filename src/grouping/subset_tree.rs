@@ -81,6 +81,26 @@ impl SubsetTree {
         })
     }
 
+    /// A tree from arrays that already hold one (as [`SubsetTree::new`] would build them:
+    /// parents and depths consistent with `children`), without checking or recomputing them.
+    pub(crate) fn from_parts(
+        parent: Vec<u32>,
+        children: Vec<[u32; 2]>,
+        depth: Vec<u32>,
+        aabb: Vec<Aabb>,
+        diameter: Vec<f64>,
+    ) -> SubsetTree {
+        debug_assert!(parent.len() == 2 * children.len() + 1 && aabb.len() == parent.len());
+        SubsetTree {
+            n: (children.len() + 1) as u32,
+            parent,
+            children,
+            depth,
+            aabb,
+            diameter,
+        }
+    }
+
     /// Number of leaves N.
     pub fn leaves(&self) -> usize {
         self.n as usize

@@ -203,11 +203,21 @@ pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, St
         } else {
             RefineParams::default()
         };
-        let r = refine::refine(&built.tree, &rp, ());
-        built.refine_seconds = t.elapsed().as_secs_f64();
-        built.seconds += built.refine_seconds;
-        built.tree = r.tree;
-        built.method = method;
+        let Built {
+            tree,
+            seconds,
+            stats,
+            ..
+        } = built;
+        let tree = refine::refine_owned(tree, &rp, ()).tree;
+        let refine_seconds = t.elapsed().as_secs_f64();
+        built = Built {
+            method,
+            tree,
+            seconds: seconds + refine_seconds,
+            stats,
+            refine_seconds,
+        };
     }
     Ok(built)
 }

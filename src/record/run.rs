@@ -232,16 +232,19 @@ fn group_and_refine<O: Observer>(
     events: &mut background::Background,
     progress: O,
 ) -> Result<Grouping, Stopped> {
-    let mut result = grouping::group_within(
+    let result = grouping::group_within(
         scene,
         params,
         Tee(&mut *events, progress),
         &opts.limits.budget(Some(stop)),
     );
-    if let (Ok(g), Some(rp)) = (&mut result, &opts.refine) {
-        g.tree = crate::refine::refine(&g.tree, rp, events).tree;
+    match (result, &opts.refine) {
+        (Ok(g), Some(rp)) => Ok(Grouping {
+            tree: crate::refine::refine_owned(g.tree, rp, events).tree,
+            ..g
+        }),
+        (result, _) => result,
     }
-    result
 }
 
 /// Waits for both recorders and writes their tails with `outcome` at the same time (the

@@ -3,15 +3,15 @@
 //! wherever it still holds — among the slots whose children are all numbered, the smallest
 //! input id comes next. An unmoved tree keeps every id.
 
-use super::work::{WorkTree, tabulate};
-use crate::grouping::SubsetTree;
+use super::work::{PARALLEL_COPY, WorkTree, tabulate};
+use crate::grouping::{C_PRIM, C_TRAV, SubsetTree};
+use rayon::prelude::*;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
-/// The Subset Tree of `w`: interior slots renumbered (see the module doc), boxes as refitted,
-/// and the diameter of `input` for every node whose leaf set is unchanged, the box diagonal for
-/// the others.
-pub fn subset_tree(w: &WorkTree, input: &SubsetTree) -> Result<SubsetTree, String> {
+/// The interior slots of `w` in their new order (slot `order[k]` becomes node `N + k`; see the
+/// module doc). Fails unless every slot is reachable from the root.
+pub fn order(w: &WorkTree) -> Result<Vec<u32>, String> {
     let n = w.n as usize;
     let slots = w.children.len();
     // Children of a slot not yet numbered: 0, 1 or 2. The smallest ready slot comes next: a
@@ -24,7 +24,6 @@ pub fn subset_tree(w: &WorkTree, input: &SubsetTree) -> Result<SubsetTree, Strin
         .collect();
     let mut late = BinaryHeap::new();
     let mut scan = 0u32;
-    let mut new_id = vec![0u32; slots];
     let mut order = Vec::with_capacity(slots);
     loop {
         while (scan as usize) < slots && waiting[scan as usize] != 0 {
@@ -41,7 +40,6 @@ pub fn subset_tree(w: &WorkTree, input: &SubsetTree) -> Result<SubsetTree, Strin
             }
             _ => break,
         };
-        new_id[i as usize] = (n + order.len()) as u32;
         order.push(i);
         let p = w.parent[n + i as usize];
         if p != crate::grouping::NONE {
@@ -58,6 +56,33 @@ pub fn subset_tree(w: &WorkTree, input: &SubsetTree) -> Result<SubsetTree, Strin
             order.len()
         ));
     }
+    Ok(order)
+}
+
+/// The SAH ([`crate::grouping::sah`]) of the Subset Tree that [`subset_tree`] makes of `w` in
+/// `order`, bit for bit, from the areas `w` keeps: the same areas summed in the same order
+/// (`leaves` is the sum of the leaves' areas in id order).
+pub fn sah(w: &WorkTree, order: &[u32], leaves: f64) -> f64 {
+    let n = w.n as usize;
+    let root = w.area[w.root as usize];
+    if root.is_nan() || root <= 0.0 {
+        return w.parent.len() as f64;
+    }
+    let interior: f64 = order.iter().map(|&i| w.area[n + i as usize]).sum();
+    (C_TRAV * interior + C_PRIM * leaves) / root
+}
+
+/// The Subset Tree of `w` with its interior slots renumbered in `order` ([`order`]): boxes as
+/// refitted, and `diameter` (the input's, by input id) for every node whose leaf set is
+/// unchanged, the box diagonal for the others. The boxes and diameters are permuted in the
+/// arrays they came in, from the first slot that moved on.
+pub fn subset_tree(w: WorkTree, order: &[u32], diameter: Vec<f64>) -> Result<SubsetTree, String> {
+    let n = w.n as usize;
+    let slots = order.len();
+    let mut new_id = vec![0u32; slots];
+    for (k, &i) in order.iter().enumerate() {
+        new_id[i as usize] = (n + k) as u32;
+    }
     let id = |c: u32| {
         if w.is_leaf(c) {
             c
@@ -65,17 +90,42 @@ pub fn subset_tree(w: &WorkTree, input: &SubsetTree) -> Result<SubsetTree, Strin
             new_id[(c as usize) - n]
         }
     };
-    // The arrays in the new order (on rayon's threads for large trees).
-    let node = |k: usize| if k < n { k } else { n + order[k - n] as usize };
-    let aabb = tabulate(n + slots, |k| w.aabb[node(k)]);
-    let diameter = tabulate(n + slots, |k| {
-        let x = node(k);
-        if x >= n && w.changed[x - n] {
-            w.aabb[x].diameter()
-        } else {
-            input.diameter[x]
-        }
-    });
     let children = tabulate(slots, |k| w.children[order[k] as usize].map(id));
-    SubsetTree::new(aabb, diameter, children)
+    // Slots before the first that moved keep their place (`order` is a permutation whose
+    // prefix is the identity).
+    let first = order
+        .iter()
+        .enumerate()
+        .position(|(k, &i)| k != i as usize)
+        .unwrap_or(slots);
+    let (mut aabb, mut diam) = (w.aabb, diameter);
+    permute(&mut aabb[n..], order, first);
+    permute(&mut diam[n..], order, first);
+    let changed = &w.changed;
+    let fix = |(k, d): (usize, &mut f64)| {
+        if changed[order[k] as usize] {
+            *d = aabb[n + k].diameter();
+        }
+    };
+    if slots >= PARALLEL_COPY {
+        diam[n..].par_iter_mut().enumerate().for_each(fix);
+    } else {
+        diam[n..].iter_mut().enumerate().for_each(fix);
+    }
+    SubsetTree::new(aabb, diam, children)
+}
+
+/// `v[k] = v_before[order[k]]` for every `k` from `first` on (`order[..first]` is the
+/// identity, so only the rest is copied aside); on rayon's threads for large arrays.
+fn permute<T: Copy + Send + Sync>(v: &mut [T], order: &[u32], first: usize) {
+    if first == order.len() {
+        return;
+    }
+    let old = v[first..].to_vec();
+    let put = |(x, &i): (&mut T, &u32)| *x = old[i as usize - first];
+    if order.len() - first >= PARALLEL_COPY {
+        v[first..].par_iter_mut().zip(&order[first..]).for_each(put);
+    } else {
+        v[first..].iter_mut().zip(&order[first..]).for_each(put);
+    }
 }

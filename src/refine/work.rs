@@ -21,6 +21,30 @@ pub struct Moved {
     pub parent: u32,
 }
 
+/// What undoes one kept step ([`WorkTree::undo`]), logged so that a run can give back the tree
+/// it was handed when its final check fails.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Undo {
+    /// A move: `node` goes back next to its old sibling ([`WorkTree::reinsert`] undoes itself).
+    Move {
+        /// The moved node.
+        node: u32,
+        /// Its sibling before the move.
+        sibling: u32,
+    },
+    /// An interior slot as it was before a treelet was rebuilt.
+    Slot {
+        /// The slot.
+        x: u32,
+        /// Its children.
+        kids: [u32; 2],
+        /// Its box.
+        aabb: Aabb,
+        /// Its box's area.
+        area: f64,
+    },
+}
+
 /// Trees of at least this many nodes have their arrays built on rayon's threads.
 pub const PARALLEL_COPY: usize = 1 << 16;
 
@@ -61,26 +85,49 @@ pub struct WorkTree {
 }
 
 impl WorkTree {
-    /// The working form of `tree`.
-    ///
-    /// Large trees' arrays are copied on rayon's threads ([`tabulate`]: at 10^6 leaves the
-    /// copies and their fresh pages are most of the setup); the interior sum is taken in id
-    /// order, so it is the same for any number of threads.
+    /// The working form of `tree` (a copy: see [`WorkTree::from_tree`]).
     pub fn of(tree: &SubsetTree) -> WorkTree {
-        let area: Vec<f64> = tabulate(tree.len(), |i| area(&tree.aabb[i]));
-        let n = tree.leaves();
-        WorkTree {
+        WorkTree::from_tree(tree.clone()).0
+    }
+
+    /// The working form of `tree`, made of its own arrays (parents, children, boxes: moved,
+    /// not copied), with the depths and diameters it does not use given back for
+    /// [`WorkTree::into_tree`] and [`super::renumber`].
+    ///
+    /// Only the areas are new: on rayon's threads for large trees ([`tabulate`]), the interior
+    /// sum taken in id order, so it is the same for any number of threads.
+    pub fn from_tree(tree: SubsetTree) -> (WorkTree, Vec<u32>, Vec<f64>) {
+        let (n, root) = (tree.leaves(), tree.root());
+        let SubsetTree {
+            parent,
+            children,
+            depth,
+            aabb,
+            diameter,
+            ..
+        } = tree;
+        let area: Vec<f64> = tabulate(aabb.len(), |i| area(&aabb[i]));
+        let slots = children.len();
+        let w = WorkTree {
             n: n as u32,
-            parent: tabulate(tree.len(), |i| tree.parent[i]),
-            children: tabulate(tree.children.len(), |i| tree.children[i]),
-            aabb: tabulate(tree.len(), |i| tree.aabb[i]),
+            mark: vec![false; parent.len()],
+            parent,
+            children,
+            aabb,
             interior: area[n..].iter().sum(),
             area,
-            root: tree.root(),
-            changed: vec![false; tree.children.len()],
+            root,
+            changed: vec![false; slots],
             topological: true,
-            mark: vec![false; tree.len()],
-        }
+        };
+        (w, depth, diameter)
+    }
+
+    /// The Subset Tree this working tree was made from, with its `depth` and `diameter`: for a
+    /// tree no step changed (moves undone leave every array as it was, boxes being the unions
+    /// of their children's).
+    pub fn into_tree(self, depth: Vec<u32>, diameter: Vec<f64>) -> SubsetTree {
+        SubsetTree::from_parts(self.parent, self.children, depth, self.aabb, diameter)
     }
 
     /// Whether `x` is a leaf.
@@ -198,6 +245,29 @@ impl WorkTree {
                 self.changed[(x - self.n) as usize] = true;
             }
             x = self.parent[x as usize];
+        }
+    }
+
+    /// Undoes `u`; undoing a log's entries newest first gives back the tree before them.
+    pub fn undo(&mut self, u: &Undo) {
+        match *u {
+            Undo::Move { node, sibling } => {
+                self.reinsert(node, sibling);
+            }
+            Undo::Slot {
+                x,
+                kids,
+                aabb,
+                area,
+            } => {
+                self.children[(x - self.n) as usize] = kids;
+                for c in kids {
+                    self.parent[c as usize] = x;
+                }
+                self.interior += area - self.area[x as usize];
+                self.aabb[x as usize] = aabb;
+                self.area[x as usize] = area;
+            }
         }
     }
 

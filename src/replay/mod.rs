@@ -275,7 +275,7 @@ pub enum RefineVerified {
 pub fn final_tree(replay: &Replay) -> Result<SubsetTree> {
     let t = replay.tree()?;
     Ok(match &replay.rec.refine {
-        Some(r) => refine::refine(&t, &r.params, ()).tree,
+        Some(r) => refine::refine_owned(t, &r.params, ()).tree,
         None => t,
     })
 }
@@ -288,7 +288,7 @@ pub fn verify_refinement(replay: &Replay) -> Result<Option<RefineVerified>> {
         return Ok(None);
     };
     let mut log = EventLog::default();
-    refine::refine(&replay.tree()?, &r.params, &mut log);
+    refine::refine_owned(replay.tree()?, &r.params, &mut log);
     let n = rec.refine_steps.len().max(log.refine.len());
     Ok(Some(
         match (0..n).find(|&i| rec.refine_steps.get(i) != log.refine.get(i)) {
