@@ -7,7 +7,7 @@ use super::{brute_force, voxel_step};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Halves of at least this many primitives are grouped in parallel.
-const GRAIN: u32 = 2048;
+const GRAIN: u32 = 1024;
 
 /// The read-only inputs of the recursive grouping.
 pub(super) struct Executor<'a> {

@@ -146,7 +146,7 @@ pub(super) fn post_order(nodes: &[Node]) -> Vec<u32> {
 }
 
 /// Ranges of at least this many primitives plan their halves in parallel.
-const PLAN_GRAIN: u32 = 1 << 15;
+const PLAN_GRAIN: u32 = 1 << 10;
 
 /// The split of the primitives into chunks, nodes in pre-order (the root first): `codes`
 /// sorted, `leaves` the primitives in the same order. Ranges of at most
@@ -421,7 +421,9 @@ pub(super) mod tests {
 
     #[test]
     fn parallel_plan_equals_one_sequential_pass() {
-        let mut items = codes(5 * PLAN_GRAIN as usize + 17, 5);
+        // Above the size the default chunking groups whole, and several plan grains.
+        let len = (5 * PLAN_GRAIN).max(2 * Chunking::DEFAULT.top) as usize + 17;
+        let mut items = codes(len, 5);
         items.sort_unstable();
         let bodies = leaves(&items, 6);
         for chunking in [
