@@ -36,6 +36,11 @@ pub use subset_tree::{C_PRIM, C_TRAV, NONE, SubsetTree, sah};
 
 use crate::geom::Aabb;
 use crate::scene::Scene;
+
+/// Fewest items per piece of the grouping's parallel per-primitive passes (boxes, diameters,
+/// Morton codes): below it a pass stays on the calling thread, where waking another costs more
+/// than the pass (a 200-triangle scene took 25 % longer on 2 threads than on 1 without it).
+pub(crate) const PAR_MIN_LEN: usize = 4096;
 use std::sync::atomic::AtomicBool;
 
 /// Counters of one run, for benchmarks and the stability study.

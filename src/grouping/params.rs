@@ -335,7 +335,13 @@ impl Params {
     /// scene's.
     pub fn resolve_boxes(&self, boxes: &[Aabb]) -> ResolvedParams {
         self.resolve_with(
-            || boxes.par_iter().map(Aabb::diameter).collect(),
+            || {
+                boxes
+                    .par_iter()
+                    .with_min_len(super::PAR_MIN_LEN)
+                    .map(Aabb::diameter)
+                    .collect()
+            },
             || boxes.iter().fold(Aabb::EMPTY, |u, b| u.merge(b)).diameter(),
         )
     }

@@ -214,6 +214,10 @@ pub fn candidates(w: &WorkTree, count: usize) -> Vec<u32> {
     tied.sort_unstable();
     tied.truncate(count - ids.len());
     ids.extend(tied);
-    ids.par_sort_unstable();
+    if ids.len() < PARALLEL_MIN {
+        ids.sort_unstable();
+    } else {
+        ids.par_sort_unstable();
+    }
     ids
 }

@@ -12,7 +12,9 @@ use crate::geom::Aabb;
 use crate::grouping::cluster;
 use crate::grouping::subset_tree::SubsetTree;
 use crate::grouping::voxel_hash::prefetch;
-use crate::grouping::{Budget, Grouping, PSet, ResolvedParams, Stats, StopReason, Stopped};
+use crate::grouping::{
+    Budget, Grouping, PAR_MIN_LEN, PSet, ResolvedParams, Stats, StopReason, Stopped,
+};
 use crate::scene::Scene;
 use rayon::prelude::*;
 use std::sync::Mutex;
@@ -69,7 +71,12 @@ pub fn group_with<O: Observer>(
     let n = scene.len();
     // Room for the merged bodies from the start (no copy when they are added).
     let mut aabb: Vec<Aabb> = Vec::with_capacity(2 * n - 1);
-    aabb.par_extend((0..n).into_par_iter().map(|i| scene.prim_aabb(i)));
+    aabb.par_extend(
+        (0..n)
+            .into_par_iter()
+            .with_min_len(PAR_MIN_LEN)
+            .map(|i| scene.prim_aabb(i)),
+    );
     group_boxes(aabb, params, chunking, observer, budget)
 }
 
@@ -87,7 +94,11 @@ pub fn group_boxes<O: Observer>(
     let n = aabb.len();
     aabb.reserve_exact(n - 1);
     let mut diameter: Vec<f64> = Vec::with_capacity(2 * n - 1);
-    diameter.par_extend(aabb.par_iter().map(Aabb::diameter));
+    diameter.par_extend(
+        aabb.par_iter()
+            .with_min_len(PAR_MIN_LEN)
+            .map(Aabb::diameter),
+    );
     let mut codes = morton_order(&aabb);
     let mut leaves = gather_leaves(&aabb, &codes);
     // Planned on the leaves themselves: the SAH cuts read their boxes in order, and reorder
@@ -107,8 +118,8 @@ pub fn group_boxes<O: Observer>(
     let mut children = vec![[0u32; 2]; merges];
     // The merges' slots, filled on every thread (fresh pages are written, and faulted in, in
     // parallel).
-    aabb.par_extend(rayon::iter::repeat_n(Aabb::EMPTY, n - 1));
-    diameter.par_extend(rayon::iter::repeat_n(0.0, n - 1));
+    aabb.par_extend(rayon::iter::repeat_n(Aabb::EMPTY, n - 1).with_min_len(PAR_MIN_LEN));
+    diameter.par_extend(rayon::iter::repeat_n(0.0, n - 1).with_min_len(PAR_MIN_LEN));
     let listens = !observer.is_silent();
     let mut info = if listens {
         vec![MergeInfo::default(); merges]
@@ -164,6 +175,7 @@ pub fn group_boxes<O: Observer>(
 fn gather_leaves(aabb: &[Aabb], codes: &[(u64, u32)]) -> Vec<Body> {
     (0..codes.len())
         .into_par_iter()
+        .with_min_len(PAR_MIN_LEN)
         .map(|i| {
             if let Some(&(_, ahead)) = codes.get(i + GATHER_AHEAD) {
                 prefetch(&aabb[ahead as usize]);

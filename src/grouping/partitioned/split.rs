@@ -19,6 +19,7 @@
 use super::subproblem::Body;
 use crate::geom::morton::spread_bits;
 use crate::geom::{Aabb, V3, surface_area};
+use crate::grouping::PAR_MIN_LEN;
 use crate::grouping::mpairs::order_bits;
 use rayon::prelude::*;
 
@@ -44,6 +45,7 @@ pub(super) fn morton_cut<T>(items: &[T], code: impl Fn(&T) -> u64) -> usize {
 pub(super) fn morton_order(boxes: &[Aabb]) -> Vec<(u64, u32)> {
     let cb = boxes
         .par_iter()
+        .with_min_len(PAR_MIN_LEN)
         .fold(|| Aabb::EMPTY, |b, x| b.grow(&x.center()))
         .reduce(|| Aabb::EMPTY, |a, b| a.merge(&b));
     let ext = cb.extents().max();
@@ -55,6 +57,7 @@ pub(super) fn morton_order(boxes: &[Aabb]) -> Vec<(u64, u32)> {
     let scale = [s; 3];
     let codes: Vec<(u64, u32)> = boxes
         .par_iter()
+        .with_min_len(PAR_MIN_LEN)
         .enumerate()
         .map(|(i, b)| {
             let c = b.center();
