@@ -70,7 +70,9 @@ pub fn find_best(
             if g > best_g {
                 (best_t, best_g) = (t, g);
             }
-            if !w.is_leaf(t) {
+            // The children's bound, checked before they are stacked (the best gain only grows,
+            // so one that fails now would be skipped when popped).
+            if !w.is_leaf(t) && g + w.area[t as usize] - node_area > best_g {
                 let down = g + w.area[t as usize];
                 let [a, b] = w.kids(t);
                 stack.push((down, b));
