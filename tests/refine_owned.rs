@@ -53,15 +53,7 @@ fn undoing_treelets_and_moves_newest_first_gives_back_every_array() {
         // Treelets rebuilt on the lowest heights, as a treelet pass does...
         for roots in treelet::by_height(&w, 3).into_iter().take(3) {
             for plan in treelet::solve_all(&w, &roots, 7, min_gain) {
-                for &(x, ..) in &plan.nodes {
-                    log.push(Undo::Slot {
-                        x,
-                        kids: w.kids(x),
-                        aabb: w.aabb[x as usize],
-                        area: w.area[x as usize],
-                    });
-                }
-                w.restructure(&plan);
+                w.restructure(&plan, &mut log);
             }
         }
         let treelet_entries = log.len();

@@ -32,16 +32,16 @@ pub use crate::events::{Event, EventLog, Merge, Observer, Part, PartKind, Tee};
 pub use limits::{Budget, Limits, StopReason, Stopped};
 pub use params::{CostMeasure, Mode, PSet, Params, Pregroup, ResolvedParams, Schedule, Weights};
 pub use pregroup::Pregrouping;
-pub use subset_tree::{C_PRIM, C_TRAV, NONE, SubsetTree, sah};
+pub use subset_tree::{C_PRIM, C_TRAV, NONE, SubsetTree, sah, sah_of_sums};
 
 use crate::geom::Aabb;
 use crate::scene::Scene;
+use std::sync::atomic::AtomicBool;
 
 /// Fewest items per piece of the grouping's parallel per-primitive passes (boxes, diameters,
 /// Morton codes): below it a pass stays on the calling thread, where waking another costs more
 /// than the pass (a 200-triangle scene took 25 % longer on 2 threads than on 1 without it).
 pub(crate) const PAR_MIN_LEN: usize = 4096;
-use std::sync::atomic::AtomicBool;
 
 /// Counters of one run, for benchmarks and the stability study.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]

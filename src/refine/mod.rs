@@ -21,8 +21,8 @@ pub mod treelet;
 pub mod work;
 
 use crate::geom::area;
-use crate::grouping::sah;
 use crate::grouping::{Event, Observer, SubsetTree};
+use crate::grouping::{sah, sah_of_sums};
 use work::WorkTree;
 
 /// The fast path's refinement (`--fast`, bench method `fast`), after the partitioned grouping
@@ -211,7 +211,7 @@ pub fn refine_tuned_owned<O: Observer>(
     }
     let order = renumber::order(&w).expect("moves keep one binary tree");
     // What `sah` gives the renumbered tree, from the areas at hand.
-    let sah_after = renumber::sah(&w, &order, leaves);
+    let sah_after = sah_of_sums(renumber::interior_area(&w, &order), leaves, root_area);
     if sah_after > sah_before {
         for u in undo.iter().rev() {
             w.undo(u);
@@ -254,16 +254,7 @@ impl<O: Observer> Run<'_, O> {
         for roots in levels.into_iter().step_by(every) {
             for plan in treelet::solve_all(&self.w, &roots, k, self.min_gain) {
                 let sah_before = self.sah();
-                for &(x, ..) in &plan.nodes {
-                    let i = x as usize;
-                    self.undo.push(work::Undo::Slot {
-                        x,
-                        kids: self.w.kids(x),
-                        aabb: self.w.aabb[i],
-                        area: self.w.area[i],
-                    });
-                }
-                self.w.restructure(&plan);
+                self.w.restructure(&plan, &mut self.undo);
                 let bx = self.w.aabb[plan.root as usize];
                 self.emit(Step {
                     step: self.steps,

@@ -4,7 +4,7 @@
 //! input id comes next. An unmoved tree keeps every id.
 
 use super::work::{PARALLEL_COPY, WorkTree, tabulate};
-use crate::grouping::{C_PRIM, C_TRAV, SubsetTree};
+use crate::grouping::SubsetTree;
 use rayon::prelude::*;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -59,17 +59,12 @@ pub fn order(w: &WorkTree) -> Result<Vec<u32>, String> {
     Ok(order)
 }
 
-/// The SAH ([`crate::grouping::sah`]) of the Subset Tree that [`subset_tree`] makes of `w` in
-/// `order`, bit for bit, from the areas `w` keeps: the same areas summed in the same order
-/// (`leaves` is the sum of the leaves' areas in id order).
-pub fn sah(w: &WorkTree, order: &[u32], leaves: f64) -> f64 {
+/// The sum of the interior areas of the Subset Tree that [`subset_tree`] makes of `w` in
+/// `order`, from the areas `w` keeps, in that tree's id order: the sum
+/// [`crate::grouping::sah`] takes of it, bit for bit.
+pub fn interior_area(w: &WorkTree, order: &[u32]) -> f64 {
     let n = w.n as usize;
-    let root = w.area[w.root as usize];
-    if root.is_nan() || root <= 0.0 {
-        return w.parent.len() as f64;
-    }
-    let interior: f64 = order.iter().map(|&i| w.area[n + i as usize]).sum();
-    (C_TRAV * interior + C_PRIM * leaves) / root
+    order.iter().map(|&i| w.area[n + i as usize]).sum()
 }
 
 /// The Subset Tree of `w` with its interior slots renumbered in `order` ([`order`]): boxes as

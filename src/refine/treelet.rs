@@ -14,7 +14,7 @@
 //! [`PARALLEL_MIN`] treelets up) and applied in root-id order, which makes the result the same
 //! for any number of threads.
 
-use super::work::WorkTree;
+use super::work::{Undo, WorkTree};
 use crate::geom::Aabb;
 use crate::geom::area;
 use crate::grouping::NONE;
@@ -290,11 +290,18 @@ pub fn solve_all(w: &WorkTree, roots: &[u32], k: usize, min_gain: f64) -> Vec<Pl
 
 impl WorkTree {
     /// Replaces a treelet by its plan: new children, parents, boxes and areas of its interior
-    /// slots, the running interior sum kept in step, changed leaf sets marked. The root's box
-    /// is its leaves' union either way, so nothing above it changes.
-    pub fn restructure(&mut self, plan: &Plan) {
+    /// slots, the running interior sum kept in step, changed leaf sets marked; each slot as it
+    /// was goes to `undo`. The root's box is its leaves' union either way, so nothing above it
+    /// changes.
+    pub fn restructure(&mut self, plan: &Plan, undo: &mut Vec<Undo>) {
         self.topological = false;
         for &(x, kids, bx, changed) in &plan.nodes {
+            undo.push(Undo::Slot {
+                x,
+                kids: self.kids(x),
+                aabb: self.aabb[x as usize],
+                area: self.area[x as usize],
+            });
             let i = (x - self.n) as usize;
             self.children[i] = kids;
             for c in kids {

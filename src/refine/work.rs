@@ -273,7 +273,6 @@ impl WorkTree {
 
     /// SAH of the current tree from the running interior sum (see [`crate::grouping::sah`]).
     pub fn sah(&self, leaves: f64, root_area: f64) -> f64 {
-        use crate::grouping::{C_PRIM, C_TRAV};
-        (C_TRAV * self.interior + C_PRIM * leaves) / root_area
+        crate::grouping::sah_of_sums(self.interior, leaves, root_area)
     }
 }

@@ -129,7 +129,7 @@ fn lsd(codes: Vec<(u64, u32)>, key_bits: u32) -> Vec<(u64, u32)> {
     const R: usize = 1 << DIGIT;
     let n = codes.len();
     let passes = key_bits.div_ceil(DIGIT) as usize;
-    let mut counts = vec![[0u32; R]; passes];
+    let mut counts = vec![[0usize; R]; passes];
     for &(code, _) in &codes {
         for (p, h) in counts.iter_mut().enumerate() {
             h[(code >> (p as u32 * DIGIT)) as usize & (R - 1)] += 1;
@@ -137,21 +137,14 @@ fn lsd(codes: Vec<(u64, u32)>, key_bits: u32) -> Vec<(u64, u32)> {
     }
     let (mut from, mut to) = (codes, vec![(0u64, 0u32); n]);
     for (p, h) in counts.iter().enumerate() {
-        if h.iter().any(|&k| k as usize == n) {
+        if h.contains(&n) {
             continue;
         }
-        let mut next = [0u32; R];
-        let mut at = 0;
-        for (x, &k) in next.iter_mut().zip(h) {
-            *x = at;
-            at += k;
-        }
+        let mut next = starts(h);
         let shift = p as u32 * DIGIT;
-        for &pair in &from {
-            let d = (pair.0 >> shift) as usize & (R - 1);
-            to[next[d] as usize] = pair;
-            next[d] += 1;
-        }
+        scatter(&from, &mut to, &mut next, |code| {
+            (code >> shift) as usize & (R - 1)
+        });
         std::mem::swap(&mut from, &mut to);
     }
     for run in from.chunk_by_mut(|a, b| a.0 == b.0) {
@@ -174,32 +167,48 @@ fn sort_bucket(s: &mut [(u64, u32)], shift: u32, tmp: &mut Vec<(u64, u32)>) {
     }
     let mask = (1usize << INNER_BITS) - 1;
     let digit = |code: u64| (code >> shift) as usize & mask;
-    let mut next = [0usize; 1 << INNER_BITS];
+    let mut counts = [0usize; 1 << INNER_BITS];
     for &(code, _) in s.iter() {
-        next[digit(code)] += 1;
+        counts[digit(code)] += 1;
     }
-    let mut at = 0;
-    for c in next.iter_mut() {
-        let k = *c;
-        *c = at;
-        at += k;
-    }
-    let starts = next;
+    let begin = starts(&counts);
+    let mut next = begin;
     tmp.clear();
     tmp.resize(s.len(), (0, 0));
-    for &pair in s.iter() {
-        let d = digit(pair.0);
-        tmp[next[d]] = pair;
-        next[d] += 1;
-    }
+    scatter(s, tmp, &mut next, digit);
     s.copy_from_slice(tmp);
-    for (&lo, &hi) in starts.iter().zip(&next) {
+    for (&lo, &hi) in begin.iter().zip(&next) {
         match hi - lo {
             0 | 1 => {}
             k if k <= INSERTION => insertion_sort(&mut s[lo..hi]),
             // A dense spot of the scene (one run holding most of a bucket): no quadratic sort.
             _ => s[lo..hi].sort_unstable(),
         }
+    }
+}
+
+/// Where each digit's pairs start, from the digits' counts.
+fn starts<const R: usize>(counts: &[usize; R]) -> [usize; R] {
+    let mut at = 0;
+    counts.map(|k| {
+        at += k;
+        at - k
+    })
+}
+
+/// Moves `from` into `to` by `digit` of their codes, keeping their order within a digit:
+/// digit d's pairs go from `next[d]` on, and `next[d]` ends past them.
+#[inline]
+fn scatter(
+    from: &[(u64, u32)],
+    to: &mut [(u64, u32)],
+    next: &mut [usize],
+    digit: impl Fn(u64) -> usize,
+) {
+    for &pair in from {
+        let d = digit(pair.0);
+        to[next[d]] = pair;
+        next[d] += 1;
     }
 }
 
