@@ -2,9 +2,12 @@
 //!
 //! The `vertex` element's `x`, `y`, `z` (any scalar type) are the vertices, and each `face`
 //! element's `vertex_indices` (or `vertex_index`) list, of any length and integer type, is one
-//! face; other elements and properties (normals, colours, texture coordinates, edges) are read
-//! past and ignored. The file is one object named after its stem. An element count larger
-//! than the payload holds is an error, as is a face index outside the vertex list.
+//! face. A `tristrips` element's lists (as Stanford's scans write them) are triangle strips,
+//! each list one or more strips separated by −1: every three consecutive vertices of a strip
+//! are a triangle, and those that repeat a vertex (the joins between strips) are dropped. Other
+//! elements and properties (normals, colours, texture coordinates, edges) are read past and
+//! ignored. The file is one object named after its stem. An element count larger than the
+//! payload holds is an error, as is a face index outside the vertex list.
 
 use std::io::BufReader;
 
@@ -79,7 +82,7 @@ impl Face {
     }
 }
 
-/// Whether a `face` property named `name` holds the vertex indices.
+/// Whether a `face` or `tristrips` property named `name` holds the vertex indices.
 fn is_index_list(name: &str) -> bool {
     matches!(name, "vertex_indices" | "vertex_index")
 }
@@ -182,6 +185,7 @@ pub(crate) fn read(file_name: &str, bytes: &[u8]) -> Result<Faces, LoadError> {
     let mut coords: Vec<[f64; 3]> = Vec::new();
     let mut lists: Vec<Vec<i64>> = Vec::new();
     let mut has_faces = false;
+    let mut strips: Vec<Vec<i64>> = Vec::new();
     for (name, e) in &header.elements {
         match name.as_str() {
             "vertex" => {
@@ -196,6 +200,13 @@ pub(crate) fn read(file_name: &str, bytes: &[u8]) -> Result<Faces, LoadError> {
                     .read_payload_for_element(&mut reader, e, &header)
                     .map_err(malformed)?;
                 lists = fs.into_iter().map(|f| f.idx).collect();
+            }
+            "tristrips" if e.properties.keys().any(|k| is_index_list(k)) => {
+                has_faces = true;
+                let ss = Parser::<Face>::new()
+                    .read_payload_for_element(&mut reader, e, &header)
+                    .map_err(malformed)?;
+                strips = ss.into_iter().map(|f| f.idx).collect();
             }
             _ => {
                 Parser::<Skip>::new()
@@ -228,6 +239,37 @@ pub(crate) fn read(file_name: &str, bytes: &[u8]) -> Result<Faces, LoadError> {
             });
         }
         faces.face(list.iter().map(|&i| i as u32), object);
+    }
+    for (k, list) in strips.iter().enumerate() {
+        if let Some(&bad) = list
+            .iter()
+            .find(|&&i| i < -1 || (i >= 0 && i as u64 >= n as u64))
+        {
+            let why = format!(
+                "triangle strip list {} refers to vertex {bad} but the file has {n} vertices",
+                k + 1
+            );
+            return Err(LoadError {
+                file: file_name.to_string(),
+                kind: LoadErrorKind::BadIndex,
+                problem: why,
+            });
+        }
+        for strip in list.split(|&i| i == -1) {
+            for (t, w) in strip.windows(3).enumerate() {
+                if w[0] == w[1] || w[1] == w[2] || w[0] == w[2] {
+                    continue;
+                }
+                // Every other triangle of a strip turns the other way: swap two to keep the
+                // winding.
+                let tri = if t % 2 == 0 {
+                    [w[0], w[1], w[2]]
+                } else {
+                    [w[1], w[0], w[2]]
+                };
+                faces.face(tri.iter().map(|&i| i as u32), object);
+            }
+        }
     }
     Ok(faces)
 }
@@ -305,5 +347,29 @@ mod tests {
         );
         let e = read("q.ply", b"ply\nformat ascii 1.0\n").unwrap_err();
         assert!(e.problem.starts_with("not a valid PLY file ("), "{e}");
+    }
+
+    const STRIPS: &str = "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\n\
+                          property float y\nproperty float z\nelement tristrips 1\n\
+                          property list int int vertex_indices\nend_header\n\
+                          0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 2 0\n1 2 0\n\
+                          9 0 1 2 3 3 4 -1 4 5\n";
+
+    #[test]
+    fn triangle_strips_split_at_minus_one_and_drop_joins() {
+        let f = read("s.ply", STRIPS.as_bytes()).unwrap();
+        let tris: Vec<Vec<u32>> = f.faces().map(|(v, _)| v.to_vec()).collect();
+        // 0 1 2 3 3 4: (0 1 2), (2 1 3) turned back, then (2 3 3) and (3 3 4) repeat a vertex;
+        // -1 ends the strip, and 4 5 alone is no triangle.
+        assert_eq!(tris, [vec![0, 1, 2], vec![2, 1, 3]]);
+        let bad = STRIPS.replace("-1 4 5", "-1 4 6");
+        let e = read("s.ply", bad.as_bytes()).unwrap_err();
+        assert_eq!(
+            e.problem,
+            "triangle strip list 1 refers to vertex 6 but the file has 6 vertices"
+        );
+        let neg = STRIPS.replace("-1 4 5", "-2 4 5");
+        let e = read("s.ply", neg.as_bytes()).unwrap_err();
+        assert!(e.problem.contains("vertex -2"), "{e}");
     }
 }
