@@ -4,8 +4,8 @@
 //! (all queries, and the point and distance queries alone); with `LOOP=SECONDS` set it instead builds
 //! the first method on the first file over and over for that long (a target for `perf`).
 //!
-//! The fast path's settings can be varied through the environment: `TOP`, `SAH`, `EPS` (its
-//! split: root share, SAH-cut size, ε) and `PASSES`, `BATCH` (its reinsertion passes).
+//! The fast path's settings can be varied through the environment: `TOP`, `SAH`, `EPS`, `MAX`
+//! (its split: root share, SAH-cut size, ε, largest chunk) and `PASSES`, `BATCH` (its reinsertion passes).
 //!
 //! `cargo run --release --example method_timing -- [--threads 1] [--repeat 5]
 //! [--methods fast,grouping] FILE...`
@@ -34,6 +34,7 @@ fn build_varied(method: Method, scene: &Scene, params: &Params) -> Built {
     p.mode.chunk_top = env("TOP").unwrap_or(p.mode.chunk_top);
     p.mode.chunk_sah = env("SAH").unwrap_or(p.mode.chunk_sah);
     p.mode.chunk_epsilon = env("EPS").unwrap_or(p.mode.chunk_epsilon);
+    p.mode.chunk_max = env("MAX").unwrap_or(p.mode.chunk_max);
     let mut rp = refine::FAST;
     rp.passes = env("PASSES").unwrap_or(rp.passes);
     rp.batch = env("BATCH").unwrap_or(rp.batch);

@@ -39,6 +39,7 @@ pub mod geom;
 pub mod grouping;
 pub mod metrics;
 pub mod output;
+mod par;
 pub mod peers;
 pub mod query;
 pub mod record;

@@ -35,6 +35,7 @@ pub use pregroup::Pregrouping;
 pub use subset_tree::{C_PRIM, C_TRAV, NONE, SubsetTree, sah, sah_of_sums};
 
 use crate::geom::Aabb;
+use crate::par::{POOL_MIN, on_pool};
 use crate::scene::Scene;
 use std::sync::atomic::AtomicBool;
 
@@ -117,6 +118,16 @@ pub fn group_boxes<O: Observer>(
     params: &ResolvedParams,
     observer: O,
 ) -> Grouping {
+    if observer.is_silent() {
+        // Nothing to tell: the whole run goes to the pool in one piece (`crate::par`).
+        let worth = boxes.len() >= POOL_MIN;
+        return on_pool(worth, move || run_boxes(boxes, params, ()));
+    }
+    run_boxes(boxes, params, observer)
+}
+
+/// [`group_boxes`] on the caller's thread.
+fn run_boxes<O: Observer>(boxes: Vec<Aabb>, params: &ResolvedParams, observer: O) -> Grouping {
     let budget = Budget::default();
     match params.mode.schedule {
         Schedule::Exact => cluster::run_boxes(boxes, params, observer, &budget),
@@ -125,8 +136,24 @@ pub fn group_boxes<O: Observer>(
     .expect("an unlimited budget never stops")
 }
 
-/// Runs the grouping phase in the schedule and mode that `params` names.
+/// Runs the grouping phase in the schedule and mode that `params` names: with an observer that
+/// ignores every event, in one piece on the rayon pool (`crate::par`).
 fn run<O: Observer>(
+    scene: &Scene,
+    params: &ResolvedParams,
+    observer: O,
+    budget: &Budget<'_>,
+) -> Result<Grouping, Stopped> {
+    if observer.is_silent() {
+        return on_pool(scene.len() >= POOL_MIN, || {
+            run_here(scene, params, (), budget)
+        });
+    }
+    run_here(scene, params, observer, budget)
+}
+
+/// [`run`] on the caller's thread.
+fn run_here<O: Observer>(
     scene: &Scene,
     params: &ResolvedParams,
     observer: O,

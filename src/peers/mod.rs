@@ -191,9 +191,17 @@ pub struct Built {
 /// grouping's round-start scans (rounds of at least 2,048 active bodies), the pre-grouped
 /// methods and obvhs PLOC (its `parallel` feature) use the current rayon pool (run them inside
 /// `ThreadPool::install` to choose the thread count); the other builders are single-threaded.
+/// Called from outside the pool, the build runs on one of its threads.
 /// A refined method's time includes the refinement (which searches on rayon's threads);
 /// [`Built::refine_seconds`] is its part.
 pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, String> {
+    // Every method is timed on a thread of the pool, as a caller inside it would run it: from
+    // outside, each of a builder's parallel steps would be handed over (`crate::par`).
+    crate::par::on_pool(true, || build_here(method, scene, params))
+}
+
+/// [`build`] on the caller's thread.
+fn build_here(method: Method, scene: &Scene, params: &Params) -> Result<Built, String> {
     let base = method.base();
     let mut built = build_base(base, scene, params)?;
     if method.is_refined() {

@@ -23,6 +23,7 @@ pub mod work;
 use crate::geom::area;
 use crate::grouping::{Event, Observer, SubsetTree};
 use crate::grouping::{sah, sah_of_sums};
+use crate::par::{POOL_MIN, on_pool};
 use work::WorkTree;
 
 /// The fast path's refinement (`--fast`, bench method `fast`), after the partitioned grouping
@@ -135,6 +136,27 @@ pub fn refine_tuned<O: Observer>(
 
 /// [`refine_owned`] with other [`Tuning`] than the default.
 pub fn refine_tuned_owned<O: Observer>(
+    tree: SubsetTree,
+    params: &RefineParams,
+    tuning: &Tuning,
+    observer: O,
+) -> Refined {
+    if observer.is_silent() {
+        // Nothing to tell: a run with parallel steps goes to the pool in one piece
+        // (`crate::par`). Those are the searches of a first reinsertion batch of at least
+        // `reinsert::PARALLEL_MIN` candidates, and the treelets of a tree large enough for
+        // some height to have `treelet::PARALLEL_MIN` of them.
+        let nodes = 2 * tree.leaves().max(1) - 1;
+        let first = (nodes as f64 * params.batch).ceil() as usize;
+        let worth = first >= reinsert::PARALLEL_MIN
+            || (params.treelet_passes > 0 && tree.leaves() >= POOL_MIN);
+        return on_pool(worth, move || refine_here(tree, params, tuning, ()));
+    }
+    refine_here(tree, params, tuning, observer)
+}
+
+/// [`refine_tuned_owned`] on the caller's thread.
+fn refine_here<O: Observer>(
     tree: SubsetTree,
     params: &RefineParams,
     tuning: &Tuning,

@@ -4,9 +4,9 @@
 use super::announce::{Built, announce};
 use super::brute_force::RoundLimits;
 use super::executor::Executor;
-use super::plan::{Chunking, plan};
+use super::plan::{Chunking, Node, plan};
 use super::split::morton_order;
-use super::subproblem::{Body, Counters, MergeInfo, MergeSlots, RunInputs};
+use super::subproblem::{Body, Counters, Leftover, MergeInfo, MergeSlots, RunInputs};
 use crate::events::{Event, Observer};
 use crate::geom::Aabb;
 use crate::grouping::cluster;
@@ -15,6 +15,7 @@ use crate::grouping::voxel_hash::prefetch;
 use crate::grouping::{
     Budget, Grouping, PAR_MIN_LEN, PSet, ResolvedParams, Stats, StopReason, Stopped,
 };
+use crate::par::{POOL_MIN, on_pool};
 use crate::scene::Scene;
 use rayon::prelude::*;
 use std::sync::Mutex;
@@ -83,14 +84,78 @@ pub fn group_with<O: Observer>(
 /// The partitioned schedule (AABB p-set) on primitives whose boxes are `aabb`, the primitive
 /// ids being their indices (`aabb` grows to the tree's 2N − 1 boxes: give it that capacity to
 /// spare a copy). Panics only if `aabb` is empty.
+///
+/// The split and the subproblems, which tell the observer nothing until they are done, run in
+/// one piece on the rayon pool (`crate::par`); the events are announced on the caller's thread.
 pub fn group_boxes<O: Observer>(
-    mut aabb: Vec<Aabb>,
+    aabb: Vec<Aabb>,
     params: &ResolvedParams,
     chunking: &Chunking,
     mut observer: O,
     budget: &Budget<'_>,
 ) -> Result<Grouping, Stopped> {
     assert!(!aabb.is_empty(), "grouping needs at least one primitive");
+    let n = aabb.len();
+    let ctx = RunInputs {
+        params: *params,
+        dl: RoundLimits::new(params.dlimit0),
+        gl: RoundLimits::new(params.glimit0),
+        budget,
+        pairs: AtomicU64::new(0),
+        halt: AtomicBool::new(false),
+        reason: Mutex::new(None),
+    };
+    let listens = !observer.is_silent();
+    let g = on_pool(n >= POOL_MIN, || {
+        split_and_group(aabb, chunking, &ctx, listens)
+    });
+    // Events, in post-order, up to the first unfinished subproblem.
+    let emitted = if listens || g.result.is_none() {
+        let made = Built {
+            n,
+            children: &g.children,
+            aabb: &g.aabb,
+            diameter: &g.diameter,
+            info: &g.info,
+        };
+        announce(&mut observer, &g.nodes, &g.done, &made, listens)
+    } else {
+        0
+    };
+    if g.result.is_none() {
+        return Err(stopped(&ctx, emitted));
+    }
+    let tree = SubsetTree::new(g.aabb, g.diameter, g.children)
+        .expect("the partitioned schedule makes exactly N - 1 valid merges");
+    observer.on_event(&Event::Finish {
+        root: tree.root(),
+        rounds: g.sub.rounds,
+        merges: (n - 1) as u32,
+    });
+    Ok(finished(tree, params, &g.sub))
+}
+
+/// What the split and the subproblems leave: the tree's arrays (the merges' details when the
+/// observer listens), the split's nodes with which of them finished, and the outcome.
+struct Grouped {
+    aabb: Vec<Aabb>,
+    diameter: Vec<f64>,
+    children: Vec<[u32; 2]>,
+    info: Vec<MergeInfo>,
+    nodes: Vec<Node>,
+    done: Vec<AtomicBool>,
+    /// `None` when the budget stopped the run.
+    result: Option<Leftover>,
+    sub: Counters,
+}
+
+/// The Morton order, the split planned over it and the executor run on it.
+fn split_and_group(
+    mut aabb: Vec<Aabb>,
+    chunking: &Chunking,
+    ctx: &RunInputs,
+    listens: bool,
+) -> Grouped {
     let n = aabb.len();
     aabb.reserve_exact(n - 1);
     let mut diameter: Vec<f64> = Vec::with_capacity(2 * n - 1);
@@ -105,22 +170,12 @@ pub fn group_boxes<O: Observer>(
     // them with their codes.
     let nodes = plan(&mut codes, &mut leaves, chunking);
     drop(codes);
-    let ctx = RunInputs {
-        params: *params,
-        dl: RoundLimits::new(params.dlimit0),
-        gl: RoundLimits::new(params.glimit0),
-        budget,
-        pairs: AtomicU64::new(0),
-        halt: AtomicBool::new(false),
-        reason: Mutex::new(None),
-    };
     let merges = n - 1;
     let mut children = vec![[0u32; 2]; merges];
     // The merges' slots, filled on every thread (fresh pages are written, and faulted in, in
     // parallel).
     aabb.par_extend(rayon::iter::repeat_n(Aabb::EMPTY, n - 1).with_min_len(PAR_MIN_LEN));
     diameter.par_extend(rayon::iter::repeat_n(0.0, n - 1).with_min_len(PAR_MIN_LEN));
-    let listens = !observer.is_silent();
     let mut info = if listens {
         vec![MergeInfo::default(); merges]
     } else {
@@ -128,7 +183,7 @@ pub fn group_boxes<O: Observer>(
     };
     let done: Vec<AtomicBool> = nodes.iter().map(|_| AtomicBool::new(false)).collect();
     let exec = Executor {
-        ctx: &ctx,
+        ctx,
         nodes: &nodes,
         done: &done,
     };
@@ -143,30 +198,16 @@ pub fn group_boxes<O: Observer>(
         stats: Counters::default(),
     };
     let (result, sub) = exec.node(0, &mut leaves, out, false);
-    // Events, in post-order, up to the first unfinished subproblem.
-    let emitted = if listens || result.is_none() {
-        let made = Built {
-            n,
-            children: &children,
-            aabb: &aabb,
-            diameter: &diameter,
-            info: &info,
-        };
-        announce(&mut observer, &nodes, &done, &made, listens)
-    } else {
-        0
-    };
-    if result.is_none() {
-        return Err(stopped(&ctx, emitted));
+    Grouped {
+        aabb,
+        diameter,
+        children,
+        info,
+        nodes,
+        done,
+        result,
+        sub,
     }
-    let tree = SubsetTree::new(aabb, diameter, children)
-        .expect("the partitioned schedule makes exactly N - 1 valid merges");
-    observer.on_event(&Event::Finish {
-        root: tree.root(),
-        rounds: sub.rounds,
-        merges: merges as u32,
-    });
-    Ok(finished(tree, params, &sub))
 }
 
 /// The leaves as bodies in Morton order: one gather (its loads overlap) instead of one per
