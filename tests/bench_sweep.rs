@@ -64,7 +64,19 @@ fn bench_writes_one_row_per_method_and_wrapper_with_charts_and_rrd() {
     // A missing output directory is created with its parents.
     let out = dir.path().join("new").join("out");
     let o = out.to_str().unwrap();
-    let r = wraptree(&["bench", "robot-base", "soup:300", "-o", o, "--repeat", "1"]);
+    let r = wraptree(&[
+        "bench",
+        "robot-base",
+        "soup:300",
+        "-o",
+        o,
+        "--repeat",
+        "1",
+        "--methods",
+        "all",
+        "--wrappers",
+        "all",
+    ]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
     let mut lines = csv.lines();
@@ -131,6 +143,42 @@ fn bench_writes_one_row_per_method_and_wrapper_with_charts_and_rrd() {
     // Results are not replaced without --force.
     let again = wraptree(&["bench", "robot-base", "-o", o, "--repeat", "1"]);
     common::assert_one_line_error(&again, "already exists");
+    // By default: the default builders × the default wrappers, in their order.
+    let d = dir.path().join("defaults");
+    let r = wraptree(&[
+        "bench",
+        "robot-base",
+        "-o",
+        d.to_str().unwrap(),
+        "--repeat",
+        "1",
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let csv = std::fs::read_to_string(d.join("results.csv")).unwrap();
+    let pairs: Vec<(String, String)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[col("method")].to_string(), f[col("wrapper")].to_string())
+        })
+        .collect();
+    let want: Vec<(String, String)> = Method::DEFAULT
+        .iter()
+        .flat_map(|m| {
+            compare::Wrapper::DEFAULT
+                .iter()
+                .map(|w| (m.name().to_string(), w.name().to_string()))
+        })
+        .collect();
+    assert_eq!(pairs, want);
+    let bad = wraptree(&["bench", "robot-base", "-o", o, "--methods", "fast,nope"]);
+    assert!(!bad.status.success());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        err.contains("unknown method 'nope'") && err.contains("or all"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -475,6 +475,49 @@ fn workload_queries_stop_at_the_cap_on_coincident_copies() {
     );
 }
 
+/// The workload's queries run side by side on rayon's threads: every count (tests, capped
+/// queries, overlaps) is the same for any number of threads, with sphere BVs, and where the
+/// sets stop at their cap (the capped queries land in different places of each pool's run).
+#[test]
+fn workload_counts_are_the_same_for_any_thread_count() {
+    let counts = |c: &wraptree::query::QueryCost| {
+        let m = |m: &wraptree::query::MeanCost| (m.queries, m.bv_tests, m.prim_tests, m.capped);
+        (m(&c.point), m(&c.distance), m(&c.overlap), c.overlapping)
+    };
+    let soup = generate::soup(600, 3);
+    let soup_tree = group(&soup, &Params::default(), ()).tree;
+    let spheres = sphere_tree(&soup_tree, &soup, SphereMethod::Ritter);
+    let stack = wraptree::scene::pathological::coincident(300);
+    let stack_tree = pairing_tree(&stack);
+    let mut capped = Workload::standard(&stack, 2);
+    capped.max_tests = 5_000;
+    let cases = [
+        (&soup_tree, &soup, Bv::Aabb, Workload::standard(&soup, 4)),
+        (
+            &soup_tree,
+            &soup,
+            Bv::Sphere(&spheres),
+            Workload::standard(&soup, 4),
+        ),
+        (&stack_tree, &stack, Bv::Aabb, capped),
+    ];
+    for (k, (tree, scene, bv, w)) in cases.iter().enumerate() {
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            counts(&pool.install(|| measure(tree, scene, *bv, w)))
+        };
+        let one = on(1);
+        assert_eq!(one, on(2), "case {k}");
+        assert_eq!(one, on(5), "case {k}");
+        if k == 2 {
+            assert_eq!(one.1.3, 8, "every distance query of the stack is capped");
+        }
+    }
+}
+
 /// Prints the workload cost on the 12,144-polygon scene and one brute-force scene–scene
 /// query's time on the lamp (626 polygons). Not asserted: run with `--ignored --nocapture`.
 #[test]

@@ -1,4 +1,4 @@
-//! `wraptree bench`: every hierarchy builder × wrapper on given scenes (CSV, charts, `.rrd`),
+//! `wraptree bench`: hierarchy builders × wrappers on given scenes (CSV, charts, `.rrd`),
 //! the targets table against obvhs PLOC and parry Binned measured in the same run, and (with
 //! `--record`) what recording costs ([`wraptree::metrics::bench`]).
 
@@ -22,7 +22,7 @@ use wraptree::stop::Stop;
 /// Arguments of `wraptree bench`.
 #[derive(Args, Debug)]
 pub struct BenchCmd {
-    /// Scenes to compare every method × wrapper on: OBJ files, or generated scenes as
+    /// Scenes to compare the methods × wrappers on: OBJ files, or generated scenes as
     /// KIND[:COUNT] (soup:100000, robot-bases:44, lamps:5, robot-base, lamp). Without scenes:
     /// the targets table on the standard scenes and the bundled meshes.
     scenes: Vec<String>,
@@ -33,12 +33,14 @@ pub struct BenchCmd {
     /// Replace existing result files.
     #[arg(long)]
     force: bool,
-    /// Hierarchy builders to compare (comma list) [default: all].
-    #[arg(long, value_delimiter = ',', value_parser = Method::parse)]
-    methods: Vec<Method>,
-    /// Wrappers to build on each hierarchy (comma list) [default: all].
-    #[arg(long, value_delimiter = ',', value_parser = Wrapper::parse)]
-    wrappers: Vec<Wrapper>,
+    /// Hierarchy builders to compare (comma list, or `all`) [default:
+    /// grouping,fast,grouping+refine,grouping-partitioned,parry-binned,obvhs-ploc,obvhs-ploc-reinsert].
+    #[arg(long, value_delimiter = ',', value_parser = method_choice)]
+    methods: Vec<Choice<Method>>,
+    /// Wrappers to build on each hierarchy (comma list, or `all`) [default:
+    /// box,sphere-min,obb,hull].
+    #[arg(long, value_delimiter = ',', value_parser = wrapper_choice)]
+    wrappers: Vec<Choice<Wrapper>>,
     /// Tightness is measured up to this many primitives.
     #[arg(long, default_value_t = 1_000_000)]
     tightness_max_n: usize,
@@ -67,6 +69,50 @@ pub struct BenchCmd {
     /// scenes on the targets scenes (and a 10^7 soup with --max-soup 10000000).
     #[arg(long, conflicts_with = "record")]
     partitioned: bool,
+}
+
+/// A `--methods` or `--wrappers` item: one name, or `all`.
+#[derive(Clone, Copy, Debug)]
+enum Choice<T> {
+    All,
+    One(T),
+}
+
+/// Parses a `--methods` item.
+fn method_choice(s: &str) -> Result<Choice<Method>, String> {
+    match s.trim() {
+        "all" => Ok(Choice::All),
+        _ => Method::parse(s)
+            .map(Choice::One)
+            .map_err(|e| format!("{e}, or all")),
+    }
+}
+
+/// Parses a `--wrappers` item.
+fn wrapper_choice(s: &str) -> Result<Choice<Wrapper>, String> {
+    match s.trim() {
+        "all" => Ok(Choice::All),
+        _ => Wrapper::parse(s)
+            .map(Choice::One)
+            .map_err(|e| format!("{e}, or all")),
+    }
+}
+
+/// The items chosen, in the order given (`all`: every one of `all`, in its order), each once.
+fn chosen<T: Copy + PartialEq>(items: &[Choice<T>], all: &[T]) -> Vec<T> {
+    let mut out: Vec<T> = Vec::new();
+    for c in items {
+        let more = match c {
+            Choice::All => all.to_vec(),
+            Choice::One(x) => vec![*x],
+        };
+        for x in more {
+            if !out.contains(&x) {
+                out.push(x);
+            }
+        }
+    }
+    out
 }
 
 /// Loads a KIND[:COUNT] or OBJ scene spec, printing loader warnings to stderr.
@@ -104,10 +150,10 @@ impl BenchCmd {
             ..Options::default()
         };
         if !self.methods.is_empty() {
-            opts.methods = self.methods.clone();
+            opts.methods = chosen(&self.methods, &Method::ALL);
         }
         if !self.wrappers.is_empty() {
-            opts.wrappers = self.wrappers.clone();
+            opts.wrappers = chosen(&self.wrappers, &Wrapper::ALL);
         }
         let output = output_dir(self.output.as_deref(), "recordings/bench")?;
         let stop = Stop::on_signals();

@@ -49,11 +49,12 @@ enum Command {
     /// Generate a seeded synthetic scene as Wavefront OBJ (2·10^5 triangles: under 1 s; n-gons,
     /// 1,024 vertices each: about 0.6 s per 1,000).
     Scene(scene_cmd::SceneCmd),
-    /// Compare every hierarchy builder × wrapper on scenes (CSV, charts, .rrd), or print the
-    /// targets table against obvhs PLOC and parry Binned. With the defaults a scene takes about
-    /// 1.5–4 ms per primitive on 2 cores (35,880 polygons: under a minute; 124,004: 4 min).
-    /// Stacked coincident copies cost more: their queries test every tied pair, up to a cap
-    /// (ten coincident copies of a 3,476-triangle part: about 40 s per builder).
+    /// Compare hierarchy builders × wrappers on scenes (CSV, charts, .rrd), or print the targets
+    /// table against obvhs PLOC and parry Binned. With the defaults (7 builders × 4 wrappers) a
+    /// real scene takes 0.1–0.7 ms per primitive on 2 cores (a 35,902-polygon assembly of rigid
+    /// copies: 23 s; 124,705 polygons: 48 s). Stacked coincident copies cost more: their queries
+    /// test every tied pair, up to a cap (ten coincident copies of a 3,476-triangle part: about
+    /// 8 s per builder).
     Bench(bench::BenchCmd),
     /// Run the A/B/C grid of the grouping Cost on a scene: table, heat maps, the series of every
     /// setting (sweep.rrd) and the trees of the 6 best distinct settings side by side

@@ -72,7 +72,21 @@ pub enum Method {
 }
 
 impl Method {
-    /// Every method, ours first.
+    /// What a bench compares by default: the paper's exact run, the fast path, the exact run
+    /// refined, the partitioned schedule, and the peers users choose between (parry Binned,
+    /// obvhs PLOC with and without reinsertion). The others (the hull p-set, pre-grouping,
+    /// the peers refined, median split, Goldsmith–Salmon) on request.
+    pub const DEFAULT: [Method; 7] = [
+        Method::Grouping,
+        Method::Fast,
+        Method::GroupingRefine,
+        Method::GroupingPartitioned,
+        Method::ParryBinned,
+        Method::ObvhsPloc,
+        Method::ObvhsPlocReinsert,
+    ];
+
+    /// Every method, ours first (`--methods all`).
     pub const ALL: [Method; 18] = [
         Method::Grouping,
         Method::Fast,

@@ -15,6 +15,8 @@ use crate::stop::{Interrupted, Stop};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// Cost of one BV test in eq. (1) as [`measure`] reports it.
@@ -156,7 +158,8 @@ pub struct MeanCost {
     pub prim_tests: f64,
     /// Eq. (1) per query: `N_v·C_V + N_p·C_P` (with `C_V = C_P = 1`).
     pub cost: f64,
-    /// Wall seconds for all queries of this kind.
+    /// Seconds of the queries of this kind, each timed on its own and summed (they run side by
+    /// side on rayon's threads, so on several threads their wall time is less).
     pub seconds: f64,
     /// Queries stopped at [`Workload::max_tests`] (their tests are a lower bound of the
     /// exact query's).
@@ -188,7 +191,7 @@ pub struct QueryCost {
     pub overlap: MeanCost,
     /// How many overlap queries answered true.
     pub overlapping: usize,
-    /// Wall seconds of all queries (moving the copies excluded).
+    /// Seconds of all queries, summed as [`MeanCost::seconds`] (moving the copies excluded).
     pub seconds: f64,
 }
 
@@ -208,11 +211,42 @@ impl QueryCost {
 /// of near poses, those of touching poses) is not run and is counted as capped with no tests
 /// (its mean is then a lower bound, and an overlap not run is not counted as overlapping): only
 /// exact ties reach the cap, and on them every query of the set would run to it.
+///
+/// The queries run side by side on rayon's threads, and their counts are summed in workload
+/// order with the rule above, so the result is that of running them one by one, for any number
+/// of threads: a query is not started once one before it in its set was capped, and one that
+/// ran after such a query (started before that query ended) is dropped.
 pub fn measure(tree: &SubsetTree, scene: &Scene, bv: Bv, workload: &Workload) -> QueryCost {
     match measure_until(tree, scene, bv, workload, &Stop::new()) {
         Ok(cost) => cost,
         Err(Interrupted) => unreachable!("nobody holds the new stop token"),
     }
+}
+
+/// The lowest index of a capped query in a set run side by side (`usize::MAX`: none yet).
+struct FirstCapped(AtomicUsize);
+
+impl FirstCapped {
+    fn new() -> FirstCapped {
+        FirstCapped(AtomicUsize::new(usize::MAX))
+    }
+
+    /// Whether query `i` is still to run: no query before it was capped so far.
+    fn open(&self, i: usize) -> bool {
+        self.0.load(Ordering::Relaxed) >= i
+    }
+
+    /// Notes that query `i` was capped.
+    fn capped(&self, i: usize) {
+        self.0.fetch_min(i, Ordering::Relaxed);
+    }
+}
+
+/// What one pose of the workload measured: its distance and overlap queries (`None`: not run),
+/// each with its tests and seconds.
+struct PoseResult {
+    distance: Option<(Counts, f64)>,
+    overlap: Option<(Counts, f64, bool)>,
 }
 
 /// [`measure`] that checks `stop` before each query (Err: [`Interrupted`]).
@@ -224,64 +258,112 @@ pub fn measure_until(
     stop: &Stop,
 ) -> Result<QueryCost, Interrupted> {
     let h = Hierarchy { tree, scene, bv };
+    let first = FirstCapped::new();
+    let each: Vec<Option<(Counts, f64)>> = workload
+        .points
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| {
+            if !first.open(i) || stop.is_requested() {
+                return None;
+            }
+            let (mut c, start) = (Counts::default(), Instant::now());
+            point_distance_within(&h, p, workload.max_tests, &mut c);
+            if c.capped > 0 {
+                first.capped(i);
+            }
+            Some((c, start.elapsed().as_secs_f64()))
+        })
+        .collect();
+    stop.check()?;
     let mut counts = Counts::default();
-    let start = Instant::now();
-    for p in &workload.points {
-        stop.check()?;
+    let mut point_s = 0.0;
+    for r in each {
         if counts.capped > 0 {
             counts.capped += 1;
-            continue;
+        } else {
+            let (c, secs) = r.expect("every query before the first capped one ran");
+            counts.add(&c);
+            point_s += secs;
         }
-        point_distance_within(&h, p, workload.max_tests, &mut counts);
     }
-    let point = MeanCost::new(
-        &counts,
-        workload.points.len(),
-        start.elapsed().as_secs_f64(),
-    );
+    let point = MeanCost::new(&counts, workload.points.len(), point_s);
+    let near = workload.poses_near.iter().map(|p| (p, true));
+    let poses: Vec<_> = near
+        .chain(workload.poses_touching.iter().map(|p| (p, false)))
+        .collect();
+    // The distances, and the overlaps of near and of touching poses, stop at the cap apart.
+    let (first_dist, first_over) = (FirstCapped::new(), [FirstCapped::new(), FirstCapped::new()]);
+    let each: Vec<PoseResult> = poses
+        .par_iter()
+        .enumerate()
+        .map(|(i, &(pose, is_near))| {
+            let over_set = &first_over[usize::from(is_near)];
+            let run_dist = is_near && first_dist.open(i);
+            let run_over = over_set.open(i);
+            if (!run_dist && !run_over) || stop.is_requested() {
+                return PoseResult {
+                    distance: None,
+                    overlap: None,
+                };
+            }
+            let (t, s) = moved(tree, scene, pose);
+            let spheres = match bv {
+                Bv::Aabb => Vec::new(),
+                Bv::Sphere(sp) => moved_spheres(sp, pose),
+            };
+            let bv2 = match bv {
+                Bv::Aabb => Bv::Aabb,
+                Bv::Sphere(_) => Bv::Sphere(&spheres),
+            };
+            let copy = Hierarchy {
+                tree: &t,
+                scene: &s,
+                bv: bv2,
+            };
+            let distance = run_dist.then(|| {
+                let (mut c, start) = (Counts::default(), Instant::now());
+                scene_distance_within(&h, &copy, workload.max_tests, &mut c);
+                if c.capped > 0 {
+                    first_dist.capped(i);
+                }
+                (c, start.elapsed().as_secs_f64())
+            });
+            let overlap = run_over.then(|| {
+                let (mut c, start) = (Counts::default(), Instant::now());
+                let hit = overlap_within(&h, &copy, workload.max_tests, &mut c);
+                if c.capped > 0 {
+                    over_set.capped(i);
+                }
+                (c, start.elapsed().as_secs_f64(), hit)
+            });
+            PoseResult { distance, overlap }
+        })
+        .collect();
+    stop.check()?;
+    // The order of the one-by-one run: a set's queries after its first capped one count as
+    // capped, with no tests.
     let (mut dist, mut over) = (Counts::default(), Counts::default());
     let (mut dist_s, mut over_s, mut overlapping) = (0.0, 0.0, 0);
-    // Overlap queries of near and of touching poses stop at the cap separately.
     let mut over_capped = [false; 2];
-    let near = workload.poses_near.iter().map(|p| (p, true));
-    for (pose, is_near) in near.chain(workload.poses_touching.iter().map(|p| (p, false))) {
-        stop.check()?;
-        let skip_dist = !is_near || dist.capped > 0;
-        let skip_over = over_capped[usize::from(is_near)];
-        if is_near && dist.capped > 0 {
-            dist.capped += 1;
+    for (&(_, is_near), r) in poses.iter().zip(each) {
+        if is_near {
+            if dist.capped > 0 {
+                dist.capped += 1;
+            } else {
+                let (c, secs) = r.distance.expect("run: no distance before it was capped");
+                dist.add(&c);
+                dist_s += secs;
+            }
         }
-        if skip_over {
+        if over_capped[usize::from(is_near)] {
             over.capped += 1;
-        }
-        if skip_dist && skip_over {
-            continue;
-        }
-        let (t, s) = moved(tree, scene, pose);
-        let spheres = match bv {
-            Bv::Aabb => Vec::new(),
-            Bv::Sphere(sp) => moved_spheres(sp, pose),
-        };
-        let bv2 = match bv {
-            Bv::Aabb => Bv::Aabb,
-            Bv::Sphere(_) => Bv::Sphere(&spheres),
-        };
-        let copy = Hierarchy {
-            tree: &t,
-            scene: &s,
-            bv: bv2,
-        };
-        if !skip_dist {
-            let start = Instant::now();
-            scene_distance_within(&h, &copy, workload.max_tests, &mut dist);
-            dist_s += start.elapsed().as_secs_f64();
-        }
-        if !skip_over {
-            let start = Instant::now();
-            let before = over.capped;
-            overlapping += overlap_within(&h, &copy, workload.max_tests, &mut over) as usize;
-            over_s += start.elapsed().as_secs_f64();
-            if over.capped > before {
+        } else {
+            let (c, secs, hit) = r.overlap.expect("run: no overlap before it was capped");
+            over.add(&c);
+            over_s += secs;
+            overlapping += usize::from(hit);
+            if c.capped > 0 {
                 over_capped[usize::from(is_near)] = true;
             }
         }
