@@ -78,24 +78,24 @@ enum Choice<T> {
     One(T),
 }
 
-/// Parses a `--methods` item.
-fn method_choice(s: &str) -> Result<Choice<Method>, String> {
+/// Parses a `--methods` or `--wrappers` item with `parse`, or `all`.
+fn choice<T>(s: &str, parse: fn(&str) -> Result<T, String>) -> Result<Choice<T>, String> {
     match s.trim() {
         "all" => Ok(Choice::All),
-        _ => Method::parse(s)
+        _ => parse(s)
             .map(Choice::One)
             .map_err(|e| format!("{e}, or all")),
     }
 }
 
+/// Parses a `--methods` item.
+fn method_choice(s: &str) -> Result<Choice<Method>, String> {
+    choice(s, Method::parse)
+}
+
 /// Parses a `--wrappers` item.
 fn wrapper_choice(s: &str) -> Result<Choice<Wrapper>, String> {
-    match s.trim() {
-        "all" => Ok(Choice::All),
-        _ => Wrapper::parse(s)
-            .map(Choice::One)
-            .map_err(|e| format!("{e}, or all")),
-    }
+    choice(s, Wrapper::parse)
 }
 
 /// The items chosen, in the order given (`all`: every one of `all`, in its order), each once.

@@ -194,19 +194,17 @@ pub(crate) fn read(file_name: &str, bytes: &[u8]) -> Result<Faces, LoadError> {
                     .map_err(malformed)?;
                 coords = vs.into_iter().map(|v| v.p).collect();
             }
-            "face" if e.properties.keys().any(|k| is_index_list(k)) => {
+            "face" | "tristrips" if e.properties.keys().any(|k| is_index_list(k)) => {
                 has_faces = true;
                 let fs = Parser::<Face>::new()
                     .read_payload_for_element(&mut reader, e, &header)
                     .map_err(malformed)?;
-                lists = fs.into_iter().map(|f| f.idx).collect();
-            }
-            "tristrips" if e.properties.keys().any(|k| is_index_list(k)) => {
-                has_faces = true;
-                let ss = Parser::<Face>::new()
-                    .read_payload_for_element(&mut reader, e, &header)
-                    .map_err(malformed)?;
-                strips = ss.into_iter().map(|f| f.idx).collect();
+                let idx = fs.into_iter().map(|f| f.idx).collect();
+                if name == "face" {
+                    lists = idx;
+                } else {
+                    strips = idx;
+                }
             }
             _ => {
                 Parser::<Skip>::new()
@@ -228,15 +226,7 @@ pub(crate) fn read(file_name: &str, bytes: &[u8]) -> Result<Faces, LoadError> {
     let n = faces.coords.len();
     for (k, list) in lists.iter().enumerate() {
         if let Some(&bad) = list.iter().find(|&&i| i < 0 || i as u64 >= n as u64) {
-            let why = format!(
-                "face {} refers to vertex {bad} but the file has {n} vertices",
-                k + 1
-            );
-            return Err(LoadError {
-                file: file_name.to_string(),
-                kind: LoadErrorKind::BadIndex,
-                problem: why,
-            });
+            return Err(bad_index(file_name, &format!("face {}", k + 1), bad, n));
         }
         faces.face(list.iter().map(|&i| i as u32), object);
     }
@@ -245,15 +235,8 @@ pub(crate) fn read(file_name: &str, bytes: &[u8]) -> Result<Faces, LoadError> {
             .iter()
             .find(|&&i| i < -1 || (i >= 0 && i as u64 >= n as u64))
         {
-            let why = format!(
-                "triangle strip list {} refers to vertex {bad} but the file has {n} vertices",
-                k + 1
-            );
-            return Err(LoadError {
-                file: file_name.to_string(),
-                kind: LoadErrorKind::BadIndex,
-                problem: why,
-            });
+            let what = format!("triangle strip list {}", k + 1);
+            return Err(bad_index(file_name, &what, bad, n));
         }
         for strip in list.split(|&i| i == -1) {
             for (t, w) in strip.windows(3).enumerate() {
@@ -272,6 +255,15 @@ pub(crate) fn read(file_name: &str, bytes: &[u8]) -> Result<Faces, LoadError> {
         }
     }
     Ok(faces)
+}
+
+/// The error of `what` (a face, a strip list) naming vertex `bad` of a file with `n`.
+fn bad_index(file_name: &str, what: &str, bad: i64, n: usize) -> LoadError {
+    LoadError {
+        file: file_name.to_string(),
+        kind: LoadErrorKind::BadIndex,
+        problem: format!("{what} refers to vertex {bad} but the file has {n} vertices"),
+    }
 }
 
 /// Bytes of the header: up to and including the line break after `end_header` (the whole file
