@@ -15,6 +15,11 @@
 //!
 //! MPairs holds each active body's cheapest partners, yet pops the global minimum ([`mpairs`]).
 //! [`group_within`] stops at a [`Budget`] with [`Stopped`], after the unlimited run's first merges.
+//!
+//! Called from a thread outside the rayon pool, a run whose observer ignores every event goes in
+//! one piece to one of the pool's threads (from 1,024 primitives), and the partitioned schedule
+//! runs its split and subproblems there whatever the observer; events are always delivered on
+//! the caller's thread.
 
 mod cluster;
 

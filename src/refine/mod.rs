@@ -111,7 +111,9 @@ pub struct Refined {
 /// - interior nodes whose leaf set changed take their box diagonal as diameter (the AABB
 ///   p-set's measure); the others keep the input's;
 /// - a tree whose root box has no area (all primitives in one point, or on one line) has
-///   nothing to gain and is returned unchanged.
+///   nothing to gain and is returned unchanged;
+/// - called from a thread outside the rayon pool with an observer that ignores every event, a
+///   run with parallel searches goes in one piece to one of the pool's threads.
 pub fn refine<O: Observer>(tree: &SubsetTree, params: &RefineParams, observer: O) -> Refined {
     refine_tuned(tree, params, &Tuning::default(), observer)
 }
