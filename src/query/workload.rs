@@ -236,17 +236,44 @@ impl FirstCapped {
         self.0.load(Ordering::Relaxed) >= i
     }
 
-    /// Notes that query `i` was capped.
-    fn capped(&self, i: usize) {
-        self.0.fetch_min(i, Ordering::Relaxed);
+    /// Runs query `i` of the set into fresh counts, timed, noting whether it was capped.
+    fn run<T>(&self, i: usize, query: impl FnOnce(&mut Counts) -> T) -> (Counts, f64, T) {
+        let (mut c, start) = (Counts::default(), Instant::now());
+        let answer = query(&mut c);
+        if c.capped > 0 {
+            self.0.fetch_min(i, Ordering::Relaxed);
+        }
+        (c, start.elapsed().as_secs_f64(), answer)
     }
 }
 
 /// What one pose of the workload measured: its distance and overlap queries (`None`: not run),
-/// each with its tests and seconds.
+/// each with its tests, seconds and (overlap) answer.
 struct PoseResult {
-    distance: Option<(Counts, f64)>,
+    distance: Option<(Counts, f64, ())>,
     overlap: Option<(Counts, f64, bool)>,
+}
+
+/// A set's queries summed in workload order, as the one-by-one run counts them: after its first
+/// capped query, each counts as capped, with no tests.
+#[derive(Default)]
+struct InOrder {
+    counts: Counts,
+    seconds: f64,
+}
+
+impl InOrder {
+    /// Adds the next query of the set (`None`: not run); returns its answer if it counts.
+    fn push<T>(&mut self, r: Option<(Counts, f64, T)>) -> Option<T> {
+        if self.counts.capped > 0 {
+            self.counts.capped += 1;
+            return None;
+        }
+        let (c, secs, answer) = r.expect("every query before a set's first capped one ran");
+        self.counts.add(&c);
+        self.seconds += secs;
+        Some(answer)
+    }
 }
 
 /// [`measure`] that checks `stop` before each query (Err: [`Interrupted`]).
@@ -259,7 +286,7 @@ pub fn measure_until(
 ) -> Result<QueryCost, Interrupted> {
     let h = Hierarchy { tree, scene, bv };
     let first = FirstCapped::new();
-    let each: Vec<Option<(Counts, f64)>> = workload
+    let each: Vec<Option<(Counts, f64, ())>> = workload
         .points
         .par_iter()
         .enumerate()
@@ -267,27 +294,17 @@ pub fn measure_until(
             if !first.open(i) || stop.is_requested() {
                 return None;
             }
-            let (mut c, start) = (Counts::default(), Instant::now());
-            point_distance_within(&h, p, workload.max_tests, &mut c);
-            if c.capped > 0 {
-                first.capped(i);
-            }
-            Some((c, start.elapsed().as_secs_f64()))
+            Some(first.run(i, |c| {
+                point_distance_within(&h, p, workload.max_tests, c);
+            }))
         })
         .collect();
     stop.check()?;
-    let mut counts = Counts::default();
-    let mut point_s = 0.0;
+    let mut points = InOrder::default();
     for r in each {
-        if counts.capped > 0 {
-            counts.capped += 1;
-        } else {
-            let (c, secs) = r.expect("every query before the first capped one ran");
-            counts.add(&c);
-            point_s += secs;
-        }
+        points.push(r);
     }
-    let point = MeanCost::new(&counts, workload.points.len(), point_s);
+    let point = MeanCost::new(&points.counts, workload.points.len(), points.seconds);
     let near = workload.poses_near.iter().map(|p| (p, true));
     let poses: Vec<_> = near
         .chain(workload.poses_touching.iter().map(|p| (p, false)))
@@ -322,58 +339,35 @@ pub fn measure_until(
                 bv: bv2,
             };
             let distance = run_dist.then(|| {
-                let (mut c, start) = (Counts::default(), Instant::now());
-                scene_distance_within(&h, &copy, workload.max_tests, &mut c);
-                if c.capped > 0 {
-                    first_dist.capped(i);
-                }
-                (c, start.elapsed().as_secs_f64())
+                first_dist.run(i, |c| {
+                    scene_distance_within(&h, &copy, workload.max_tests, c);
+                })
             });
-            let overlap = run_over.then(|| {
-                let (mut c, start) = (Counts::default(), Instant::now());
-                let hit = overlap_within(&h, &copy, workload.max_tests, &mut c);
-                if c.capped > 0 {
-                    over_set.capped(i);
-                }
-                (c, start.elapsed().as_secs_f64(), hit)
-            });
+            let overlap = run_over
+                .then(|| over_set.run(i, |c| overlap_within(&h, &copy, workload.max_tests, c)));
             PoseResult { distance, overlap }
         })
         .collect();
     stop.check()?;
-    // The order of the one-by-one run: a set's queries after its first capped one count as
-    // capped, with no tests.
-    let (mut dist, mut over) = (Counts::default(), Counts::default());
-    let (mut dist_s, mut over_s, mut overlapping) = (0.0, 0.0, 0);
-    let mut over_capped = [false; 2];
+    // The distances, then the overlaps of near and of touching poses, each set in its order.
+    let (mut dist, mut over) = (InOrder::default(), [InOrder::default(), InOrder::default()]);
+    let mut overlapping = 0;
     for (&(_, is_near), r) in poses.iter().zip(each) {
         if is_near {
-            if dist.capped > 0 {
-                dist.capped += 1;
-            } else {
-                let (c, secs) = r.distance.expect("run: no distance before it was capped");
-                dist.add(&c);
-                dist_s += secs;
-            }
+            dist.push(r.distance);
         }
-        if over_capped[usize::from(is_near)] {
-            over.capped += 1;
-        } else {
-            let (c, secs, hit) = r.overlap.expect("run: no overlap before it was capped");
-            over.add(&c);
-            over_s += secs;
-            overlapping += usize::from(hit);
-            if c.capped > 0 {
-                over_capped[usize::from(is_near)] = true;
-            }
-        }
+        let hit = over[usize::from(is_near)].push(r.overlap);
+        overlapping += usize::from(hit == Some(true));
     }
+    let mut over_counts = over[0].counts;
+    over_counts.add(&over[1].counts);
+    let over_s = over[0].seconds + over[1].seconds;
     let n_pose = workload.poses_near.len() + workload.poses_touching.len();
     Ok(QueryCost {
         point,
-        distance: MeanCost::new(&dist, workload.poses_near.len(), dist_s),
-        overlap: MeanCost::new(&over, n_pose, over_s),
+        distance: MeanCost::new(&dist.counts, workload.poses_near.len(), dist.seconds),
+        overlap: MeanCost::new(&over_counts, n_pose, over_s),
         overlapping,
-        seconds: point.seconds + dist_s + over_s,
+        seconds: point.seconds + dist.seconds + over_s,
     })
 }
