@@ -79,12 +79,12 @@ fn literal(boxes: &[Aabb], p: &ResolvedParams) -> (Vec<[u32; 2]>, Vec<u64>) {
     (merges, pairs)
 }
 
-/// 300 right triangles with legs 0.05 on a 0.2 grid (so DLimit0, their median diameter, makes
-/// voxels of about 0.088) and 250 with legs 0.0005 at seeded places in a 0.01 cube inside one
+/// `grid` right triangles with legs 0.05 on a 0.2 grid (so DLimit0, their median diameter, makes
+/// voxels of about 0.088) and `tiny` with legs 0.0005 at seeded places in a 0.01 cube inside one
 /// voxel.
-fn crowded() -> Scene {
+fn crowded(grid: usize, tiny: usize) -> Scene {
     let mut corners: Vec<([f64; 3], f64)> = Vec::new();
-    for i in 0..300 {
+    for i in 0..grid {
         corners.push(([(i % 20) as f64 * 0.2, (i / 20) as f64 * 0.2, 0.0], 0.05));
     }
     let mut state = 0x2545_f491_4f6c_dd1du64;
@@ -94,7 +94,7 @@ fn crowded() -> Scene {
         state ^= state << 17;
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
-    for _ in 0..250 {
+    for _ in 0..tiny {
         let c = [0.1 + 0.01 * next(), 0.1 + 0.01 * next(), 0.01 * next()];
         corners.push((c, 0.0005));
     }
@@ -115,14 +115,9 @@ fn crowded() -> Scene {
     s
 }
 
-#[test]
-fn crowded_voxels_give_the_literal_merges_on_1_and_2_threads() {
-    let scene = crowded();
-    let params = Params::default();
-    let resolved = params.resolve(&scene);
-    let boxes: Vec<Aabb> = (0..scene.len()).map(|i| scene.prim_aabb(i)).collect();
-    // Round 0's voxels (edge DLimit0 + GLimit0 from the active boxes' lowest corner) are
-    // crowded: more than 64 voxel-mates per active body on average.
+/// Whether round 0's voxels (edge DLimit0 + GLimit0 from the active boxes' lowest corner) are
+/// crowded: more than 64 voxel-mates per active body on average.
+fn crowded_round(boxes: &[Aabb], resolved: &ResolvedParams) -> bool {
     let csize = resolved.dlimit0 + resolved.glimit0;
     let active: Vec<&Aabb> = boxes
         .iter()
@@ -136,19 +131,22 @@ fn crowded_voxels_give_the_literal_merges_on_1_and_2_threads() {
         *voxels.entry(v).or_insert(0usize) += 1;
     }
     let mates: usize = voxels.values().map(|n| n * n).sum();
-    assert!(
-        mates > 64 * active.len(),
-        "{mates} voxel-mates for {}",
-        active.len()
-    );
+    mates > 64 * active.len()
+}
+
+/// The merges and each round's eligible pairs of `scene` are the literal run's on 1 and 2 threads.
+fn check_literal(scene: &Scene) {
+    let params = Params::default();
+    let resolved = params.resolve(scene);
+    let boxes: Vec<Aabb> = (0..scene.len()).map(|i| scene.prim_aabb(i)).collect();
     let (want, pairs) = literal(&boxes, &resolved);
     for threads in [1, 2] {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap();
-        let (g, log) = pool.install(|| common::run(&scene, &params));
-        common::check_tree(&scene, &g, &log);
+        let (g, log) = pool.install(|| common::run(scene, &params));
+        common::check_tree(scene, &g, &log);
         let got: Vec<[u32; 2]> = log.merges.iter().map(|m| [m.a, m.b]).collect();
         assert_eq!(got.len(), want.len());
         for (i, (g, w)) in got.iter().zip(&want).enumerate() {
@@ -160,4 +158,24 @@ fn crowded_voxels_give_the_literal_merges_on_1_and_2_threads() {
             "eligible pairs per round on {threads} threads"
         );
     }
+}
+
+#[test]
+fn crowded_voxels_give_the_literal_merges_on_1_and_2_threads() {
+    let scene = crowded(300, 250);
+    let params = Params::default();
+    let boxes: Vec<Aabb> = (0..scene.len()).map(|i| scene.prim_aabb(i)).collect();
+    assert!(crowded_round(&boxes, &params.resolve(&scene)));
+    check_literal(&scene);
+}
+
+#[test]
+fn one_crowded_voxel_in_a_sparse_round_gives_the_literal_merges() {
+    // 90 tiny triangles in one voxel: its records are cut into blocks (searched block by block
+    // and scanned run by run at the round start), in a round that is not crowded overall.
+    let scene = crowded(400, 90);
+    let params = Params::default();
+    let boxes: Vec<Aabb> = (0..scene.len()).map(|i| scene.prim_aabb(i)).collect();
+    assert!(!crowded_round(&boxes, &params.resolve(&scene)));
+    check_literal(&scene);
 }

@@ -113,6 +113,8 @@ struct Clusterer<P, O> {
     quick: bool,
     /// The last AABB partner search, reused while the voxel hash is unchanged.
     memo: Option<scan::Memo>,
+    /// A single search's Cost bounds of a crowded cell's blocks (kept for its allocation).
+    items: Vec<(f64, u32)>,
     stats: Stats,
 }
 
@@ -174,6 +176,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                 && finite
                 && (0..3).all(|k| bounds.min[k].abs() < 1e100 && bounds.max[k].abs() < 1e100),
             memo: None,
+            items: Vec::new(),
             stats: Stats::default(),
         }
     }

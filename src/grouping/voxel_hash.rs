@@ -8,9 +8,13 @@
 //! out in the order the bodies were inserted (Morton order at round start), with slack for the
 //! bodies made during the round; a full cell moves to the end of the arena with twice the room.
 //! Removal swaps the body with its cell's last record (O(1), the arena position of every body is
-//! kept). At build each cell's records are sorted by their boxes' smallest x, so the round-start
-//! scan can stop early in a cell; insertions append after them and a removal keeps the order only
-//! of the records before its place ([`VoxelHash::sorted_len`]). Each
+//! kept). At build each cell's records are laid out in sorted runs: a cell of fewer than
+//! [`BLOCKED_MIN`] records is one run, sorted by the boxes' smallest x; a larger one is cut into
+//! blocks of at most [`BLOCK`] records with nearby centres (median splits of the centres on their
+//! widest axis), each sorted by smallest x and with its own bounds ([`VoxelHash::block_bounds`]),
+//! so a search can bound the Cost of a block's bodies and skip it, as it skips cells. The
+//! round-start scan stops early in each run; insertions append after the runs and a removal
+//! keeps the order only of the records before its place ([`VoxelHash::sorted_len`]). Each
 //! cell also keeps the union of the boxes, the largest box minimum and smallest box maximum
 //! corner, and the largest and smallest diameter ever stored in it this round, so callers can
 //! bound the Cost of any pair with a body of that cell.
@@ -75,6 +79,11 @@ const NO_CELL: u32 = u32::MAX;
 pub const DEAD: u32 = u32::MAX;
 /// Cells of at least this many records keep their sorted records in order when one is removed.
 const KEEP_ORDER: u32 = 32;
+/// The most records in a block of a cell's sorted runs.
+pub const BLOCK: usize = 16;
+/// Cells of at least this many records are cut into blocks (at least [`KEEP_ORDER`], so a
+/// removal leaves the blocks in place).
+pub const BLOCKED_MIN: usize = 32;
 const BLANK: Rec = Rec {
     aabb: Aabb::EMPTY,
     diameter: 0.0,
@@ -96,6 +105,10 @@ pub struct VoxelHash {
     dead: Vec<u32>,
     coords: Vec<[i64; 3]>,
     recs: Vec<Rec>,
+    /// Each cell's first block in `block_bounds` and its number of blocks (0: one run).
+    blocks: Vec<(u32, u32)>,
+    /// The bounds of every block, for the boxes stored in it when it was made.
+    block_bounds: Vec<CellBounds>,
     /// Arena position and cell of every body id (valid while the body is stored).
     at: Vec<(u32, u32)>,
     /// Bumped by every build, insertion and removal.
@@ -114,6 +127,8 @@ impl Default for VoxelHash {
             dead: Vec::new(),
             coords: Vec::new(),
             recs: Vec::new(),
+            blocks: Vec::new(),
+            block_bounds: Vec::new(),
             at: Vec::new(),
             version: 0,
         }
@@ -145,6 +160,8 @@ impl VoxelHash {
         self.dead.clear();
         self.coords.clear();
         self.recs.clear();
+        self.blocks.clear();
+        self.block_bounds.clear();
         self.sparse.clear();
         self.at.resize(ids, (0, NO_CELL));
         self.dims = None;
@@ -185,14 +202,39 @@ impl VoxelHash {
                 },
             );
         }
-        for cell in &mut self.cells {
-            let (s, e) = (cell.start as usize, (cell.start + cell.len) as usize);
-            let recs = &mut self.recs[s..e];
-            recs.sort_unstable_by(|a, b| a.aabb.min.x.total_cmp(&b.aabb.min.x));
-            for (i, r) in recs.iter().enumerate() {
-                self.at[r.id as usize].0 = (s + i) as u32;
+        for c in 0..self.cells.len() as u32 {
+            let len = self.cells[c as usize].len;
+            self.lay_out(c, len);
+        }
+    }
+
+    /// Lays out the first `len` records of cell `c` (none of them [`DEAD`]) in sorted runs
+    /// (module doc), updates their arena positions, and makes them the cell's sorted head.
+    fn lay_out(&mut self, c: u32, len: u32) {
+        let cell = &mut self.cells[c as usize];
+        let s = cell.start as usize;
+        cell.sorted = len;
+        let recs = &mut self.recs[s..s + len as usize];
+        let by_x = |a: &Rec, b: &Rec| a.aabb.min.x.total_cmp(&b.aabb.min.x);
+        if recs.len() < BLOCKED_MIN {
+            recs.sort_unstable_by(by_x);
+            self.blocks[c as usize] = (0, 0);
+        } else {
+            split_blocks(recs);
+            let first = self.block_bounds.len() as u32;
+            for block in recs.chunks_mut(BLOCK) {
+                block.sort_unstable_by(by_x);
+                let mut b = EMPTY_BOUNDS;
+                for r in block.iter() {
+                    grow(&mut b, &r.aabb, r.diameter);
+                }
+                self.block_bounds.push(b);
             }
-            cell.sorted = cell.len;
+            let n = self.block_bounds.len() as u32 - first;
+            self.blocks[c as usize] = (first, n);
+        }
+        for (i, r) in recs.iter().enumerate() {
+            self.at[r.id as usize].0 = (s + i) as u32;
         }
     }
 
@@ -244,6 +286,7 @@ impl VoxelHash {
             bounds: EMPTY_BOUNDS,
         });
         self.dead.push(0);
+        self.blocks.push((0, 0));
         self.coords.push(v);
         c
     }
@@ -271,15 +314,7 @@ impl VoxelHash {
         cell.len += 1;
         self.recs[i] = rec;
         self.at[id as usize] = (i as u32, c);
-        let b = &mut self.cells[c as usize].bounds;
-        for k in 0..3 {
-            b.union.min[k] = b.union.min[k].min(aabb.min[k]);
-            b.union.max[k] = b.union.max[k].max(aabb.max[k]);
-            b.max_lo[k] = b.max_lo[k].max(aabb.min[k]);
-            b.min_hi[k] = b.min_hi[k].min(aabb.max[k]);
-        }
-        b.dmax = b.dmax.max(diameter);
-        b.dmin = b.dmin.min(diameter);
+        grow(&mut self.cells[c as usize].bounds, aabb, diameter);
     }
 
     /// Adds body `id` (partner-list slot `slot`) by the centre of its box.
@@ -342,19 +377,19 @@ impl VoxelHash {
         }
         let s = cell.start as usize;
         let recs = &mut self.recs[s..s + cell.len as usize];
-        recs.sort_unstable_by(|a, b| {
-            (a.id == DEAD)
-                .cmp(&(b.id == DEAD))
-                .then(a.aabb.min.x.total_cmp(&b.aabb.min.x))
-        });
-        let live = cell.len - self.dead[c as usize];
-        for (i, r) in recs[..live as usize].iter().enumerate() {
-            self.at[r.id as usize].0 = (s + i) as u32;
+        // The live records first, in their order (a stable partition).
+        let mut live = 0;
+        for i in 0..recs.len() {
+            if recs[i].id != DEAD {
+                recs[live] = recs[i];
+                live += 1;
+            }
         }
-        recs[live as usize..].fill(BLANK);
+        recs[live..].fill(BLANK);
+        let live = live as u32;
         cell.len = live;
-        cell.sorted = live;
         self.dead[c as usize] = 0;
+        self.lay_out(c, live);
     }
 
     /// A number that changes whenever the stored bodies or the voxel edge change.
@@ -376,12 +411,58 @@ impl VoxelHash {
         &self.recs[cell.start as usize..(cell.start + cell.len) as usize]
     }
 
-    /// How many leading records of cell `c` ([`VoxelHash::recs`]) are sorted by their boxes'
-    /// smallest x: all of them after a build, then those before the first removal's place
-    /// (insertions append after them).
+    /// How many leading records of cell `c` ([`VoxelHash::recs`]) are in their sorted runs:
+    /// all of them after a build, then those before the first removal's place (insertions
+    /// append after them).
     #[inline]
     pub fn sorted_len(&self, c: u32) -> usize {
         self.cells[c as usize].sorted as usize
+    }
+
+    /// The bounds of cell `c`'s blocks (empty when its sorted head is one run); block `j` holds
+    /// the records `j·BLOCK..(j + 1)·BLOCK` of the cell, cut at [`VoxelHash::sorted_len`].
+    #[inline]
+    pub fn block_bounds(&self, c: u32) -> &[CellBounds] {
+        let (first, n) = self.blocks[c as usize];
+        &self.block_bounds[first as usize..(first + n) as usize]
+    }
+
+    /// The records in each of cell `c`'s sorted runs (a block, or the whole sorted head of an
+    /// unblocked cell): [`BLOCK`] or the head's length.
+    #[inline]
+    pub fn run_size(&self, c: u32) -> usize {
+        if self.blocks[c as usize].1 == 0 {
+            self.sorted_len(c).max(1)
+        } else {
+            BLOCK
+        }
+    }
+
+    /// The sorted runs of cell `c`'s head from position `from` of [`VoxelHash::recs`] on (the
+    /// rest of `from`'s run, then the later runs), each sorted by the boxes' smallest x, with
+    /// the position of its first record.
+    #[inline]
+    pub fn runs_from(&self, c: u32, from: usize) -> impl Iterator<Item = (usize, &[Rec])> {
+        let head = &self.recs(c)[..self.sorted_len(c)];
+        let size = self.run_size(c);
+        let from = from.min(head.len());
+        let end = ((from / size + 1) * size).min(head.len());
+        let rest = head[end..]
+            .chunks(size)
+            .enumerate()
+            .map(move |(k, r)| (end + k * size, r));
+        std::iter::once((from, &head[from..end])).chain(rest)
+    }
+
+    /// The sorted runs of cell `c`'s head, each with the bounds of the boxes stored in it: a
+    /// block's own, or the cell's for an unblocked cell's one run.
+    #[inline]
+    pub fn bounded_runs(&self, c: u32) -> impl Iterator<Item = (&[Rec], &CellBounds)> {
+        let blocks = self.block_bounds(c);
+        let cell = self.bounds(c);
+        self.runs_from(c, 0)
+            .enumerate()
+            .map(move |(j, (_, r))| (r, blocks.get(j).unwrap_or(cell)))
     }
 
     /// Asks the CPU to start loading the first records of cell `c` (a no-op off x86-64), so a
@@ -432,6 +513,43 @@ impl VoxelHash {
     }
 }
 
+/// Adds a box of diameter `diameter` to the bounds `b`.
+#[inline]
+fn grow(b: &mut CellBounds, aabb: &Aabb, diameter: f64) {
+    for k in 0..3 {
+        b.union.min[k] = b.union.min[k].min(aabb.min[k]);
+        b.union.max[k] = b.union.max[k].max(aabb.max[k]);
+        b.max_lo[k] = b.max_lo[k].max(aabb.min[k]);
+        b.min_hi[k] = b.min_hi[k].min(aabb.max[k]);
+    }
+    b.dmax = b.dmax.max(diameter);
+    b.dmin = b.dmin.min(diameter);
+}
+
+/// Orders `recs` so that each run of [`BLOCK`] records (from the start) holds nearby centres:
+/// the records are split at a multiple of `BLOCK` near their middle by the centres on their
+/// widest axis (ties by id), and each side likewise, until a side fits in one block.
+fn split_blocks(recs: &mut [Rec]) {
+    if recs.len() <= BLOCK {
+        return;
+    }
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for r in recs.iter() {
+        let c = r.aabb.center();
+        for k in 0..3 {
+            lo[k] = lo[k].min(c[k]);
+            hi[k] = hi[k].max(c[k]);
+        }
+    }
+    let axis = (0..3).fold(0, |a, k| if hi[k] - lo[k] > hi[a] - lo[a] { k } else { a });
+    let mid = (recs.len() / 2 + BLOCK / 2) / BLOCK * BLOCK;
+    let key = |r: &Rec| r.aabb.min[axis] + r.aabb.max[axis];
+    recs.select_nth_unstable_by(mid, |a, b| key(a).total_cmp(&key(b)).then(a.id.cmp(&b.id)));
+    let (left, right) = recs.split_at_mut(mid);
+    split_blocks(left);
+    split_blocks(right);
+}
+
 /// `v.floor() as i64` without a libm call (baseline x86-64 has no rounding instruction); NaN
 /// gives 0 and out-of-range values saturate, like the cast.
 #[inline(always)]
@@ -457,4 +575,77 @@ pub(crate) fn prefetch<T>(x: &T) {
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = x;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    /// Every stored body is found at its arena position; every block of a cell's sorted head
+    /// is sorted by smallest x and within its bounds.
+    fn check(hash: &VoxelHash, stored: &[u32]) {
+        for &id in stored {
+            let (i, c) = hash.at[id as usize];
+            assert_eq!(hash.recs[i as usize].id, id);
+            assert!(hash.recs(c).iter().any(|r| r.id == id));
+        }
+        for c in 0..hash.cells() {
+            let blocks = hash.block_bounds(c);
+            for (j, (run, b)) in hash.bounded_runs(c).enumerate() {
+                assert!(run.is_sorted_by(|a, b| a.aabb.min.x <= b.aabb.min.x));
+                assert!(std::ptr::eq(b, blocks.get(j).unwrap_or(hash.bounds(c))));
+                for r in run.iter().filter(|r| r.id != DEAD) {
+                    for k in 0..3 {
+                        assert!(b.union.min[k] <= r.aabb.min[k] && r.aabb.max[k] <= b.union.max[k]);
+                        assert!(r.aabb.min[k] <= b.max_lo[k] && b.min_hi[k] <= r.aabb.max[k]);
+                    }
+                    assert!(b.dmin <= r.diameter && r.diameter <= b.dmax);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_crowded_cell_is_cut_into_sorted_blocks_that_stay_valid_through_removals() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let n = 300;
+        let mut boxes: Vec<Aabb> = (0..n)
+            .map(|_| {
+                let c = P3::new(rng.random(), rng.random(), rng.random());
+                let h = rng.random_range(0.001..0.05);
+                Aabb {
+                    min: c - crate::geom::V3::repeat(h),
+                    max: c + crate::geom::V3::repeat(h),
+                }
+            })
+            .collect();
+        let diameters: Vec<f64> = boxes.iter().map(Aabb::diameter).collect();
+        let ids: Vec<u32> = (0..n as u32).collect();
+        let slots = ids.clone();
+        let mut hash = VoxelHash::default();
+        // One voxel holds every centre.
+        hash.build(2.0, &ids, &boxes, &diameters, &slots, 2 * n);
+        assert_eq!(hash.cells(), 1);
+        assert_eq!(hash.block_bounds(0).len(), n.div_ceil(BLOCK));
+        check(&hash, &ids);
+        // The blocks hold nearby centres: their boxes span less than the cell's.
+        let spread = |b: &CellBounds| (0..3).map(|k| b.union.max[k] - b.union.min[k]).sum::<f64>();
+        let blocks = hash.block_bounds(0);
+        let mean = blocks.iter().map(spread).sum::<f64>() / blocks.len() as f64;
+        assert!(mean < 0.6 * spread(hash.bounds(0)), "{mean}");
+        // Remove two thirds and add merged bodies: the blocks and the tail stay consistent.
+        let mut stored: Vec<u32> = ids.clone();
+        for round in 0..100u32 {
+            let (a, b) = (stored.remove(0), stored.remove(0));
+            hash.remove(a);
+            hash.remove(b);
+            let merged = boxes[a as usize].merge(&boxes[b as usize]);
+            let new = n as u32 + round;
+            boxes.push(merged);
+            hash.insert(new, &merged, merged.diameter(), new);
+            stored.push(new);
+            check(&hash, &stored);
+        }
+    }
 }

@@ -6,11 +6,12 @@
 //! counts only if the union of its boxes is within GLimit ([`reachable`]). For the AABB p-set,
 //! the round-start scan visits each pair of cells once (`pairs_once`), and a single search
 //! visits cells cheapest Cost bound first ([`cost_bound`]) and stops when no cell can improve
-//! its list, which is still exactly the first partners in key order (`scan_pruned`); in a cell
-//! whose records are sorted by smallest x it reads them outward from the searcher and stops each
-//! way at the first record no pair with could enter the list. Where the round's cells are
+//! its list, which is still exactly the first partners in key order (`scan_pruned`). A cell cut
+//! into blocks is read block by block, cheapest block bound first, and in a run of records sorted
+//! by smallest x a search reads them outward from the searcher and stops each way at the first
+//! record no pair with could enter the list. Where the round's cells are
 //! crowded ([`CROWDED`]), the round-start scan runs that search for each body instead and counts
-//! the eligible pairs apart (`count_pairs`). Other p-sets search every candidate for the first
+//! the eligible pairs apart (`count_pairs`, a pair of blocks at once where it can). Other p-sets search every candidate for the first
 //! partners (`scan_all`). A search after a merge by a body identical to the last searcher (same
 //! box, diameter and p-set body, the voxel hash unchanged) reuses its result ([`Memo`]).
 //!
@@ -24,7 +25,7 @@ use crate::events::Observer;
 use crate::geom::surface_area;
 use crate::geom::{Aabb, P3, V3};
 use crate::grouping::mpairs::{K_MAX, Top};
-use crate::grouping::voxel_hash::{CellBounds, DEAD, Rec};
+use crate::grouping::voxel_hash::{BLOCK, CellBounds, DEAD, Rec, VoxelHash};
 use crate::grouping::{CostMeasure, Weights};
 
 /// The last search after a merge: its searcher, the bits of the searcher's box and diameter
@@ -229,6 +230,51 @@ fn count_near(xa: &Aabb, recs: &[Rec], g: f64) -> (u64, u64) {
     (near as u64, end as u64)
 }
 
+/// Sorts a few bounds ascending (insertion sort: at most 27 cells, or a cell's blocks).
+#[inline]
+fn insertion_sort<T: Copy>(v: &mut [(f64, T)]) {
+    for i in 1..v.len() {
+        let mut j = i;
+        while j > 0 && v[j].0 < v[j - 1].0 {
+            v.swap(j, j - 1);
+            j -= 1;
+        }
+    }
+}
+
+/// What an item of a single search reads of its cell.
+#[derive(Clone, Copy, Debug)]
+enum Part {
+    /// Every record.
+    All,
+    /// One block of the sorted head.
+    Block(u32),
+    /// The records after the sorted head.
+    Tail,
+}
+
+/// Adds to `pairs` the number of eligible pairs of a record of sorted run `a` with one of sorted
+/// run `b` (fresh, finite boxes, GLimit `g` ≥ 0), each run with the bounds of its boxes: the
+/// product of their sizes when every two boxes are within `g`, none when their unions are apart,
+/// else counted record by record (those read added to `candidates`).
+fn count_across(
+    (a, ab): (&[Rec], &CellBounds),
+    (b, bb): (&[Rec], &CellBounds),
+    g: f64,
+    pairs: &mut u64,
+    candidates: &mut u64,
+) {
+    if within(ab, bb, g) {
+        *pairs += (a.len() * b.len()) as u64;
+    } else if !apart(&ab.union, &bb.union, g) {
+        for x in a {
+            let (m, seen) = count_near(&x.aabb, b, g);
+            *pairs += m;
+            *candidates += seen;
+        }
+    }
+}
+
 /// What a single search offers each record with.
 struct Searcher<'t> {
     xa: Aabb,
@@ -260,6 +306,68 @@ impl Searcher<'_> {
         let cost = pair_cost::<A>(&self.w, d, sx, sy);
         list.offer(self.wide, cost, r.id, self.tags);
         list.bar(self.wide)
+    }
+}
+
+impl Searcher<'_> {
+    /// Offers the records of `part` of `cell` to `list`, counting them into `candidates`;
+    /// a sorted run of at least [`SWEEP_MIN`] records is read outward from the searcher and
+    /// left each way at the first record no pair with could enter the list.
+    #[inline(always)]
+    fn read<const A: u8>(
+        &self,
+        hash: &VoxelHash,
+        cell: u32,
+        part: Part,
+        list: &mut Top<{ K_MAX + 1 }>,
+        candidates: &mut u64,
+    ) {
+        let xa = &self.xa;
+        let mut bar = list.bar(self.wide);
+        let recs = hash.recs(cell);
+        let sorted = hash.sorted_len(cell);
+        let (head, tail, dmax) = match part {
+            Part::All => (&recs[..sorted], &recs[sorted..], hash.bounds(cell).dmax),
+            Part::Tail => (&recs[..0], &recs[sorted..], 0.0),
+            Part::Block(j) => {
+                let j = j as usize;
+                let end = ((j + 1) * BLOCK).min(sorted);
+                let dmax = hash.block_bounds(cell)[j].dmax;
+                (&recs[j * BLOCK..end], &recs[..0], dmax)
+            }
+        };
+        let (swept, rest) = match self.quick {
+            Some(q) if head.len() >= SWEEP_MIN && self.dx > 0.0 => {
+                // Outward from `x`'s smallest x: the merged box's x extent is at least the
+                // distance between the two smallest x (rightward) or from the other's smallest
+                // x to `x`'s largest (leftward), and grows with each step, so a direction ends
+                // at the first record beyond the bar.
+                let at = head.partition_point(|r| r.aabb.min.x < xa.min.x);
+                for r in &head[at..] {
+                    let s = r.aabb.min.x - xa.min.x;
+                    if q.beyond_all(s * s, self.dx, dmax, bar) {
+                        break;
+                    }
+                    *candidates += 1;
+                    bar = self.visit::<A>(r, bar, list);
+                }
+                for r in head[..at].iter().rev() {
+                    let s = xa.max.x - r.aabb.min.x;
+                    if q.beyond_all(s * s, self.dx, dmax, bar) {
+                        break;
+                    }
+                    *candidates += 1;
+                    bar = self.visit::<A>(r, bar, list);
+                }
+                (true, tail)
+            }
+            _ => (false, tail),
+        };
+        let unswept = if swept { &head[..0] } else { head };
+        for r in unswept.iter().chain(rest) {
+            *candidates += 1;
+            bar = self.visit::<A>(r, bar, list);
+        }
     }
 }
 
@@ -372,21 +480,30 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             if within(hash.bounds(c), hash.bounds(c), glimit) {
                 pairs += n * n.saturating_sub(1) / 2;
             } else {
-                for (i, x) in recs.iter().enumerate() {
-                    let (m, seen) = count_near(&x.aabb, &recs[i + 1..], glimit);
-                    pairs += m;
-                    candidates += seen;
+                for (i, (a, ab)) in hash.bounded_runs(c).enumerate() {
+                    let m = a.len() as u64;
+                    if within(ab, ab, glimit) {
+                        pairs += m * m.saturating_sub(1) / 2;
+                    } else {
+                        for (j, x) in a.iter().enumerate() {
+                            let (m, seen) = count_near(&x.aabb, &a[j + 1..], glimit);
+                            pairs += m;
+                            candidates += seen;
+                        }
+                    }
+                    for (b, bb) in hash.bounded_runs(c).skip(i + 1) {
+                        count_across((a, ab), (b, bb), glimit, &mut pairs, &mut candidates);
+                    }
                 }
             }
             for &cell in &near {
-                let other = hash.recs(cell);
                 if within(hash.bounds(c), hash.bounds(cell), glimit) {
-                    pairs += n * other.len() as u64;
+                    pairs += n * hash.recs(cell).len() as u64;
                 } else {
-                    for x in recs {
-                        let (m, seen) = count_near(&x.aabb, other, glimit);
-                        pairs += m;
-                        candidates += seen;
+                    for a in hash.bounded_runs(c) {
+                        for b in hash.bounded_runs(cell) {
+                            count_across(a, b, glimit, &mut pairs, &mut candidates);
+                        }
                     }
                 }
             }
@@ -490,10 +607,11 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                         .filter(|&cell| reachable(hash.bounds(cell), &xa, glimit)),
                 );
                 let (tags, partners) = (&self.tag, &mut self.partners);
-                let own = &hash.recs(c)[i + 1..];
-                for seg in std::iter::once(own).chain(fwd.iter().map(|&cell| hash.recs(cell))) {
+                let own = hash.runs_from(c, i + 1);
+                let later = fwd.iter().flat_map(|&cell| hash.runs_from(cell, 0));
+                for (_, seg) in own.chain(later) {
                     for yr in seg {
-                        // Fresh cells are sorted by smallest x: the rest are farther still.
+                        // Fresh runs are sorted by smallest x: the rest are farther still.
                         if finite && yr.aabb.min.x - xa.max.x > glimit {
                             break;
                         }
@@ -537,9 +655,6 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         let (lo, hi) = self.query(&xa, glimit);
         let area = self.params.mode.cost == CostMeasure::Area;
         let prune = self.prune && !area;
-        let mut cells: [(f64, u32); 64] = [(0.0, 0); 64];
-        let mut n = 0;
-        let mut overflow: Vec<(f64, u32)> = Vec::new();
         // Gather the voxels' cells first and start loading their bounds, so those cache misses
         // overlap instead of following one another.
         let mut ids = [0u32; 64];
@@ -554,6 +669,10 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                 more.push(cell);
             }
         });
+        // The reachable cells with a lower bound on the Cost of their pairs, cheapest first.
+        let mut cells: [(f64, u32); 64] = [(0.0, 0); 64];
+        let mut n = 0;
+        let mut overflow: Vec<(f64, u32)> = Vec::new();
         for &cell in ids[..m].iter().chain(&more) {
             let cb = hash.bounds(cell);
             if reachable(cb, &xa, glimit) {
@@ -571,28 +690,20 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                 }
             }
         }
+        let cells: &mut [(f64, u32)] = if overflow.is_empty() {
+            &mut cells[..n]
+        } else {
+            // Only reachable through rounding at voxel boundaries.
+            overflow.extend_from_slice(&cells);
+            &mut overflow
+        };
+        insertion_sort(cells);
+        let items = &mut self.items;
         // One more partner than a list holds, and `x` among the candidates (see [`Memo`]).
         let mut list = Top::<{ K_MAX + 1 }>::EMPTY;
         let wide = k + 1;
         let mut candidates = 0u64;
         let tags = &self.tag;
-        let cells: &mut [(f64, u32)] = if overflow.is_empty() {
-            let cells = &mut cells[..n];
-            // Insertion sort: at most 27 cells.
-            for i in 1..cells.len() {
-                let mut j = i;
-                while j > 0 && cells[j].0 < cells[j - 1].0 {
-                    cells.swap(j, j - 1);
-                    j -= 1;
-                }
-            }
-            cells
-        } else {
-            // Only reachable through rounding at voxel boundaries: visit everything, unsorted.
-            overflow.extend_from_slice(&cells);
-            overflow.iter_mut().for_each(|c| c.0 = f64::NEG_INFINITY);
-            &mut overflow
-        };
         let quick = Quick::new(&w, self.quick && !area);
         let me = Searcher {
             xa,
@@ -604,48 +715,44 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             wide,
             tags,
         };
-        let visit = |r: &Rec, bar: f64, list: &mut Top<{ K_MAX + 1 }>| me.visit::<A>(r, bar, list);
         for &(bound, cell) in cells.iter() {
-            let mut bar = list.bar(wide);
-            if bound > bar {
+            if bound > list.bar(wide) {
                 break;
             }
-            let recs = hash.recs(cell);
+            // A blocked cell is read block by block, cheapest bound first, each picked when the
+            // last is read (a search reads few of a crowded cell's blocks), then its tail.
+            let blocks = hash.block_bounds(cell);
             let sorted = hash.sorted_len(cell);
-            let (head, tail) = match quick {
-                Some(q) if sorted >= SWEEP_MIN && dx > 0.0 => {
-                    // The sorted head, outward from `x`'s smallest x: the merged box's x extent
-                    // is at least the distance between the two smallest x (rightward) or from
-                    // the other's smallest x to `x`'s largest (leftward), and grows with each
-                    // step, so a direction ends at the first record beyond the bar.
-                    let (head, tail) = recs.split_at(sorted);
-                    let dmax = hash.bounds(cell).dmax;
-                    let at = head.partition_point(|r| r.aabb.min.x < xa.min.x);
-                    for r in &head[at..] {
-                        let s = r.aabb.min.x - xa.min.x;
-                        if q.beyond_all(s * s, dx, dmax, bar) {
-                            break;
-                        }
-                        candidates += 1;
-                        bar = visit(r, bar, &mut list);
+            let last = if !prune || blocks.is_empty() {
+                Part::All
+            } else {
+                items.clear();
+                for (j, bb) in blocks.iter().enumerate() {
+                    if j * BLOCK < sorted && reachable(bb, &xa, glimit) {
+                        items.push((cost_bound::<A>(&w, &xa, dx, bb), j as u32));
                     }
-                    for r in head[..at].iter().rev() {
-                        let s = xa.max.x - r.aabb.min.x;
-                        if q.beyond_all(s * s, dx, dmax, bar) {
-                            break;
-                        }
-                        candidates += 1;
-                        bar = visit(r, bar, &mut list);
-                    }
-                    (head, tail)
                 }
-                _ => (&recs[..0], recs),
+                for i in 0..items.len() {
+                    let least = (i..items.len())
+                        .fold(i, |a, j| if items[j].0 < items[a].0 { j } else { a });
+                    items.swap(i, least);
+                    if items[i].0 > list.bar(wide) {
+                        break;
+                    }
+                    me.read::<A>(
+                        hash,
+                        cell,
+                        Part::Block(items[i].1),
+                        &mut list,
+                        &mut candidates,
+                    );
+                }
+                if sorted == hash.recs(cell).len() || bound > list.bar(wide) {
+                    continue;
+                }
+                Part::Tail
             };
-            debug_assert!(head.len() + tail.len() == recs.len());
-            for r in tail {
-                candidates += 1;
-                bar = visit(r, bar, &mut list);
-            }
+            me.read::<A>(hash, cell, last, &mut list, &mut candidates);
         }
         self.stats.candidates += candidates;
         *self.partners.get(x) = list.without(x, k);

@@ -139,10 +139,12 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                             .copied()
                             .filter(|&cell| reachable(hash.bounds(cell), &xa, glimit)),
                     );
-                    let own = (c, i + 1);
-                    let segs = fwd.iter().map(|&cell| (cell, 0));
-                    for (cell, from) in std::iter::once(own).chain(segs) {
-                        for (j, yr) in hash.recs(cell).iter().enumerate().skip(from) {
+                    let own = hash.runs_from(c, i + 1).map(|run| (c, run));
+                    let later = fwd
+                        .iter()
+                        .flat_map(|&cell| hash.runs_from(cell, 0).map(move |run| (cell, run)));
+                    for (cell, (at, seg)) in own.chain(later) {
+                        for (j, yr) in (at..).zip(seg) {
                             if finite && yr.aabb.min.x - xa.max.x > glimit {
                                 break;
                             }
