@@ -81,7 +81,7 @@ pub const DEAD: u32 = u32::MAX;
 const KEEP_ORDER: u32 = 32;
 /// The most records in a block of a cell's sorted runs.
 pub const BLOCK: usize = 16;
-/// Cells of at least this many records are cut into blocks (at least [`KEEP_ORDER`], so a
+/// Cells of at least this many records are cut into blocks (at least `KEEP_ORDER`, so a
 /// removal leaves the blocks in place).
 pub const BLOCKED_MIN: usize = 32;
 const BLANK: Rec = Rec {
