@@ -9,11 +9,12 @@
 //! its list, which is still exactly the first partners in key order (`scan_pruned`). A cell cut
 //! into blocks is read block by block, cheapest block bound first, and in a run of records sorted
 //! by smallest x a search reads them outward from the searcher and stops each way at the first
-//! record no pair with could enter the list. Where the round's cells are
-//! crowded ([`CROWDED`]), the round-start scan runs that search for each body instead and counts
-//! the eligible pairs apart (`count_pairs`, a pair of blocks at once where it can). Other p-sets search every candidate for the first
-//! partners (`scan_all`). A search after a merge by a body identical to the last searcher (same
-//! box, diameter and p-set body, the voxel hash unchanged) reuses its result ([`Memo`]).
+//! record no pair with could enter the list. Where the round's cells are crowded ([`CROWDED`]),
+//! the round-start scan runs that search for each body instead and counts the eligible pairs
+//! apart (`count_pairs`, a pair of blocks at once where it can). Other p-sets search every
+//! candidate for the first partners (`scan_all`). A search after a merge by a body identical to
+//! the last searcher (same box, diameter and p-set body, the voxel hash unchanged) reuses its
+//! result ([`Memo`]).
 //!
 //! With `--cost area` the bound and the `sqrt`-free filter ([`Quick`]) do not hold, so those
 //! searches visit every reachable cell (`docs/method.md`, "The Cost in surface area").
@@ -230,7 +231,7 @@ fn count_near(xa: &Aabb, recs: &[Rec], g: f64) -> (u64, u64) {
     (near as u64, end as u64)
 }
 
-/// Sorts a few bounds ascending (insertion sort: at most 27 cells, or a cell's blocks).
+/// Sorts a search's cells by Cost bound, ascending (insertion sort: 27 cells but for rounding).
 #[inline]
 fn insertion_sort<T: Copy>(v: &mut [(f64, T)]) {
     for i in 1..v.len() {
@@ -242,7 +243,7 @@ fn insertion_sort<T: Copy>(v: &mut [(f64, T)]) {
     }
 }
 
-/// What an item of a single search reads of its cell.
+/// The records of a cell that a single search reads in one go.
 #[derive(Clone, Copy, Debug)]
 enum Part {
     /// Every record.
