@@ -454,15 +454,21 @@ impl VoxelHash {
         std::iter::once((from, &head[from..end])).chain(rest)
     }
 
+    /// The sorted runs of cell `c`'s head, each sorted by the boxes' smallest x.
+    #[inline]
+    pub fn runs(&self, c: u32) -> std::slice::Chunks<'_, Rec> {
+        self.recs(c)[..self.sorted_len(c)].chunks(self.run_size(c))
+    }
+
     /// The sorted runs of cell `c`'s head, each with the bounds of the boxes stored in it: a
     /// block's own, or the cell's for an unblocked cell's one run.
     #[inline]
     pub fn bounded_runs(&self, c: u32) -> impl Iterator<Item = (&[Rec], &CellBounds)> {
         let blocks = self.block_bounds(c);
         let cell = self.bounds(c);
-        self.runs_from(c, 0)
+        self.runs(c)
             .enumerate()
-            .map(move |(j, (_, r))| (r, blocks.get(j).unwrap_or(cell)))
+            .map(move |(j, r)| (r, blocks.get(j).unwrap_or(cell)))
     }
 
     /// Asks the CPU to start loading the first records of cell `c` (a no-op off x86-64), so a

@@ -608,9 +608,9 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                         .filter(|&cell| reachable(hash.bounds(cell), &xa, glimit)),
                 );
                 let (tags, partners) = (&self.tag, &mut self.partners);
-                let own = hash.runs_from(c, i + 1);
-                let later = fwd.iter().flat_map(|&cell| hash.runs_from(cell, 0));
-                for (_, seg) in own.chain(later) {
+                let own = hash.runs_from(c, i + 1).map(|(_, run)| run);
+                let later = fwd.iter().flat_map(|&cell| hash.runs(cell));
+                for seg in own.chain(later) {
                     for yr in seg {
                         // Fresh runs are sorted by smallest x: the rest are farther still.
                         if finite && yr.aabb.min.x - xa.max.x > glimit {
