@@ -430,7 +430,7 @@ impl VoxelHash {
     /// The records in each of cell `c`'s sorted runs (a block, or the whole sorted head of an
     /// unblocked cell): [`BLOCK`] or the head's length.
     #[inline]
-    pub fn run_size(&self, c: u32) -> usize {
+    fn run_size(&self, c: u32) -> usize {
         if self.blocks[c as usize].1 == 0 {
             self.sorted_len(c).max(1)
         } else {

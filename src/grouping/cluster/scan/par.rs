@@ -140,13 +140,9 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                             .filter(|&cell| reachable(hash.bounds(cell), &xa, glimit)),
                     );
                     let own = hash.runs_from(c, i + 1).map(|run| (c, run));
-                    let later = fwd.iter().flat_map(|&cell| {
-                        let size = hash.run_size(cell);
-                        (0..)
-                            .step_by(size)
-                            .zip(hash.runs(cell))
-                            .map(move |run| (cell, run))
-                    });
+                    let later = fwd
+                        .iter()
+                        .flat_map(|&cell| hash.runs_from(cell, 0).map(move |run| (cell, run)));
                     for (cell, (at, seg)) in own.chain(later) {
                         for (j, yr) in (at..).zip(seg) {
                             if finite && yr.aabb.min.x - xa.max.x > glimit {
