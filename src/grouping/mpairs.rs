@@ -123,9 +123,11 @@ impl MPairs {
             }
             let mut m = c;
             for j in c + 1..(c + 4).min(n) {
-                if self.heap[j].before(&self.heap[m], tags) {
-                    m = j;
-                }
+                // The least child without a branch on the Costs' order (a coin flip); equal
+                // Costs, rare, go to the tie tags.
+                let (a, b) = (&self.heap[j], &self.heap[m]);
+                let take = (a.cost < b.cost) | ((a.cost == b.cost) && a.before(b, tags));
+                m = if take { j } else { m };
             }
             if !self.heap[m].before(&e, tags) {
                 break;

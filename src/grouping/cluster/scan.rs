@@ -157,7 +157,7 @@ impl Quick {
     #[inline(always)]
     fn beyond(self, d2: f64, sum: f64, bar: f64) -> bool {
         let rhs = bar * sum * (1.0 + 1e-12);
-        sum > 0.0 && d2 > 1e-250 && rhs > 1e-200 && d2 * self.b > rhs
+        (sum > 0.0) & (d2 > 1e-250) & (rhs > 1e-200) & (d2 * self.b > rhs)
     }
 
     /// Whether every pair of a body of diameter `dx` > 0 with a body of diameter at most `dmax`
@@ -294,13 +294,13 @@ impl Searcher<'_> {
     #[inline(always)]
     fn visit<const A: u8>(&self, r: &Rec, bar: f64, list: &mut Top<{ K_MAX + 1 }>) -> f64 {
         let xa = &self.xa;
-        if r.id == DEAD || apart(xa, &r.aabb, self.glimit) {
-            return bar;
-        }
         let e = merged_extents(xa, &r.aabb);
-        if let Some(q) = self.quick
-            && q.beyond(e.norm_squared(), self.dx + r.diameter, bar)
-        {
+        // One branch on the three tests together (each alone is a coin flip to predict).
+        let beyond = match self.quick {
+            Some(q) => q.beyond(e.norm_squared(), self.dx + r.diameter, bar),
+            None => false,
+        };
+        if (r.id == DEAD) | apart(xa, &r.aabb, self.glimit) | beyond {
             return bar;
         }
         let (d, sx, sy) = measures(self.area, &e, xa, self.dx, &r.aabb, r.diameter);
