@@ -162,6 +162,7 @@ fn check_literal(scene: &Scene) {
 
 #[test]
 fn crowded_voxels_give_the_literal_merges_on_1_and_2_threads() {
+    // 300 active bodies in crowded round 0: on 2 threads its start runs in parallel (from 256).
     let scene = crowded(300, 250);
     let params = Params::default();
     let boxes: Vec<Aabb> = (0..scene.len()).map(|i| scene.prim_aabb(i)).collect();

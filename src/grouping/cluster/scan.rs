@@ -39,9 +39,20 @@ use crate::grouping::{CostMeasure, Weights};
 /// which body is left out. It is kept until the voxel hash changes, so N coincident bodies
 /// re-searching between two merges cost one scan, not N.
 pub(super) struct Memo {
-    key: ([u64; 6], u64, u64),
+    key: MemoKey,
     body: u32,
     top: Top<{ K_MAX + 1 }>,
+}
+
+/// A body's box and diameter bits and the voxel hash version (see [`Memo`]).
+type MemoKey = ([u64; 6], u64, u64);
+
+/// The memo key of a body with box `xa` and diameter `dx` while the voxel hash is at `version`.
+#[inline]
+fn memo_key(xa: &Aabb, dx: f64, version: u64) -> MemoKey {
+    let b = |p: &P3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+    let (l, h) = (b(&xa.min), b(&xa.max));
+    ([l[0], l[1], l[2], h[0], h[1], h[2]], dx.to_bits(), version)
 }
 
 /// Cost of a pair of AABB bodies whose merged box has diagonal `d`; `A` = 1 or 0 selects the
@@ -276,6 +287,70 @@ fn count_across(
     }
 }
 
+/// The eligible pairs of cell `c`'s bodies with each other and with the bodies of later cells
+/// (fresh cells, finite boxes, GLimit `g` ≥ 0; `half_ext` the round's largest half-extents), as
+/// [`Clusterer::pairs_once`] counts them, and the records read: a pair of cells or runs whose
+/// every two boxes are within GLimit adds the product of their sizes without reading the
+/// records. `near` is scratch.
+fn count_cell(
+    hash: &VoxelHash,
+    half_ext: &[f64; 3],
+    c: u32,
+    g: f64,
+    near: &mut Vec<u32>,
+) -> (u64, u64) {
+    let (mut pairs, mut candidates) = (0u64, 0u64);
+    let vc = hash.coords(c);
+    let recs = hash.recs(c);
+    let (mut clo, mut chi) = (
+        P3::new(f64::MAX, f64::MAX, f64::MAX),
+        P3::new(f64::MIN, f64::MIN, f64::MIN),
+    );
+    for r in recs {
+        let (lo, hi) = query_box(half_ext, &r.aabb, g);
+        clo = clo.inf(&lo);
+        chi = chi.sup(&hi);
+    }
+    near.clear();
+    hash.for_each_cell(&clo, &chi, |cell, v| {
+        if v > vc && !apart(&hash.bounds(c).union, &hash.bounds(cell).union, g) {
+            near.push(cell);
+        }
+    });
+    let n = recs.len() as u64;
+    if within(hash.bounds(c), hash.bounds(c), g) {
+        pairs += n * n.saturating_sub(1) / 2;
+    } else {
+        for (i, (a, ab)) in hash.bounded_runs(c).enumerate() {
+            let m = a.len() as u64;
+            if within(ab, ab, g) {
+                pairs += m * m.saturating_sub(1) / 2;
+            } else {
+                for (j, x) in a.iter().enumerate() {
+                    let (m, seen) = count_near(&x.aabb, &a[j + 1..], g);
+                    pairs += m;
+                    candidates += seen;
+                }
+            }
+            for (b, bb) in hash.bounded_runs(c).skip(i + 1) {
+                count_across((a, ab), (b, bb), g, &mut pairs, &mut candidates);
+            }
+        }
+    }
+    for &cell in near.iter() {
+        if within(hash.bounds(c), hash.bounds(cell), g) {
+            pairs += n * hash.recs(cell).len() as u64;
+        } else {
+            for a in hash.bounded_runs(c) {
+                for b in hash.bounded_runs(cell) {
+                    count_across(a, b, g, &mut pairs, &mut candidates);
+                }
+            }
+        }
+    }
+    (pairs, candidates)
+}
+
 /// What a single search offers each record with.
 struct Searcher<'t> {
     xa: Aabb,
@@ -380,6 +455,132 @@ fn reachable(cb: &CellBounds, xa: &Aabb, glimit: f64) -> bool {
     !apart(xa, &cb.union, glimit)
 }
 
+/// What a pruned search (AABB p-set) reads: the round's voxel hash and bodies, and the Cost.
+pub(super) struct PrunedSearch<'a> {
+    hash: &'a VoxelHash,
+    aabb: &'a [Aabb],
+    diameter: &'a [f64],
+    half_ext: [f64; 3],
+    w: Weights,
+    /// Partner list length.
+    k: usize,
+    /// Whether the Cost is in surface area.
+    area: bool,
+    /// Whether Cost bounds may skip cells and blocks.
+    prune: bool,
+    quick: Option<Quick>,
+    tags: &'a [u64],
+}
+
+impl PrunedSearch<'_> {
+    /// The first `K_MAX + 1` partners of `x` in key order, `x` among them (see [`Memo`]),
+    /// visiting cells cheapest bound first and stopping at the first cell whose [`cost_bound`]
+    /// exceeds the last Cost the list keeps; `items` is scratch, and the records read are
+    /// added to `candidates`.
+    fn list<const A: u8>(
+        &self,
+        x: u32,
+        glimit: f64,
+        items: &mut Vec<(f64, u32)>,
+        candidates: &mut u64,
+    ) -> Top<{ K_MAX + 1 }> {
+        let (k, w, hash, prune, area) = (self.k, self.w, self.hash, self.prune, self.area);
+        let xa = self.aabb[x as usize];
+        let dx = self.diameter[x as usize];
+        let (lo, hi) = query_box(&self.half_ext, &xa, glimit);
+        // Gather the voxels' cells first and start loading their bounds, so those cache misses
+        // overlap instead of following one another.
+        let mut ids = [0u32; 64];
+        let mut m = 0;
+        let mut more: Vec<u32> = Vec::new();
+        hash.for_each_cell(&lo, &hi, |cell, _| {
+            hash.prefetch_cell(cell);
+            if m < ids.len() {
+                ids[m] = cell;
+                m += 1;
+            } else {
+                more.push(cell);
+            }
+        });
+        // The reachable cells with a lower bound on the Cost of their pairs, cheapest first.
+        let mut cells: [(f64, u32); 64] = [(0.0, 0); 64];
+        let mut n = 0;
+        let mut overflow: Vec<(f64, u32)> = Vec::new();
+        for &cell in ids[..m].iter().chain(&more) {
+            let cb = hash.bounds(cell);
+            if reachable(cb, &xa, glimit) {
+                hash.prefetch(cell);
+                let bound = if prune {
+                    cost_bound::<A>(&w, &xa, dx, cb)
+                } else {
+                    f64::NEG_INFINITY
+                };
+                if n < cells.len() {
+                    cells[n] = (bound, cell);
+                    n += 1;
+                } else {
+                    overflow.push((bound, cell));
+                }
+            }
+        }
+        let cells: &mut [(f64, u32)] = if overflow.is_empty() {
+            &mut cells[..n]
+        } else {
+            // Only reachable through rounding at voxel boundaries.
+            overflow.extend_from_slice(&cells);
+            &mut overflow
+        };
+        insertion_sort(cells);
+        // One more partner than a list holds, and `x` among the candidates (see [`Memo`]).
+        let mut list = Top::<{ K_MAX + 1 }>::EMPTY;
+        let wide = k + 1;
+        let me = Searcher {
+            xa,
+            dx,
+            glimit,
+            quick: self.quick,
+            area,
+            w,
+            wide,
+            tags: self.tags,
+        };
+        for &(bound, cell) in cells.iter() {
+            if bound > list.bar(wide) {
+                break;
+            }
+            // A blocked cell is read block by block, cheapest bound first, each picked when the
+            // last is read (a search reads few of a crowded cell's blocks), then its tail.
+            let blocks = hash.block_bounds(cell);
+            let sorted = hash.sorted_len(cell);
+            let last = if !prune || blocks.is_empty() {
+                Part::All
+            } else {
+                items.clear();
+                for (j, bb) in blocks.iter().enumerate() {
+                    if j * BLOCK < sorted && reachable(bb, &xa, glimit) {
+                        items.push((cost_bound::<A>(&w, &xa, dx, bb), j as u32));
+                    }
+                }
+                for i in 0..items.len() {
+                    let least = (i..items.len())
+                        .fold(i, |a, j| if items[j].0 < items[a].0 { j } else { a });
+                    items.swap(i, least);
+                    if items[i].0 > list.bar(wide) {
+                        break;
+                    }
+                    me.read::<A>(hash, cell, Part::Block(items[i].1), &mut list, candidates);
+                }
+                if sorted == hash.recs(cell).len() || bound > list.bar(wide) {
+                    continue;
+                }
+                Part::Tail
+            };
+            me.read::<A>(hash, cell, last, &mut list, candidates);
+        }
+        list
+    }
+}
+
 impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
     /// The box that holds the centre of every eligible partner of a body with box `xa`.
     #[inline]
@@ -402,6 +603,11 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             let area = self.params.mode.cost == CostMeasure::Area;
             let quick = Quick::new(&self.params.weights, self.quick && !area).is_some();
             if quick && glimit >= 0.0 && limit.budget.max_pairs.is_none() && self.crowded() {
+                if par::crowded_worth_it(order.len(), limit) {
+                    // The sqrt-free filter holds for A = 1 only.
+                    debug_assert!(a == 1.0);
+                    return self.crowded_par::<1>(order, glimit, limit);
+                }
                 let pairs = self.count_pairs(glimit);
                 for &x in order {
                     if limit.over(0) {
@@ -452,62 +658,14 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
     }
 
     /// The number of eligible pairs among the stored bodies (fresh cells, finite boxes, GLimit
-    /// ≥ 0), as [`Clusterer::pairs_once`] counts them: a pair of cells whose every two boxes
-    /// are within GLimit adds the product of their sizes without reading the records.
+    /// ≥ 0), as [`Clusterer::pairs_once`] counts them ([`count_cell`], cell by cell).
     fn count_pairs(&mut self, glimit: f64) -> u64 {
-        let hash = &self.hash;
-        let mut pairs = 0u64;
-        let mut candidates = 0u64;
         let mut near: Vec<u32> = Vec::with_capacity(27);
-        for c in 0..hash.cells() {
-            let vc = hash.coords(c);
-            let recs = hash.recs(c);
-            let (mut clo, mut chi) = (
-                P3::new(f64::MAX, f64::MAX, f64::MAX),
-                P3::new(f64::MIN, f64::MIN, f64::MIN),
-            );
-            for r in recs {
-                let (lo, hi) = self.query(&r.aabb, glimit);
-                clo = clo.inf(&lo);
-                chi = chi.sup(&hi);
-            }
-            near.clear();
-            hash.for_each_cell(&clo, &chi, |cell, v| {
-                if v > vc && !apart(&hash.bounds(c).union, &hash.bounds(cell).union, glimit) {
-                    near.push(cell);
-                }
-            });
-            let n = recs.len() as u64;
-            if within(hash.bounds(c), hash.bounds(c), glimit) {
-                pairs += n * n.saturating_sub(1) / 2;
-            } else {
-                for (i, (a, ab)) in hash.bounded_runs(c).enumerate() {
-                    let m = a.len() as u64;
-                    if within(ab, ab, glimit) {
-                        pairs += m * m.saturating_sub(1) / 2;
-                    } else {
-                        for (j, x) in a.iter().enumerate() {
-                            let (m, seen) = count_near(&x.aabb, &a[j + 1..], glimit);
-                            pairs += m;
-                            candidates += seen;
-                        }
-                    }
-                    for (b, bb) in hash.bounded_runs(c).skip(i + 1) {
-                        count_across((a, ab), (b, bb), glimit, &mut pairs, &mut candidates);
-                    }
-                }
-            }
-            for &cell in &near {
-                if within(hash.bounds(c), hash.bounds(cell), glimit) {
-                    pairs += n * hash.recs(cell).len() as u64;
-                } else {
-                    for a in hash.bounded_runs(c) {
-                        for b in hash.bounded_runs(cell) {
-                            count_across(a, b, glimit, &mut pairs, &mut candidates);
-                        }
-                    }
-                }
-            }
+        let (mut pairs, mut candidates) = (0u64, 0u64);
+        for c in 0..self.hash.cells() {
+            let (p, seen) = count_cell(&self.hash, &self.half_ext, c, glimit, &mut near);
+            pairs += p;
+            candidates += seen;
         }
         self.stats.candidates += candidates;
         pairs
@@ -529,17 +687,17 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         }
     }
 
-    /// The memo key of body `x`: its box and diameter bits and the voxel hash version.
-    fn memo_key(&self, x: u32) -> ([u64; 6], u64, u64) {
-        let (xa, dx) = (self.aabb[x as usize], self.diameter[x as usize]);
-        let b = |p: &P3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
-        let (l, h) = (b(&xa.min), b(&xa.max));
-        let key = [l[0], l[1], l[2], h[0], h[1], h[2]];
-        (key, dx.to_bits(), self.hash.version())
+    /// The memo key of body `x`.
+    fn memo_key(&self, x: u32) -> MemoKey {
+        memo_key(
+            &self.aabb[x as usize],
+            self.diameter[x as usize],
+            self.hash.version(),
+        )
     }
 
     /// `x`'s list from the [`Memo`] of a search by a body identical to it, if there is one.
-    fn reuse_memo(&mut self, x: u32, key: &([u64; 6], u64, u64)) -> bool {
+    fn reuse_memo(&mut self, x: u32, key: &MemoKey) -> bool {
         let Some(m) = &self.memo else {
             return false;
         };
@@ -642,121 +800,38 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         pairs
     }
 
-    /// The first partners of `x` in key order (AABB p-set), visiting cells cheapest bound first
-    /// and stopping at the first cell whose [`cost_bound`] exceeds the last Cost the list keeps.
+    /// What a pruned search reads (AABB p-set).
+    fn pruned(&self) -> PrunedSearch<'_> {
+        let area = self.params.mode.cost == CostMeasure::Area;
+        PrunedSearch {
+            hash: &self.hash,
+            aabb: &self.aabb,
+            diameter: &self.diameter,
+            half_ext: self.half_ext,
+            w: self.params.weights,
+            k: self.k,
+            area,
+            prune: self.prune && !area,
+            quick: Quick::new(&self.params.weights, self.quick && !area),
+            tags: &self.tag,
+        }
+    }
+
+    /// The first partners of `x` in key order (AABB p-set), into its list, served from the
+    /// [`Memo`] where it can be ([`PrunedSearch::list`]).
     fn scan_pruned<const A: u8>(&mut self, x: u32, glimit: f64) {
-        let (k, w) = (self.k, self.params.weights);
-        let xa = self.aabb[x as usize];
-        let dx = self.diameter[x as usize];
         let key = self.memo_key(x);
         if self.reuse_memo(x, &key) {
             return;
         }
-        let hash = &self.hash;
-        let (lo, hi) = self.query(&xa, glimit);
-        let area = self.params.mode.cost == CostMeasure::Area;
-        let prune = self.prune && !area;
-        // Gather the voxels' cells first and start loading their bounds, so those cache misses
-        // overlap instead of following one another.
-        let mut ids = [0u32; 64];
-        let mut m = 0;
-        let mut more: Vec<u32> = Vec::new();
-        hash.for_each_cell(&lo, &hi, |cell, _| {
-            hash.prefetch_cell(cell);
-            if m < ids.len() {
-                ids[m] = cell;
-                m += 1;
-            } else {
-                more.push(cell);
-            }
-        });
-        // The reachable cells with a lower bound on the Cost of their pairs, cheapest first.
-        let mut cells: [(f64, u32); 64] = [(0.0, 0); 64];
-        let mut n = 0;
-        let mut overflow: Vec<(f64, u32)> = Vec::new();
-        for &cell in ids[..m].iter().chain(&more) {
-            let cb = hash.bounds(cell);
-            if reachable(cb, &xa, glimit) {
-                hash.prefetch(cell);
-                let bound = if prune {
-                    cost_bound::<A>(&w, &xa, dx, cb)
-                } else {
-                    f64::NEG_INFINITY
-                };
-                if n < cells.len() {
-                    cells[n] = (bound, cell);
-                    n += 1;
-                } else {
-                    overflow.push((bound, cell));
-                }
-            }
-        }
-        let cells: &mut [(f64, u32)] = if overflow.is_empty() {
-            &mut cells[..n]
-        } else {
-            // Only reachable through rounding at voxel boundaries.
-            overflow.extend_from_slice(&cells);
-            &mut overflow
-        };
-        insertion_sort(cells);
-        let items = &mut self.items;
-        // One more partner than a list holds, and `x` among the candidates (see [`Memo`]).
-        let mut list = Top::<{ K_MAX + 1 }>::EMPTY;
-        let wide = k + 1;
+        let mut items = std::mem::take(&mut self.items);
         let mut candidates = 0u64;
-        let tags = &self.tag;
-        let quick = Quick::new(&w, self.quick && !area);
-        let me = Searcher {
-            xa,
-            dx,
-            glimit,
-            quick,
-            area,
-            w,
-            wide,
-            tags,
-        };
-        for &(bound, cell) in cells.iter() {
-            if bound > list.bar(wide) {
-                break;
-            }
-            // A blocked cell is read block by block, cheapest bound first, each picked when the
-            // last is read (a search reads few of a crowded cell's blocks), then its tail.
-            let blocks = hash.block_bounds(cell);
-            let sorted = hash.sorted_len(cell);
-            let last = if !prune || blocks.is_empty() {
-                Part::All
-            } else {
-                items.clear();
-                for (j, bb) in blocks.iter().enumerate() {
-                    if j * BLOCK < sorted && reachable(bb, &xa, glimit) {
-                        items.push((cost_bound::<A>(&w, &xa, dx, bb), j as u32));
-                    }
-                }
-                for i in 0..items.len() {
-                    let least = (i..items.len())
-                        .fold(i, |a, j| if items[j].0 < items[a].0 { j } else { a });
-                    items.swap(i, least);
-                    if items[i].0 > list.bar(wide) {
-                        break;
-                    }
-                    me.read::<A>(
-                        hash,
-                        cell,
-                        Part::Block(items[i].1),
-                        &mut list,
-                        &mut candidates,
-                    );
-                }
-                if sorted == hash.recs(cell).len() || bound > list.bar(wide) {
-                    continue;
-                }
-                Part::Tail
-            };
-            me.read::<A>(hash, cell, last, &mut list, &mut candidates);
-        }
+        let list = self
+            .pruned()
+            .list::<A>(x, glimit, &mut items, &mut candidates);
+        self.items = items;
         self.stats.candidates += candidates;
-        *self.partners.get(x) = list.without(x, k);
+        *self.partners.get(x) = list.without(x, self.k);
         self.memo = Some(Memo {
             key,
             body: x,

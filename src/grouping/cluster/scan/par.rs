@@ -12,12 +12,12 @@
 //! bodies and the budget has no `max_pairs` (where a scan stops would depend on the order of
 //! counting). The stop flag and deadline are read every [`Budget::CLOCK_EVERY`] bodies.
 
-use super::reachable;
 use super::{Clusterer, PSetBodies, Quick, ScanLimit, apart, merged_extents, pair_cost, query_box};
+use super::{MemoKey, count_cell, memo_key, reachable};
 use crate::events::Observer;
 use crate::geom::P3;
-use crate::grouping::Budget;
-use crate::grouping::mpairs::List;
+use crate::grouping::mpairs::{K_MAX, List, Top};
+use crate::grouping::{Budget, StopReason};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -27,9 +27,19 @@ pub(super) const MIN_BODIES: usize = 2048;
 /// Record ranges per thread (more than one evens out uneven ranges).
 const RANGES_PER_THREAD: usize = 8;
 
+/// Crowded rounds with fewer active bodies start on one thread (their bodies cost more each).
+pub(super) const CROWDED_MIN_BODIES: usize = 256;
+
 /// Whether a round-start scan of `bodies` active bodies under `limit` runs in parallel.
 pub(super) fn worth_it(bodies: usize, limit: &ScanLimit<'_>) -> bool {
     bodies >= MIN_BODIES && limit.budget.max_pairs.is_none() && rayon::current_num_threads() > 1
+}
+
+/// Whether a crowded round start of `bodies` active bodies under `limit` runs in parallel.
+pub(super) fn crowded_worth_it(bodies: usize, limit: &ScanLimit<'_>) -> bool {
+    bodies >= CROWDED_MIN_BODIES
+        && limit.budget.max_pairs.is_none()
+        && rayon::current_num_threads() > 1
 }
 
 /// The partner lists, shared by the ranges; each range writes only its own bodies' lists.
@@ -91,7 +101,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         let lists = Lists(lists.as_mut_ptr());
         let halt = AtomicBool::new(false);
         let (budget, timed) = (limit.budget, limit.timed);
-        let scan = |p: usize| -> (Found, Option<crate::grouping::StopReason>) {
+        let scan = |p: usize| -> (Found, Option<StopReason>) {
             let (lo, hi) = (p * total / parts, (p + 1) * total / parts);
             let ours = |cell: u32, i: usize| (lo..hi).contains(&(first[cell as usize] + i));
             let mut f = Found::default();
@@ -181,7 +191,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             }
             (f, None)
         };
-        let found: Vec<(Found, Option<crate::grouping::StopReason>)> =
+        let found: Vec<(Found, Option<StopReason>)> =
             (0..parts).into_par_iter().map(scan).collect();
         let lists = self.partners.lists_mut();
         let mut pairs = 0u64;
@@ -193,6 +203,90 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             }
             for &(s, cost, x) in &f.remote {
                 lists[s as usize].offer(k, cost, x, &self.tag);
+            }
+        }
+        if limit.hit.is_none() && halt.load(Ordering::Relaxed) {
+            limit.hit = budget.exceeded_now();
+        }
+        pairs
+    }
+
+    /// The crowded round start on the current rayon pool: the eligible pairs counted cell by
+    /// cell, and each body's search, in ranges of `order`. Each search is a function of the
+    /// voxel hash alone, and each range keeps its own [`Memo`](super::Memo), so every list and
+    /// count is the sequential run's.
+    pub(super) fn crowded_par<const A: u8>(
+        &mut self,
+        order: &[u32],
+        glimit: f64,
+        limit: &mut ScanLimit<'_>,
+    ) -> u64 {
+        let hash = &self.hash;
+        let half_ext = self.half_ext;
+        let (pairs, seen) = (0..hash.cells())
+            .into_par_iter()
+            .map_init(
+                || Vec::with_capacity(27),
+                |near, c| count_cell(hash, &half_ext, c, glimit, near),
+            )
+            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+        let search = self.pruned();
+        let (aabb, diameter, version, k) = (&self.aabb, &self.diameter, hash.version(), self.k);
+        let len = order.len();
+        let parts = (rayon::current_num_threads() * RANGES_PER_THREAD).clamp(1, len.max(1));
+        let start = |p: usize| p * len / parts;
+        let range = |p: usize| &order[start(p)..start(p + 1)];
+        let halt = AtomicBool::new(false);
+        let (budget, timed) = (limit.budget, limit.timed);
+        let found: Vec<(Vec<List>, u64, Option<StopReason>)> = (0..parts)
+            .into_par_iter()
+            .map(|p| {
+                let bodies = range(p);
+                let mut lists = Vec::with_capacity(bodies.len());
+                let (mut items, mut candidates) = (Vec::new(), 0u64);
+                let key_of = |x: u32| memo_key(&aabb[x as usize], diameter[x as usize], version);
+                // The key the one-thread run's memo holds on entering the range: its last body's
+                // (a body identical to the last one is served from the memo, and reads nothing).
+                let before = start(p).checked_sub(1).map(|i| key_of(order[i]));
+                let mut memo: Option<(MemoKey, Top<{ K_MAX + 1 }>)> = None;
+                for (i, &x) in bodies.iter().enumerate() {
+                    if timed && (i as u32 + 1).is_multiple_of(Budget::CLOCK_EVERY) {
+                        if halt.load(Ordering::Relaxed) {
+                            return (lists, candidates, None);
+                        }
+                        if let Some(r) = budget.exceeded_now() {
+                            halt.store(true, Ordering::Relaxed);
+                            return (lists, candidates, Some(r));
+                        }
+                    }
+                    let key = key_of(x);
+                    let top = match memo {
+                        Some((mk, top)) if mk == key => top,
+                        _ => {
+                            // Counted as the one-thread run reads: nothing for a body that its
+                            // memo would have served.
+                            let mut read = 0u64;
+                            let top = search.list::<A>(x, glimit, &mut items, &mut read);
+                            if !(i == 0 && before == Some(key)) {
+                                candidates += read;
+                            }
+                            memo = Some((key, top));
+                            top
+                        }
+                    };
+                    lists.push(top.without(x, k));
+                }
+                (lists, candidates, None)
+            })
+            .collect();
+        self.stats.candidates += seen;
+        for (p, (lists, candidates, hit)) in found.into_iter().enumerate() {
+            for (&x, list) in range(p).iter().zip(lists) {
+                *self.partners.get(x) = list;
+            }
+            self.stats.candidates += candidates;
+            if limit.hit.is_none() {
+                limit.hit = hit;
             }
         }
         if limit.hit.is_none() && halt.load(Ordering::Relaxed) {
