@@ -287,6 +287,27 @@ fn count_across(
     }
 }
 
+/// The later cells (in voxel order) any body of cell `c` may pair with, into `near`: those
+/// in reach of its bodies' query boxes whose unions are within GLimit `g` of its union.
+fn later_near(hash: &VoxelHash, half_ext: &[f64; 3], c: u32, g: f64, near: &mut Vec<u32>) {
+    let vc = hash.coords(c);
+    let (mut clo, mut chi) = (
+        P3::new(f64::MAX, f64::MAX, f64::MAX),
+        P3::new(f64::MIN, f64::MIN, f64::MIN),
+    );
+    for r in hash.recs(c) {
+        let (lo, hi) = query_box(half_ext, &r.aabb, g);
+        clo = clo.inf(&lo);
+        chi = chi.sup(&hi);
+    }
+    near.clear();
+    hash.for_each_cell(&clo, &chi, |cell, v| {
+        if v > vc && !apart(&hash.bounds(c).union, &hash.bounds(cell).union, g) {
+            near.push(cell);
+        }
+    });
+}
+
 /// The eligible pairs of cell `c`'s bodies with each other and with the bodies of later cells
 /// (fresh cells, finite boxes, GLimit `g` ≥ 0; `half_ext` the round's largest half-extents), as
 /// [`Clusterer::pairs_once`] counts them, and the records read: a pair of cells or runs whose
@@ -300,24 +321,8 @@ fn count_cell(
     near: &mut Vec<u32>,
 ) -> (u64, u64) {
     let (mut pairs, mut candidates) = (0u64, 0u64);
-    let vc = hash.coords(c);
-    let recs = hash.recs(c);
-    let (mut clo, mut chi) = (
-        P3::new(f64::MAX, f64::MAX, f64::MAX),
-        P3::new(f64::MIN, f64::MIN, f64::MIN),
-    );
-    for r in recs {
-        let (lo, hi) = query_box(half_ext, &r.aabb, g);
-        clo = clo.inf(&lo);
-        chi = chi.sup(&hi);
-    }
-    near.clear();
-    hash.for_each_cell(&clo, &chi, |cell, v| {
-        if v > vc && !apart(&hash.bounds(c).union, &hash.bounds(cell).union, g) {
-            near.push(cell);
-        }
-    });
-    let n = recs.len() as u64;
+    later_near(hash, half_ext, c, g, near);
+    let n = hash.recs(c).len() as u64;
     if within(hash.bounds(c), hash.bounds(c), g) {
         pairs += n * n.saturating_sub(1) / 2;
     } else {
@@ -735,24 +740,9 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         let mut near: Vec<u32> = Vec::with_capacity(27);
         let mut fwd: Vec<u32> = Vec::with_capacity(27);
         'cells: for c in 0..self.hash.cells() {
-            let vc = self.hash.coords(c);
             // The later cells any body of this cell may pair with, found once per cell.
-            let (mut clo, mut chi) = (
-                P3::new(f64::MAX, f64::MAX, f64::MAX),
-                P3::new(f64::MIN, f64::MIN, f64::MIN),
-            );
-            for r in self.hash.recs(c) {
-                let (lo, hi) = self.query(&r.aabb, glimit);
-                clo = clo.inf(&lo);
-                chi = chi.sup(&hi);
-            }
             let hash = &self.hash;
-            near.clear();
-            hash.for_each_cell(&clo, &chi, |cell, v| {
-                if v > vc && !apart(&hash.bounds(c).union, &hash.bounds(cell).union, glimit) {
-                    near.push(cell);
-                }
-            });
+            later_near(hash, &self.half_ext, c, glimit, &mut near);
             for i in 0..hash.recs(c).len() {
                 if limit.over(pairs) {
                     break 'cells;

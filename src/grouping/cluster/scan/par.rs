@@ -12,10 +12,9 @@
 //! bodies and the budget has no `max_pairs` (where a scan stops would depend on the order of
 //! counting). The stop flag and deadline are read every [`Budget::CLOCK_EVERY`] bodies.
 
-use super::{Clusterer, PSetBodies, Quick, ScanLimit, apart, merged_extents, pair_cost, query_box};
-use super::{MemoKey, count_cell, memo_key, reachable};
+use super::{Clusterer, PSetBodies, Quick, ScanLimit, apart, merged_extents, pair_cost};
+use super::{MemoKey, count_cell, later_near, memo_key, reachable};
 use crate::events::Observer;
-use crate::geom::P3;
 use crate::grouping::mpairs::{K_MAX, List, Top};
 use crate::grouping::{Budget, StopReason};
 use rayon::prelude::*;
@@ -110,22 +109,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             let mut bodies = 0u32;
             let c0 = first.partition_point(|&s| s <= lo).saturating_sub(1) as u32;
             for c in (c0..cells).take_while(|&c| first[c as usize] < hi) {
-                let vc = hash.coords(c);
-                let (mut clo, mut chi) = (
-                    P3::new(f64::MAX, f64::MAX, f64::MAX),
-                    P3::new(f64::MIN, f64::MIN, f64::MIN),
-                );
-                for r in hash.recs(c) {
-                    let (l, h) = query_box(&half_ext, &r.aabb, glimit);
-                    clo = clo.inf(&l);
-                    chi = chi.sup(&h);
-                }
-                near.clear();
-                hash.for_each_cell(&clo, &chi, |cell, v| {
-                    if v > vc && !apart(&hash.bounds(c).union, &hash.bounds(cell).union, glimit) {
-                        near.push(cell);
-                    }
-                });
+                later_near(hash, &half_ext, c, glimit, &mut near);
                 let at = first[c as usize];
                 for i in lo.saturating_sub(at)..hash.recs(c).len().min(hi - at) {
                     if timed {
