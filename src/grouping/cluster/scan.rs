@@ -462,10 +462,14 @@ fn reachable(cb: &CellBounds, xa: &Aabb, glimit: f64) -> bool {
 
 /// What a pruned search (AABB p-set) reads: the round's voxel hash and bodies, and the Cost.
 pub(super) struct PrunedSearch<'a> {
+    /// The round's stored bodies.
     hash: &'a VoxelHash,
+    /// Every body's box and diameter, by id.
     aabb: &'a [Aabb],
     diameter: &'a [f64],
+    /// Largest half-extent per axis of the stored bodies ([`query_box`]).
     half_ext: [f64; 3],
+    /// The Cost's weights.
     w: Weights,
     /// Partner list length.
     k: usize,
@@ -473,7 +477,9 @@ pub(super) struct PrunedSearch<'a> {
     area: bool,
     /// Whether Cost bounds may skip cells and blocks.
     prune: bool,
+    /// The sqrt-free Cost filter, where it holds.
     quick: Option<Quick>,
+    /// Every body's tie tag.
     tags: &'a [u64],
 }
 
