@@ -617,7 +617,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                 if par::crowded_worth_it(order.len(), limit) {
                     // The sqrt-free filter holds for A = 1 only.
                     debug_assert!(a == 1.0);
-                    return self.crowded_par::<1>(order, glimit, limit);
+                    return self.crowded_par(order, glimit, limit);
                 }
                 let pairs = self.count_pairs(glimit);
                 for &x in order {

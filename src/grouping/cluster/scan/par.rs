@@ -198,8 +198,8 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
     /// The crowded round start on the current rayon pool: the eligible pairs counted cell by
     /// cell, and each body's search, in ranges of `order`. Each search is a function of the
     /// voxel hash alone, and each range keeps its own [`Memo`](super::Memo), so every list and
-    /// count is the sequential run's.
-    pub(super) fn crowded_par<const A: u8>(
+    /// count is the sequential run's. Crowded rounds use the sqrt-free filter, so A = 1.
+    pub(super) fn crowded_par(
         &mut self,
         order: &[u32],
         glimit: f64,
@@ -250,7 +250,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                             // Counted as the one-thread run reads: nothing for a body that its
                             // memo would have served.
                             let mut read = 0u64;
-                            let top = search.list::<A>(x, glimit, &mut items, &mut read);
+                            let top = search.list::<1>(x, glimit, &mut items, &mut read);
                             if !(i == 0 && before == Some(key)) {
                                 candidates += read;
                             }
