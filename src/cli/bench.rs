@@ -57,7 +57,8 @@ pub struct BenchCmd {
     #[arg(long, value_name = "N")]
     pub(super) threads: Option<usize>,
     /// Timed repetitions per case (the best is reported); with SCENEs a case is repeated only
-    /// while its runs took under 0.1 s in all.
+    /// while its runs took under 0.1 s in all, and with 2 or more, one whose runs took under
+    /// 20 ms in all is repeated until they do (at most 200 runs).
     #[arg(long, default_value_t = 3)]
     repeat: u32,
     /// Instead: measure recording (time and file sizes per --detail) on the 3,130- and

@@ -93,7 +93,8 @@ pub struct Options {
     pub wrappers: Vec<Wrapper>,
     /// Grouping parameters.
     pub params: Params,
-    /// Timed repetitions of each build (the best is kept; see [`REPEAT_BUDGET_S`]).
+    /// Timed repetitions of each build (the best is kept; see [`REPEAT_BUDGET_S`] and
+    /// [`REPEAT_FLOOR_S`]).
     pub repeat: u32,
     /// Tightness is measured only up to this many primitives.
     pub tightness_max_n: usize,
@@ -153,16 +154,32 @@ pub struct Row {
 /// by itself, and repeating it would multiply the time of a bench.
 pub const REPEAT_BUDGET_S: f64 = 0.1;
 
-/// The output and time of the fastest of up to `repeat` runs of `f` (at least one), repeated
-/// only while the runs so far took less than [`REPEAT_BUDGET_S`] in total.
+/// Seconds a case with more than one repetition is repeated to at least: a build of well under
+/// a millisecond is timed over many runs, so that its best is not that of three runs a busy
+/// machine may all have slowed (on the 2-core VM a 1,120-triangle part's fast path over PLOC
+/// read 1.52–1.95× in five benches of three runs each).
+pub const REPEAT_FLOOR_S: f64 = 0.02;
+
+/// The most runs of one case.
+pub const REPEAT_MAX: u32 = 200;
+
+/// Whether a case is run again after `runs` runs that took `spent` seconds in all: while
+/// fewer than `repeat` runs took less than [`REPEAT_BUDGET_S`], or, when `repeat` > 1, less
+/// than [`REPEAT_FLOOR_S`]; never more than [`REPEAT_MAX`] runs.
+fn run_again(runs: u32, spent: f64, repeat: u32) -> bool {
+    repeat > 1
+        && runs < REPEAT_MAX
+        && ((runs < repeat && spent < REPEAT_BUDGET_S) || spent < REPEAT_FLOOR_S)
+}
+
+/// The output and time of the fastest run of `f` (at least one), run again as long as
+/// [`run_again`] says.
 fn best_of<T>(repeat: u32, mut f: impl FnMut() -> (T, f64)) -> (T, f64) {
     let (mut out, mut best) = f();
-    let mut spent = best;
-    for _ in 1..repeat.max(1) {
-        if spent >= REPEAT_BUDGET_S {
-            break;
-        }
+    let (mut runs, mut spent) = (1, best);
+    while run_again(runs, spent, repeat) {
         let (o, s) = f();
+        runs += 1;
         spent += s;
         if s < best {
             (out, best) = (o, s);
@@ -426,4 +443,40 @@ pub fn query_values(q: &QueryCost) -> [f64; 9] {
         cost / queries,
         q.seconds,
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cases_run_repeat_times_within_the_budget_and_short_ones_up_to_the_floor() {
+        // One repetition: one run, however short.
+        assert!(!run_again(1, 1e-6, 1));
+        // Long runs: the budget ends them before `repeat`.
+        assert!(run_again(1, 0.05, 3));
+        assert!(!run_again(2, 0.1, 3));
+        assert!(!run_again(1, 0.5, 3));
+        // Mid-length runs: `repeat` of them.
+        assert!(run_again(2, 0.04, 3));
+        assert!(!run_again(3, 0.06, 3));
+        // Short runs: past `repeat` until the floor, at most REPEAT_MAX.
+        assert!(run_again(3, 0.001, 3));
+        assert!(!run_again(3, REPEAT_FLOOR_S, 3));
+        assert!(!run_again(REPEAT_MAX, 0.0, 3));
+        // A short case: runs of 1/1024 s (the fifth half that) pass the floor on the 21st
+        // (20 of them take 0.0190 s, 21 take 0.0200), and the fastest run's output is kept.
+        let mut runs = 0;
+        let (out, best) = best_of(3, || {
+            runs += 1;
+            let s = if runs == 5 {
+                1.0 / 2048.0
+            } else {
+                1.0 / 1024.0
+            };
+            (runs, s)
+        });
+        assert_eq!(runs, 21);
+        assert_eq!((out, best), (5, 1.0 / 2048.0));
+    }
 }
