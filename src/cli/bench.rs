@@ -56,8 +56,8 @@ pub struct BenchCmd {
     /// scans, obvhs PLOC) [default: all cores]; the partitioned table sets 1 and 2 itself.
     #[arg(long, value_name = "N")]
     pub(super) threads: Option<usize>,
-    /// Timed repetitions per case (the best is reported); with SCENEs a case is repeated only
-    /// while its runs took under 0.1 s in all, and with 2 or more, one whose runs took under
+    /// Timed repetitions per case (the best is reported). With SCENEs a case is repeated only
+    /// while its runs took under 0.1 s in all; with 2 or more, a case whose runs took under
     /// 20 ms in all is repeated until they do (at most 200 runs).
     #[arg(long, default_value_t = 3)]
     repeat: u32,
