@@ -155,9 +155,8 @@ pub struct Row {
 pub const REPEAT_BUDGET_S: f64 = 0.1;
 
 /// Seconds a case with more than one repetition is repeated to at least: a build of well under
-/// a millisecond is timed over many runs, so that its best is not that of three runs a busy
-/// machine may all have slowed (on the 2-core VM a 1,120-triangle part's fast path over PLOC
-/// read 1.52–1.95× in five benches of three runs each).
+/// a millisecond is timed over many runs, whose best a busy machine is unlikely to have slowed
+/// in every one (`docs/benchmarks.md`).
 pub const REPEAT_FLOOR_S: f64 = 0.02;
 
 /// The most runs of one case.

@@ -614,7 +614,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
             let area = self.params.mode.cost == CostMeasure::Area;
             let quick = Quick::new(&self.params.weights, self.quick && !area).is_some();
             if quick && glimit >= 0.0 && limit.budget.max_pairs.is_none() && self.crowded() {
-                if par::crowded_worth_it(order.len(), limit) {
+                if par::worth_it(par::CROWDED_MIN_BODIES, order.len(), limit) {
                     // The sqrt-free filter holds for A = 1 only.
                     debug_assert!(a == 1.0);
                     return self.crowded_par(order, glimit, limit);
@@ -628,7 +628,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                 }
                 return pairs;
             }
-            if !area && par::worth_it(order.len(), limit) {
+            if !area && par::worth_it(par::MIN_BODIES, order.len(), limit) {
                 if a == 1.0 {
                     self.pairs_once_par::<1>(glimit, limit)
                 } else if a == 0.0 {

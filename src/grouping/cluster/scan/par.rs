@@ -29,16 +29,11 @@ const RANGES_PER_THREAD: usize = 8;
 /// Crowded rounds with fewer active bodies start on one thread (their bodies cost more each).
 pub(super) const CROWDED_MIN_BODIES: usize = 256;
 
-/// Whether a round-start scan of `bodies` active bodies under `limit` runs in parallel.
-pub(super) fn worth_it(bodies: usize, limit: &ScanLimit<'_>) -> bool {
-    bodies >= MIN_BODIES && limit.budget.max_pairs.is_none() && rayon::current_num_threads() > 1
-}
-
-/// Whether a crowded round start of `bodies` active bodies under `limit` runs in parallel.
-pub(super) fn crowded_worth_it(bodies: usize, limit: &ScanLimit<'_>) -> bool {
-    bodies >= CROWDED_MIN_BODIES
-        && limit.budget.max_pairs.is_none()
-        && rayon::current_num_threads() > 1
+/// Whether a round start of `bodies` active bodies under `limit` runs in parallel: at least
+/// `min` of them ([`MIN_BODIES`], or [`CROWDED_MIN_BODIES`] for a crowded round), no
+/// `max_pairs`, and more than one thread.
+pub(super) fn worth_it(min: usize, bodies: usize, limit: &ScanLimit<'_>) -> bool {
+    bodies >= min && limit.budget.max_pairs.is_none() && rayon::current_num_threads() > 1
 }
 
 /// The partner lists, shared by the ranges; each range writes only its own bodies' lists.
