@@ -190,12 +190,22 @@ pub(super) struct Zone<'z> {
     perm: Vec<u32>,
     /// Doubled centre (min + max) of each primitive, by position on entry.
     cen: Vec<[f64; 3]>,
-    /// Bin (binned cuts, on the chosen axis) or side (sweeps) of each primitive of the range
-    /// being cut, and the partition's buffer.
+    /// Bin on the chosen axis of each primitive of the range a binned cut cuts, and the
+    /// partitions' buffer.
     bin: Vec<u8>,
     /// Bins of each primitive of the range being cut on the three axes (binned cuts).
     bins: Vec<[u8; 3]>,
     tmp: Vec<u32>,
+    /// Per axis, the positions on entry of each range of at most [`SWEEP`] primitives sorted
+    /// by centre as a sweep orders them, at the range's place in the planned order: a sweep
+    /// sorts a range once and hands each side its part of the orders (a stable partition of
+    /// a sorted sequence is sorted, ties included, as each side keeps its order).
+    ord: [Vec<u32>; 3],
+    /// Whether `ord` holds the orders of the range planned to start at each place.
+    sorted: Vec<bool>,
+    /// Side (0 left, 1 right) of each primitive of the range a sweep cuts, by position on
+    /// entry.
+    side: Vec<u8>,
 }
 
 /// Surface area of the box `lo..hi`.
@@ -282,6 +292,22 @@ fn centres(cen: &[[f64; 3]], ps: impl Iterator<Item = u32>) -> Bounds {
     b
 }
 
+/// Moves the positions of `part` whose `side` is 0 (`nl` of them) before the others, each
+/// side in its order, without branches; `tmp` is scratch.
+#[inline(always)]
+fn stable_split(part: &mut [u32], nl: usize, side: &[u8], tmp: &mut Vec<u32>) {
+    tmp.resize(part.len(), 0);
+    let (mut li, mut ri) = (0, nl);
+    for &p in part.iter() {
+        let right = usize::from(side[p as usize]);
+        let d = if right == 0 { li } else { ri };
+        tmp[d] = p;
+        li += 1 - right;
+        ri += right;
+    }
+    part.copy_from_slice(&tmp[..part.len()]);
+}
+
 impl<'z> Zone<'z> {
     /// A zone over `codes` and `leaves` (the same order, Morton-sorted).
     pub(super) fn new(codes: &'z mut [(u64, u32)], leaves: &'z mut [Body]) -> Zone<'z> {
@@ -301,6 +327,9 @@ impl<'z> Zone<'z> {
             bin: Vec::with_capacity(m),
             bins: Vec::with_capacity(m),
             tmp: Vec::with_capacity(m),
+            ord: [vec![0; m], vec![0; m], vec![0; m]],
+            sorted: vec![false; m],
+            side: vec![0; m],
         }
     }
 
@@ -313,7 +342,10 @@ impl<'z> Zone<'z> {
         }
         // Positions keep their entry order within a side, so the codes are sorted.
         let codes = &*self.codes;
-        morton_cut(&self.perm[start..start + len], |&p| codes[p as usize].0)
+        let nl = morton_cut(&self.perm[start..start + len], |&p| codes[p as usize].0);
+        self.sorted[start] = false;
+        self.sorted[start + nl] = false;
+        nl
     }
 
     /// The SAH cut of `start..start + len`, if any (moving the left side to the front).
@@ -329,15 +361,15 @@ impl<'z> Zone<'z> {
         // Every axis with a span is tried; the cheapest cut wins (ties to the lower axis), its
         // sides kept in `bin`. Bins from `cut` on are the right side.
         let spans = e.map(|w| w > 0.0 && w.is_finite());
-        let (nl, cut) = if len > SWEEP {
-            // One pass bins the centres on all three axes at once.
-            let (nl, cut, axis) = self.binned(start, len, &cb.lo, &e, spans)?;
-            self.bin.clear();
-            self.bin.extend(self.bins.iter().map(|b| b[axis]));
-            (nl, cut)
-        } else {
-            (self.sweep(start, len, spans)?, 1)
-        };
+        if len <= SWEEP {
+            return self.sweep(start, len, spans);
+        }
+        // One pass bins the centres on all three axes at once.
+        let (nl, cut, axis) = self.binned(start, len, &cb.lo, &e, spans)?;
+        self.bin.clear();
+        self.bin.extend(self.bins.iter().map(|b| b[axis]));
+        self.sorted[start] = false;
+        self.sorted[start + nl] = false;
         // A stable partition of the positions (side 0 first), without branches.
         self.tmp.resize(len, 0);
         let part = &mut self.perm[start..start + len];
@@ -356,59 +388,40 @@ impl<'z> Zone<'z> {
     /// The exact cut of a range of at most [`SWEEP`]: on each axis that `spans`, the primitives
     /// sorted by centre on it, ties (and centres within 16 units in the last place) in range
     /// order (a NaN centre first, −0 as 0), and the boundary of least SAH leaving a quarter on
-    /// each side; of those the cheapest (ties to the lower axis). The boxes are gathered once
-    /// for the three axes, and the three sweeps advance together (each step of one waits on its
-    /// last, so three side by side take about the time of one). Sets `bin` to each primitive's
-    /// side and returns the left side's length.
+    /// each side; of those the cheapest (ties to the lower axis). The three sweeps advance
+    /// together (each step of one waits on its last, so three side by side take about the
+    /// time of one). The orders come from the sweep of the range's parent when it had one
+    /// (`ord`), else from sorting; the range is partitioned stably, each side with its part of
+    /// the orders. Returns the left side's length.
     fn sweep(&mut self, start: usize, len: usize, spans: [bool; 3]) -> Option<usize> {
-        let (leaves, cen) = (&*self.leaves, &self.cen);
-        let part = &self.perm[start..start + len];
+        let end = start + len;
+        if !self.sorted[start] {
+            self.sort_range(start, len);
+        }
+        let leaves = &*self.leaves;
+        let ord = &self.ord;
         let least = (len / 4).max(1);
-        let mut boxes = [Bounds::EMPTY; SWEEP];
-        for (b, &p) in boxes.iter_mut().zip(part) {
-            b.add(&leaves[p as usize].aabb);
-        }
-        // The order on each axis that spans (an axis that does not keeps the range order and
-        // is swept for nothing).
-        let mut order = [[0u8; SWEEP]; 3];
-        for axis in (0..3).filter(|&a| spans[a]) {
-            // The centre's order bits with the position in the low 4: one integer compare per
-            // step.
-            let mut keys = [u64::MAX; SWEEP];
-            for (i, &p) in part.iter().enumerate() {
-                let c = cen[p as usize][axis];
-                let c = if c.is_nan() {
-                    f64::NEG_INFINITY
-                } else {
-                    c + 0.0
-                };
-                keys[i] = order_bits(c) & !0xF | i as u64;
-            }
-            sort_keys(&mut keys, len);
-            for (o, k) in order[axis].iter_mut().zip(&keys[..len]) {
-                *o = (k & 0xF) as u8;
-            }
-        }
+        let aabb = |a: usize, i: usize| &leaves[ord[a][start + i] as usize].aabb;
         // Areas of the right sides that leave a quarter on each side.
         let mut right = [[0.0f64; 3]; SWEEP];
         let mut acc = [Bounds::EMPTY; 3];
         for i in (least..len).rev() {
             for a in 0..3 {
-                acc[a] = acc[a].join(&boxes[order[a][i] as usize]);
+                acc[a].add(aabb(a, i));
                 right[i][a] = acc[a].area();
             }
         }
         let mut left = [Bounds::EMPTY; 3];
         for i in 0..least - 1 {
-            for a in 0..3 {
-                left[a] = left[a].join(&boxes[order[a][i] as usize]);
+            for (a, l) in left.iter_mut().enumerate() {
+                l.add(aabb(a, i));
             }
         }
         let mut here = [(f64::INFINITY, 0usize); 3];
-        for i in least..=len - least {
+        for (i, r) in right.iter().enumerate().take(len - least + 1).skip(least) {
             for a in 0..3 {
-                left[a] = left[a].join(&boxes[order[a][i - 1] as usize]);
-                let cost = left[a].area() * i as f64 + right[i][a] * (len - i) as f64;
+                left[a].add(aabb(a, i - 1));
+                let cost = left[a].area() * i as f64 + r[a] * (len - i) as f64;
                 if here[a].1 == 0 || cost < here[a].0 {
                     here[a] = (cost, i);
                 }
@@ -421,13 +434,44 @@ impl<'z> Zone<'z> {
                 best = Some((cost, nl, a));
             }
         }
-        let (_, nl, axis) = best?;
-        self.bin.clear();
-        self.bin.resize(len, 1);
-        for &o in &order[axis][..nl] {
-            self.bin[o as usize] = 0;
+        let Some((_, nl, axis)) = best else {
+            self.sorted[start] = false;
+            return None;
+        };
+        for (k, &p) in self.ord[axis][start..end].iter().enumerate() {
+            self.side[p as usize] = u8::from(k >= nl);
         }
+        let side = &self.side;
+        stable_split(&mut self.perm[start..end], nl, side, &mut self.tmp);
+        for o in &mut self.ord {
+            stable_split(&mut o[start..end], nl, side, &mut self.tmp);
+        }
+        self.sorted[start] = true;
+        self.sorted[start + nl] = true;
         Some(nl)
+    }
+
+    /// Sorts the positions of `start..start + len` (at most [`SWEEP`]) by centre on each axis
+    /// into `ord`: by the centre's order bits with the range index in the low 4 (one integer
+    /// compare per step), a NaN centre as −∞ and −0 as 0.
+    fn sort_range(&mut self, start: usize, len: usize) {
+        let part = &self.perm[start..start + len];
+        for axis in 0..3 {
+            let mut keys = [u64::MAX; SWEEP];
+            for (i, &p) in part.iter().enumerate() {
+                let c = self.cen[p as usize][axis];
+                let c = if c.is_nan() {
+                    f64::NEG_INFINITY
+                } else {
+                    c + 0.0
+                };
+                keys[i] = order_bits(c) & !0xF | i as u64;
+            }
+            sort_keys(&mut keys, len);
+            for (o, k) in self.ord[axis][start..start + len].iter_mut().zip(&keys) {
+                *o = part[(k & 0xF) as usize];
+            }
+        }
     }
 
     /// The binned cut of a longer range: centres in [`BINS`] equal bins of `lo..lo + e` on each
