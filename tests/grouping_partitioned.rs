@@ -439,6 +439,22 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
     old.remove("chunk_max");
     let params = wraptree::record::mcap::metadata::params(&old).unwrap();
     assert_eq!(params.mode.chunk_max, Chunking::DEFAULT.delta - 1);
+    // δ is recorded and read back: 4 by default, 2 on the fast path, and a recording without
+    // it was made with 4.
+    assert_eq!(
+        rec.metadata.get("chunk_delta").map(String::as_str),
+        Some("4")
+    );
+    old.remove("chunk_delta");
+    let params = wraptree::record::mcap::metadata::params(&old).unwrap();
+    assert_eq!(params.mode.chunk_delta, Chunking::DEFAULT.delta);
+    let out = wraptree(&["record", "s.obj", "--fast", "-o", "q"], dir.path());
+    let rec_q = recorded(&out, &dir.path().join("q.mcap"));
+    assert_eq!(rec_q.params.mode.chunk_delta, Chunking::FAST.delta);
+    assert_eq!(Chunking::FAST.delta, 2);
+    let out = wraptree(&["replay", "q.mcap", "--verify"], dir.path());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("verified"), "{text}");
     let out = wraptree(
         &[&args[..], &["f", "--chunk-epsilon", "0.7"]].concat(),
         dir.path(),

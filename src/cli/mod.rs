@@ -206,8 +206,9 @@ pub struct GroupArgs {
     #[arg(long, value_name = "N")]
     pub chunk_top: Option<u32>,
     /// Partitioned schedule: ε of AAC's reduction f(n) = ⌈c·n^(1/2 − ε)⌉, c = δ^(1/2 + ε)/2
-    /// (δ = 4), the bodies a node of n primitives leaves below the root share: 0.5 leaves 2
-    /// per node, AAC's fast setting 0.2 more (slower) [default: 0.5].
+    /// (δ = 4, 2 with --fast), the bodies a node of n primitives leaves below the root share:
+    /// 0.5 leaves 2 per node (1 with --fast), AAC's fast setting 0.2 more (slower)
+    /// [default: 0.5].
     #[arg(long, value_name = "E")]
     pub chunk_epsilon: Option<f64>,
     /// Partitioned schedule: ranges of at most N primitives are cut where binned SAH on the
@@ -248,6 +249,7 @@ impl GroupArgs {
                 instancing: self.instancing,
                 cost: self.cost,
                 chunk_top: self.chunk_top.unwrap_or(Mode::default().chunk_top),
+                chunk_delta: Mode::default().chunk_delta,
                 chunk_epsilon: self.chunk_epsilon.unwrap_or(Mode::default().chunk_epsilon),
                 chunk_sah: self.chunk_sah.unwrap_or(Mode::default().chunk_sah),
                 chunk_max: Mode::default().chunk_max,

@@ -159,6 +159,9 @@ pub struct Mode {
     /// subproblem (the exact schedule's tree); 0 = AAC's reduction alone. The exact schedule
     /// does not read it.
     pub chunk_top: u32,
+    /// The partitioned schedule's chunk size δ
+    /// ([`Chunking::delta`](crate::grouping::partitioned::Chunking::delta)), at least 2.
+    pub chunk_delta: u32,
     /// The partitioned schedule's ε in AAC's reduction f(n) = ⌈c·n^(1/2 − ε)⌉
     /// ([`Chunking::epsilon`](crate::grouping::partitioned::Chunking::epsilon)), in [0, 1/2].
     pub chunk_epsilon: f64,
@@ -181,6 +184,7 @@ impl Default for Mode {
             instancing: false,
             cost: CostMeasure::default(),
             chunk_top: crate::grouping::partitioned::Chunking::DEFAULT.top,
+            chunk_delta: crate::grouping::partitioned::Chunking::DEFAULT.delta,
             chunk_epsilon: crate::grouping::partitioned::Chunking::DEFAULT.epsilon,
             chunk_sah: crate::grouping::partitioned::Chunking::DEFAULT.sah_below,
             chunk_max: crate::grouping::partitioned::Chunking::DEFAULT.chunk_max,
@@ -190,13 +194,14 @@ impl Default for Mode {
 
 impl Mode {
     /// This mode on the fast path: the partitioned schedule with the split of
-    /// [`Chunking::FAST`](crate::grouping::partitioned::Chunking::FAST) (its root share, ε and
-    /// SAH cuts), pre-grouping and the Cost measure kept.
+    /// [`Chunking::FAST`](crate::grouping::partitioned::Chunking::FAST) (its root share, δ, ε
+    /// and SAH cuts), pre-grouping and the Cost measure kept.
     pub fn fast(self) -> Mode {
         let ch = crate::grouping::partitioned::Chunking::FAST;
         Mode {
             schedule: Schedule::Partitioned,
             chunk_top: ch.top,
+            chunk_delta: ch.delta,
             chunk_epsilon: ch.epsilon,
             chunk_sah: ch.sah_below,
             ..self
@@ -216,6 +221,12 @@ impl Mode {
         }
         if self.pregroup != Pregroup::None && pset != PSet::Aabb {
             return Err("--pregroup needs --pset aabb (parts are grouped as boxes)".to_string());
+        }
+        if self.chunk_delta < 2 {
+            return Err(format!(
+                "the chunk size δ must be at least 2, got {}",
+                self.chunk_delta
+            ));
         }
         if !(0.0..=0.5).contains(&self.chunk_epsilon) {
             return Err(format!(

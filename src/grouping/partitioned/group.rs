@@ -24,14 +24,14 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 /// How many leaves ahead the gather asks for the box it will read (its reads are random).
 const GATHER_AHEAD: usize = 16;
 
-/// The default [`Chunking`] with the root share `params.mode` names.
+/// The [`Chunking`] `params.mode` names.
 fn chunking_of(params: &ResolvedParams) -> Chunking {
     Chunking {
         top: params.mode.chunk_top,
         epsilon: params.mode.chunk_epsilon,
         sah_below: params.mode.chunk_sah,
         chunk_max: params.mode.chunk_max,
-        ..Chunking::DEFAULT
+        delta: params.mode.chunk_delta,
     }
 }
 

@@ -45,14 +45,17 @@ impl Chunking {
     };
 
     /// The fast path's split (`--fast`, bench method `fast`): the default's with a root share
-    /// of 32 bodies, so that scenes of 10^2–10^5 primitives are grouped in small subproblems (by
-    /// brute force) under a root step of about 32 bodies, and only scenes of at most 48
-    /// primitives are grouped whole. Its trees are further from the exact schedule's than the
-    /// default's; the fast path's refinement (`refine::FAST`) takes their SAH back down. Root
-    /// shares of 16–256 gave the same SAH and node tests after the refinement on 37 scenes, the
-    /// smaller ones in less time (`docs/benchmarks.md`, "Users' sizes").
+    /// of 32 bodies and δ = 2, so that f(n) = 1: below the root share every node merges its two
+    /// halves, and the tree there is the split's own (SAH cuts in ranges of up to 256
+    /// primitives, Morton cuts above), under a root step of about 32 bodies; only scenes of at
+    /// most 48 primitives are grouped whole. Its trees are further from the exact schedule's
+    /// than the default's; the fast path's refinement (`refine::FAST`) takes their SAH back
+    /// down. Root shares of 16–256 gave the same SAH and node tests after the refinement on 37
+    /// scenes, the smaller ones in less time; δ = 2 against 4 took about a tenth off the time
+    /// and left as good trees (`docs/benchmarks.md`, "Users' sizes").
     pub const FAST: Chunking = Chunking {
         top: 32,
+        delta: 2,
         ..Chunking::DEFAULT
     };
 

@@ -1,7 +1,7 @@
 //! The brute-force subproblems (`all_pairs`, `brute_force`) against the voxel-hash one on the same bodies.
 
 use super::subproblem::{Body, Counters, Leftover, MergeInfo, MergeSlots, PairList, RunInputs};
-use super::{brute_force, voxel_step};
+use super::{all_pairs, brute_force, voxel_step};
 use crate::geom::Aabb;
 use crate::grouping::{Budget, Params, Weights};
 use crate::scene::generate;
@@ -179,6 +179,90 @@ fn brute_force_equals_the_voxel_hash_run() {
     }
 }
 
+#[test]
+fn two_bodies_merge_as_the_table_of_pairs_merges_them() {
+    let budget = Budget::default();
+    let cube = |lo: f64, hi: f64| Aabb {
+        min: [lo; 3].into(),
+        max: [hi; 3].into(),
+    };
+    // Overlapping, far apart (eligible in a later round) and two points.
+    let boxes = [
+        (cube(0.0, 1.0), cube(0.5, 2.0)),
+        (cube(0.0, 0.1), cube(40.0, 41.0)),
+        (cube(3.0, 3.0), cube(3.0, 3.0)),
+    ];
+    let params = Params::default().resolve(&generate::soup(16, 3));
+    let ctx = RunInputs {
+        params,
+        dl: RoundLimits::new(params.dlimit0),
+        gl: RoundLimits::new(params.glimit0),
+        budget: &budget,
+        pairs: AtomicU64::new(0),
+        halt: AtomicBool::new(false),
+        reason: Mutex::new(None),
+    };
+    let mut rounds = Vec::new();
+    for (x, y) in boxes {
+        let body = |id, aabb: Aabb| Body {
+            id,
+            first_round: ctx.dl.first(aabb.diameter()),
+            aabb,
+            diameter: aabb.diameter(),
+        };
+        // One half of two bodies (a chunk), or two halves of one.
+        for split in [2, 1] {
+            let run = |pair: bool| {
+                let mut children = [[0u32; 2]; 1];
+                let (mut aabb, mut diameter) = ([Aabb::EMPTY; 1], [0.0; 1]);
+                let mut info = [MergeInfo::default(); 1];
+                let mut out = MergeSlots {
+                    first_new: 9,
+                    children: &mut children,
+                    aabb: &mut aabb,
+                    diameter: &mut diameter,
+                    info: Some(&mut info),
+                    stats: Counters::default(),
+                };
+                let mut arena = [body(4, x), body(7, y)];
+                let parts = [
+                    Leftover {
+                        n: split,
+                        pairs: PairList::new(),
+                    },
+                    Leftover {
+                        n: 2 - split,
+                        pairs: PairList::new(),
+                    },
+                ];
+                let left = if pair {
+                    all_pairs::pair(&ctx, &mut arena, parts, &mut out)
+                } else {
+                    all_pairs::run(&ctx, &mut arena, parts, 1, &mut out, true)
+                };
+                let stats = format!("{:?}", out.stats);
+                (
+                    children,
+                    aabb,
+                    diameter.map(f64::to_bits),
+                    format!("{:?}", info[0]),
+                    stats,
+                    left.n,
+                    left.pairs.len(),
+                    arena[0].id,
+                )
+            };
+            let got = run(true);
+            assert_eq!(got, run(false), "{x:?} {y:?} split {split}");
+            rounds.push(got.3.contains("round: 0,"));
+        }
+    }
+    // Both merges at the first round start and merges that wait for a later one.
+    assert!(
+        rounds.contains(&true) && rounds.contains(&false),
+        "{rounds:?}"
+    );
+}
 #[test]
 fn limits_are_the_base_doubled_up_to_the_first_infinity() {
     for base in [

@@ -17,7 +17,7 @@ pub fn group_text(scene: &Scene, g: &Grouping, threads: usize, seconds: f64) -> 
     let chunking = match p.mode.schedule {
         grouping::Schedule::Partitioned => format!(
             " (chunks of δ = {}, ε = {}, root share {}, {})",
-            grouping::partitioned::Chunking::DEFAULT.delta,
+            p.mode.chunk_delta,
             p.mode.chunk_epsilon,
             p.mode.chunk_top,
             match p.mode.chunk_sah {

@@ -60,10 +60,10 @@ pub const STOP_KEYS: &[&str] = &["stop_reason", "stop_eligible_pairs"];
 pub const LOAD_KEYS: &[&str] = &["up"];
 
 /// Keys the `wraptree` record adds for the partitioned schedule ([`Chunking`]): its chunk size
-/// δ (informative, fixed in a build), the reduction function's ε (`--chunk-epsilon`), the
-/// root's share `top` (`--chunk-top`), the SAH cuts' range size (`--chunk-sah`) and the
-/// largest chunk (0 = δ), the last four read back by `replay` (a recording without `chunk_sah`
-/// was cut at Morton bits only, one without `chunk_max` into chunks of fewer than δ).
+/// δ (4, or 2 on the fast path), the reduction function's ε (`--chunk-epsilon`), the root's
+/// share `top` (`--chunk-top`), the SAH cuts' range size (`--chunk-sah`) and the largest chunk
+/// (0 = δ), all read back by `replay` (a recording without `chunk_sah` was cut at Morton bits
+/// only, one without `chunk_max` into chunks of fewer than δ).
 pub const PARTITIONED_KEYS: &[&str] = &[
     "chunk_delta",
     "chunk_epsilon",
@@ -206,8 +206,7 @@ pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String,
     put("instancing", p.mode.instancing.to_string());
     put("cost", value_name(&p.mode.cost));
     if p.mode.schedule == Schedule::Partitioned {
-        let ch = Chunking::DEFAULT;
-        put("chunk_delta", ch.delta.to_string());
+        put("chunk_delta", p.mode.chunk_delta.to_string());
         put("chunk_epsilon", p.mode.chunk_epsilon.to_string());
         put("chunk_top", p.mode.chunk_top.to_string());
         put("chunk_sah", p.mode.chunk_sah.to_string());
@@ -321,6 +320,10 @@ fn mode(m: &BTreeMap<String, String>) -> Result<Mode> {
         chunk_top: match m.contains_key("chunk_top") {
             true => parse(m, "chunk_top")?,
             false => d.chunk_top,
+        },
+        chunk_delta: match m.contains_key("chunk_delta") {
+            true => parse(m, "chunk_delta")?,
+            false => d.chunk_delta,
         },
         // A recording without `chunk_epsilon` was made with the default ε.
         chunk_epsilon: match m.contains_key("chunk_epsilon") {
