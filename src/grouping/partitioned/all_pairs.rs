@@ -83,32 +83,28 @@ impl Pairs {
     }
 }
 
-/// [`run`] for two bodies that become one: the same merge, counters and event, without the
-/// table of pairs (below the root's share of the fast path's split every node does this).
+/// [`run`] for two bodies `x` and `y` (in slot order) that become one, without the table of
+/// pairs: the same merge (slot 0 of `out`), event and counters (added to `stats`); returns the
+/// new body. Below the root's share of the fast path's split every node does this
+/// ([`Executor::merge_down`](super::executor::Executor::merge_down)).
 pub(super) fn pair(
     ctx: &RunInputs,
-    body: &mut [Body],
-    parts: [Leftover; 2],
+    x: &Body,
+    y: &Body,
     out: &mut MergeSlots<'_>,
-) -> Leftover {
-    debug_assert!(body.len() == 2 && parts[0].n + parts[1].n == 2);
-    let mut st = Counters::default();
-    let mut round = NEVER;
-    pairs_of(ctx, body, &parts, &mut st, |_, _, (_, r)| round = r);
+    stats: &mut Counters,
+) -> Body {
+    let (_, round) = eval(ctx, x, y);
     assert!(round != NEVER, "bodies of NaN size never become eligible");
-    // Eligible at the first round start, or at the round start it waits for.
-    st.eligible_pairs += 1;
-    st.pops += 1;
-    let (x, y) = (body[0], body[1]);
-    body[0] = merged(ctx, &x, &y, out.first_new);
+    let body = merged(ctx, x, y, out.first_new);
     // No body is left with a partner.
-    put_merge(ctx, out, 0, [&x, &y], &body[0], round, || 0);
-    st.rounds = round + 1;
-    out.stats.add(&st);
-    Leftover {
-        n: 1,
-        pairs: super::subproblem::PairList::new(),
-    }
+    put_merge(ctx, out, 0, [x, y], &body, round, || 0);
+    // The pair is eligible at the first round start, or at the one it waits for.
+    stats.eligible_pairs += 1;
+    stats.candidates += 1;
+    stats.pops += 1;
+    stats.rounds = stats.rounds.max(round + 1);
+    body
 }
 
 /// [`brute_force::combine`](super::brute_force::combine) for at most [`TINY`] bodies (more than `keep`).

@@ -327,9 +327,6 @@ pub(super) fn combine(
             pairs: PairList::new(),
         };
     }
-    if body.len() == 2 {
-        return super::all_pairs::pair(ctx, body, parts, out);
-    }
     if body.len() <= super::all_pairs::TINY {
         return super::all_pairs::run(ctx, body, parts, keep, out, export);
     }

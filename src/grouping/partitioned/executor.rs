@@ -3,7 +3,7 @@
 
 use super::plan::Node;
 use super::subproblem::{Body, Counters, Leftover, MergeSlots, PairList, RunInputs};
-use super::{brute_force, voxel_step};
+use super::{all_pairs, brute_force, voxel_step};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Halves of at least this many primitives are grouped in parallel.
@@ -29,6 +29,9 @@ impl Executor<'_> {
         export: bool,
     ) -> (Option<Leftover>, Counters) {
         let node = self.nodes[k as usize];
+        if node.keep == 1 && node.inputs <= 2 {
+            return self.single(k, arena, out);
+        }
         let (parts, mut own, mut stats) = match node.kids(k) {
             None => {
                 for b in arena.iter_mut() {
@@ -104,5 +107,89 @@ impl Executor<'_> {
             self.done[k as usize].store(true, Ordering::Relaxed);
         }
         (left, stats)
+    }
+
+    /// [`Executor::node`] for a node that merges the two bodies its halves leave (or that is a
+    /// chunk of at most two primitives leaving one): below it every node does the same, since
+    /// what a node keeps grows with its size, so the subtree is grouped by [`merge_down`]
+    /// without the subproblems' tables, each merge made by [`all_pairs::pair`].
+    ///
+    /// [`merge_down`]: Executor::merge_down
+    fn single(
+        &self,
+        k: u32,
+        arena: &mut [Body],
+        out: MergeSlots<'_>,
+    ) -> (Option<Leftover>, Counters) {
+        let mut stats = Counters::default();
+        let Some(body) = self.merge_down(k, arena, out, &mut stats) else {
+            return (None, stats);
+        };
+        arena[0] = body;
+        if !self.ctx.budget.is_unlimited() {
+            self.ctx
+                .pairs
+                .fetch_add(stats.eligible_pairs, Ordering::Relaxed);
+        }
+        let left = Leftover {
+            n: 1,
+            pairs: PairList::new(),
+        };
+        (Some(left), stats)
+    }
+
+    /// The body node `k`'s subtree groups into, each node merging its halves' bodies (see
+    /// [`Executor::single`]), its merges written to `out` in post-order and counted into
+    /// `stats`; `None` when the budget stopped it (checked at nodes of [`GRAIN`] primitives
+    /// and more, and at the first).
+    fn merge_down(
+        &self,
+        k: u32,
+        arena: &mut [Body],
+        out: MergeSlots<'_>,
+        stats: &mut Counters,
+    ) -> Option<Body> {
+        let node = self.nodes[k as usize];
+        let size = node.hi - node.lo;
+        if (size >= GRAIN || stats.pops == 0) && self.ctx.exceeded() {
+            return None;
+        }
+        let (x, y, mut own) = match node.kids(k) {
+            None => {
+                for b in arena.iter_mut() {
+                    b.first_round = self.ctx.dl.first(b.diameter);
+                }
+                if arena.len() == 1 {
+                    self.done[k as usize].store(true, Ordering::Relaxed);
+                    return Some(arena[0]);
+                }
+                debug_assert_eq!(arena.len(), 2);
+                (arena[0], arena[1], out)
+            }
+            Some((l, r)) => {
+                let ln = self.nodes[l as usize];
+                debug_assert!(ln.keep == 1 && self.nodes[r as usize].keep == 1);
+                let lm = ln.merges() as usize;
+                let (lout, rest) = out.split(lm);
+                let (rout, own) = rest.split(node.below() as usize - lm);
+                let (la, ra) = arena.split_at_mut((ln.hi - ln.lo) as usize);
+                let (x, y) = if size >= GRAIN {
+                    let mut rs = Counters::default();
+                    let (x, y) = rayon::join(
+                        || self.merge_down(l, la, lout, stats),
+                        || self.merge_down(r, ra, rout, &mut rs),
+                    );
+                    stats.add(&rs);
+                    (x?, y?)
+                } else {
+                    let x = self.merge_down(l, la, lout, stats)?;
+                    (x, self.merge_down(r, ra, rout, stats)?)
+                };
+                (x, y, own)
+            }
+        };
+        let body = all_pairs::pair(self.ctx, &x, &y, &mut own, stats);
+        self.done[k as usize].store(true, Ordering::Relaxed);
+        Some(body)
     }
 }

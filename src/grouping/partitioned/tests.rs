@@ -235,12 +235,19 @@ fn two_bodies_merge_as_the_table_of_pairs_merges_them() {
                         pairs: PairList::new(),
                     },
                 ];
-                let left = if pair {
-                    all_pairs::pair(&ctx, &mut arena, parts, &mut out)
+                let (left, stats) = if pair {
+                    let mut stats = Counters::default();
+                    arena[0] = all_pairs::pair(&ctx, &arena[0], &arena[1], &mut out, &mut stats);
+                    let left = Leftover {
+                        n: 1,
+                        pairs: PairList::new(),
+                    };
+                    (left, stats)
                 } else {
-                    all_pairs::run(&ctx, &mut arena, parts, 1, &mut out, true)
+                    let left = all_pairs::run(&ctx, &mut arena, parts, 1, &mut out, true);
+                    (left, out.stats)
                 };
-                let stats = format!("{:?}", out.stats);
+                let stats = format!("{stats:?}");
                 (
                     children,
                     aabb,
