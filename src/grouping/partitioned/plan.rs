@@ -51,8 +51,9 @@ impl Chunking {
     /// most 48 primitives are grouped whole. Its trees are further from the exact schedule's
     /// than the default's; the fast path's refinement (`refine::FAST`) takes their SAH back
     /// down. Root shares of 16–256 gave the same SAH and node tests after the refinement on 37
-    /// scenes, the smaller ones in less time; δ = 2 against 4 took about a tenth off the time
-    /// and left as good trees (`docs/benchmarks.md`, "Users' sizes").
+    /// scenes, the smaller ones in less time; δ = 2 against 4 (with the executor's lean
+    /// recursion for such subtrees) took about a fifth off the time and left as good trees
+    /// (`docs/benchmarks.md`, "Users' sizes").
     pub const FAST: Chunking = Chunking {
         top: 32,
         delta: 2,
