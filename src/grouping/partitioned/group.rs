@@ -2,7 +2,6 @@
 //! executor run over it, the events announced and the Subset Tree assembled.
 
 use super::announce::{Built, announce};
-use super::brute_force::RoundLimits;
 use super::executor::Executor;
 use super::plan::{Chunking, Node, plan};
 use super::split::morton_order;
@@ -18,8 +17,7 @@ use crate::grouping::{
 use crate::par::{POOL_MIN, on_pool};
 use crate::scene::Scene;
 use rayon::prelude::*;
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// How many leaves ahead the gather asks for the box it will read (its reads are random).
 const GATHER_AHEAD: usize = 16;
@@ -96,15 +94,7 @@ pub fn group_boxes<O: Observer>(
 ) -> Result<Grouping, Stopped> {
     assert!(!aabb.is_empty(), "grouping needs at least one primitive");
     let n = aabb.len();
-    let ctx = RunInputs {
-        params: *params,
-        dl: RoundLimits::new(params.dlimit0),
-        gl: RoundLimits::new(params.glimit0),
-        budget,
-        pairs: AtomicU64::new(0),
-        halt: AtomicBool::new(false),
-        reason: Mutex::new(None),
-    };
+    let ctx = RunInputs::new(*params, budget);
     let listens = !observer.is_silent();
     let g = on_pool(n >= POOL_MIN, || {
         split_and_group(aabb, chunking, &ctx, listens)

@@ -77,6 +77,21 @@ pub(super) struct RunInputs<'a> {
     pub(super) reason: Mutex<Option<StopReason>>,
 }
 
+impl<'a> RunInputs<'a> {
+    /// The inputs of a run with `params` under `budget`, nothing counted or stopped yet.
+    pub(super) fn new(params: ResolvedParams, budget: &'a Budget<'a>) -> RunInputs<'a> {
+        RunInputs {
+            params,
+            dl: RoundLimits::new(params.dlimit0),
+            gl: RoundLimits::new(params.glimit0),
+            budget,
+            pairs: AtomicU64::new(0),
+            halt: AtomicBool::new(false),
+            reason: Mutex::new(None),
+        }
+    }
+}
+
 impl RunInputs<'_> {
     /// Whether the budget stops the run before a subproblem.
     pub(super) fn exceeded(&self) -> bool {

@@ -6,8 +6,6 @@ use crate::geom::Aabb;
 use crate::grouping::{Budget, Params, Weights};
 use crate::scene::generate;
 use brute_force::RoundLimits;
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, AtomicU64};
 
 /// Children, Cost bits and round of each merge, and the ids of the bodies left.
 type Solved = (Vec<([u32; 2], u64, u32)>, Vec<u32>);
@@ -131,15 +129,7 @@ fn brute_force_equals_the_voxel_hash_run() {
                 ..Params::default()
             }
             .resolve(&scene);
-            let ctx = RunInputs {
-                params,
-                dl: RoundLimits::new(params.dlimit0),
-                gl: RoundLimits::new(params.glimit0),
-                budget: &budget,
-                pairs: AtomicU64::new(0),
-                halt: AtomicBool::new(false),
-                reason: Mutex::new(None),
-            };
+            let ctx = RunInputs::new(params, &budget);
             // Ids spread out as in a larger run: body i has id 3i + 1.
             let bodies: Vec<Body> = (0..n)
                 .map(|i| {
@@ -193,15 +183,7 @@ fn two_bodies_merge_as_the_table_of_pairs_merges_them() {
         (cube(3.0, 3.0), cube(3.0, 3.0)),
     ];
     let params = Params::default().resolve(&generate::soup(16, 3));
-    let ctx = RunInputs {
-        params,
-        dl: RoundLimits::new(params.dlimit0),
-        gl: RoundLimits::new(params.glimit0),
-        budget: &budget,
-        pairs: AtomicU64::new(0),
-        halt: AtomicBool::new(false),
-        reason: Mutex::new(None),
-    };
+    let ctx = RunInputs::new(params, &budget);
     let mut rounds = Vec::new();
     for (x, y) in boxes {
         let body = |id, aabb: Aabb| Body {
