@@ -234,6 +234,41 @@ fn the_largest_chunk_is_delta_unless_set_and_aacs_rule_still_runs() {
     assert_ne!(by_delta, run(Chunking::DEFAULT.delta - 1));
 }
 
+#[test]
+fn with_delta_2_nodes_merge_their_halves_and_larger_chunks_still_group_whole() {
+    // δ = 2 (the fast path's): below the root share every node keeps one body. Chunks of up
+    // to 6 primitives then group down to one body each inside such subtrees; both trees are
+    // valid, announced in full, and the same on 1 and 2 threads.
+    let scene = generate::soup(3_000, 13);
+    let resolved = Params::default().resolve(&scene);
+    let run = |chunk_max, threads| {
+        let chunking = Chunking {
+            top: 32,
+            delta: 2,
+            chunk_max,
+            ..Chunking::DEFAULT
+        };
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut log = EventLog::default();
+        let g = pool
+            .install(|| group_with(&scene, &resolved, &chunking, &mut log, &Budget::default()))
+            .unwrap();
+        check_tree(&scene, &g, &log);
+        g.tree
+    };
+    for chunk_max in [0, 6] {
+        assert_eq!(
+            run(chunk_max, 1),
+            run(chunk_max, 2),
+            "chunk_max {chunk_max}"
+        );
+    }
+    assert_ne!(run(0, 1), run(6, 1));
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
 

@@ -76,26 +76,7 @@ impl Executor<'_> {
         if self.ctx.exceeded() {
             return (None, stats);
         }
-        let keep = node.keep as usize;
-        let m = parts[0].n + parts[1].n;
-        let left = if m <= brute_force::SMALL {
-            Some(brute_force::combine(
-                self.ctx,
-                &mut arena[..m],
-                parts,
-                keep,
-                &mut own,
-                export,
-            ))
-        } else {
-            voxel_step::combine(self.ctx, arena[..m].to_vec(), keep, &mut own).map(|bodies| {
-                arena[..bodies.len()].copy_from_slice(&bodies);
-                Leftover {
-                    n: bodies.len(),
-                    pairs: PairList::new(),
-                }
-            })
-        };
+        let left = self.own_step(arena, parts, node.keep as usize, &mut own, export);
         // Only a budget reads the shared count (an atomic add per node costs on 2 threads).
         if !self.ctx.budget.is_unlimited() {
             self.ctx
@@ -109,10 +90,41 @@ impl Executor<'_> {
         (left, stats)
     }
 
+    /// A node's own subproblem: the bodies its halves left (`parts`, side by side at the start
+    /// of `arena`) grouped until `keep` remain, by brute force or with the voxel hash; `None`
+    /// when the budget stopped it.
+    fn own_step(
+        &self,
+        arena: &mut [Body],
+        parts: [Leftover; 2],
+        keep: usize,
+        own: &mut MergeSlots<'_>,
+        export: bool,
+    ) -> Option<Leftover> {
+        let m = parts[0].n + parts[1].n;
+        if m <= brute_force::SMALL {
+            return Some(brute_force::combine(
+                self.ctx,
+                &mut arena[..m],
+                parts,
+                keep,
+                own,
+                export,
+            ));
+        }
+        voxel_step::combine(self.ctx, arena[..m].to_vec(), keep, own).map(|bodies| {
+            arena[..bodies.len()].copy_from_slice(&bodies);
+            Leftover {
+                n: bodies.len(),
+                pairs: PairList::new(),
+            }
+        })
+    }
+
     /// [`Executor::node`] for a node that merges the two bodies its halves leave (or that is a
-    /// chunk of at most two primitives leaving one): below it every node does the same, since
-    /// what a node keeps grows with its size, so the subtree is grouped by [`merge_down`]
-    /// without the subproblems' tables, each merge made by [`all_pairs::pair`].
+    /// chunk of at most two primitives leaving one): below it every node keeps one body too,
+    /// since what a node keeps grows with its size, so the subtree is grouped by [`merge_down`]
+    /// without the subproblems' tables, each merge of two bodies made by [`all_pairs::pair`].
     ///
     /// [`merge_down`]: Executor::merge_down
     fn single(
@@ -159,11 +171,20 @@ impl Executor<'_> {
                 for b in arena.iter_mut() {
                     b.first_round = self.ctx.dl.first(b.diameter);
                 }
-                if arena.len() == 1 {
+                if arena.len() != 2 {
+                    // One primitive, or a chunk of more that keeps one (`chunk_max` above 2):
+                    // its own subproblem.
+                    let mut out = out;
+                    let part = Leftover {
+                        n: arena.len(),
+                        pairs: PairList::new(),
+                    };
+                    let parts = [part, Leftover::default()];
+                    self.own_step(arena, parts, 1, &mut out, false)?;
+                    stats.add(&out.stats);
                     self.done[k as usize].store(true, Ordering::Relaxed);
                     return Some(arena[0]);
                 }
-                debug_assert_eq!(arena.len(), 2);
                 (arena[0], arena[1], out)
             }
             Some((l, r)) => {
