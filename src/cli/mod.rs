@@ -184,9 +184,9 @@ pub struct GroupArgs {
     /// of a Morton split, bottom-up, in parallel).
     #[arg(long, value_enum, default_value_t = Schedule::Exact)]
     pub schedule: Schedule,
-    /// The fast path: the partitioned schedule with small subproblems (root share 32; the
-    /// --chunk-* flags still apply); with `record`, `--refine --refine-treelet-passes 0` adds
-    /// its refinement.
+    /// The fast path: the partitioned schedule whose split is the tree below a root share of
+    /// 32 (chunks of δ = 2; the --chunk-* flags still apply); with `record`, `--refine
+    /// --refine-treelet-passes 0` adds its refinement.
     #[arg(long, conflicts_with = "schedule")]
     pub fast: bool,
     /// Components grouped on their own first: none, objects (the file's o/g), connected
