@@ -483,6 +483,14 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
     old.remove("chunk_delta");
     let params = wraptree::record::mcap::metadata::params(&old).unwrap();
     assert_eq!(params.mode.chunk_delta, Chunking::DEFAULT.delta);
+    old.insert("chunk_delta".into(), "1".into());
+    let err = wraptree::record::mcap::metadata::params(&old).unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("chunk_delta (δ) must be at least 2, got 1"),
+        "{err}"
+    );
+    old.remove("chunk_delta");
     let out = wraptree(&["record", "s.obj", "--fast", "-o", "q"], dir.path());
     let rec_q = recorded(&out, &dir.path().join("q.mcap"));
     assert_eq!(rec_q.params.mode.chunk_delta, Chunking::FAST.delta);

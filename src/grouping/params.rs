@@ -224,7 +224,7 @@ impl Mode {
         }
         if self.chunk_delta < 2 {
             return Err(format!(
-                "the chunk size δ must be at least 2, got {}",
+                "chunk_delta (δ) must be at least 2, got {}",
                 self.chunk_delta
             ));
         }

@@ -34,9 +34,7 @@ impl Executor<'_> {
         }
         let (parts, mut own, mut stats) = match node.kids(k) {
             None => {
-                for b in arena.iter_mut() {
-                    b.first_round = self.ctx.dl.first(b.diameter);
-                }
+                self.first_rounds(arena);
                 let part = Leftover {
                     n: arena.len(),
                     pairs: PairList::new(),
@@ -77,17 +75,27 @@ impl Executor<'_> {
             return (None, stats);
         }
         let left = self.own_step(arena, parts, node.keep as usize, &mut own, export);
-        // Only a budget reads the shared count (an atomic add per node costs on 2 threads).
-        if !self.ctx.budget.is_unlimited() {
-            self.ctx
-                .pairs
-                .fetch_add(own.stats.eligible_pairs, Ordering::Relaxed);
-        }
+        self.count_pairs(own.stats.eligible_pairs);
         stats.add(&own.stats);
         if left.is_some() {
             self.done[k as usize].store(true, Ordering::Relaxed);
         }
         (left, stats)
+    }
+
+    /// Sets each primitive's first round within DLimit (a chunk's bodies on entry).
+    fn first_rounds(&self, arena: &mut [Body]) {
+        for b in arena.iter_mut() {
+            b.first_round = self.ctx.dl.first(b.diameter);
+        }
+    }
+
+    /// Adds a finished subproblem's eligible pairs to the run's count, which only a budget
+    /// reads (an atomic add per node costs on 2 threads).
+    fn count_pairs(&self, pairs: u64) {
+        if !self.ctx.budget.is_unlimited() {
+            self.ctx.pairs.fetch_add(pairs, Ordering::Relaxed);
+        }
     }
 
     /// A node's own subproblem: the bodies its halves left (`parts`, side by side at the start
@@ -138,11 +146,7 @@ impl Executor<'_> {
             return (None, stats);
         };
         arena[0] = body;
-        if !self.ctx.budget.is_unlimited() {
-            self.ctx
-                .pairs
-                .fetch_add(stats.eligible_pairs, Ordering::Relaxed);
-        }
+        self.count_pairs(stats.eligible_pairs);
         let left = Leftover {
             n: 1,
             pairs: PairList::new(),
@@ -168,9 +172,7 @@ impl Executor<'_> {
         }
         let (x, y, mut own) = match node.kids(k) {
             None => {
-                for b in arena.iter_mut() {
-                    b.first_round = self.ctx.dl.first(b.diameter);
-                }
+                self.first_rounds(arena);
                 if arena.len() != 2 {
                     // One primitive, or a chunk of more that keeps one (`chunk_max` above 2):
                     // its own subproblem.

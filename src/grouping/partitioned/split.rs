@@ -190,11 +190,9 @@ pub(super) struct Zone<'z> {
     perm: Vec<u32>,
     /// Doubled centre (min + max) of each primitive, by position on entry.
     cen: Vec<[f64; 3]>,
-    /// Bin on the chosen axis of each primitive of the range a binned cut cuts, and the
-    /// partitions' buffer.
-    bin: Vec<u8>,
     /// Bins of each primitive of the range being cut on the three axes (binned cuts).
     bins: Vec<[u8; 3]>,
+    /// The partitions' buffer.
     tmp: Vec<u32>,
     /// Per axis, the positions on entry of each range of at most [`SWEEP`] primitives sorted
     /// by centre as a sweep orders them, at the range's place in the planned order: a sweep
@@ -292,14 +290,19 @@ fn centres(cen: &[[f64; 3]], ps: impl Iterator<Item = u32>) -> Bounds {
     b
 }
 
-/// Moves the positions of `part` whose `side` is 0 (`nl` of them) before the others, each
-/// side in its order, without branches; `tmp` is scratch.
+/// Moves the positions of `part` that are not `right` (given their index and position; `nl`
+/// of them) before the others, each side in its order, without branches; `tmp` is scratch.
 #[inline(always)]
-fn stable_split(part: &mut [u32], nl: usize, side: &[u8], tmp: &mut Vec<u32>) {
+fn stable_split(
+    part: &mut [u32],
+    nl: usize,
+    tmp: &mut Vec<u32>,
+    right: impl Fn(usize, u32) -> bool,
+) {
     tmp.resize(part.len(), 0);
     let (mut li, mut ri) = (0, nl);
-    for &p in part.iter() {
-        let right = usize::from(side[p as usize]);
+    for (i, &p) in part.iter().enumerate() {
+        let right = usize::from(right(i, p));
         let d = if right == 0 { li } else { ri };
         tmp[d] = p;
         li += 1 - right;
@@ -324,7 +327,6 @@ impl<'z> Zone<'z> {
             leaves,
             perm: (0..m as u32).collect(),
             cen,
-            bin: Vec::with_capacity(m),
             bins: Vec::with_capacity(m),
             tmp: Vec::with_capacity(m),
             ord: [vec![0; m], vec![0; m], vec![0; m]],
@@ -358,30 +360,23 @@ impl<'z> Zone<'z> {
             cb.hi[1] - cb.lo[1],
             cb.hi[2] - cb.lo[2],
         ];
-        // Every axis with a span is tried; the cheapest cut wins (ties to the lower axis), its
-        // sides kept in `bin`. Bins from `cut` on are the right side.
+        // Every axis with a span is tried; the cheapest cut wins (ties to the lower axis). Bins
+        // from `cut` on are the right side.
         let spans = e.map(|w| w > 0.0 && w.is_finite());
         if len <= SWEEP {
             return self.sweep(start, len, spans);
         }
         // One pass bins the centres on all three axes at once.
         let (nl, cut, axis) = self.binned(start, len, &cb.lo, &e, spans)?;
-        self.bin.clear();
-        self.bin.extend(self.bins.iter().map(|b| b[axis]));
         self.sorted[start] = false;
         self.sorted[start + nl] = false;
-        // A stable partition of the positions (side 0 first), without branches.
-        self.tmp.resize(len, 0);
-        let part = &mut self.perm[start..start + len];
-        let (mut li, mut ri) = (0, nl);
-        for (i, &p) in part.iter().enumerate() {
-            let right = usize::from(self.bin[i] >= cut);
-            let d = if right == 0 { li } else { ri };
-            self.tmp[d] = p;
-            li += 1 - right;
-            ri += right;
-        }
-        part.copy_from_slice(&self.tmp[..len]);
+        let bins = &self.bins;
+        stable_split(
+            &mut self.perm[start..start + len],
+            nl,
+            &mut self.tmp,
+            |i, _| bins[i][axis] >= cut,
+        );
         Some(nl)
     }
 
@@ -441,10 +436,10 @@ impl<'z> Zone<'z> {
         for (k, &p) in self.ord[axis][start..end].iter().enumerate() {
             self.side[p as usize] = u8::from(k >= nl);
         }
-        let side = &self.side;
-        stable_split(&mut self.perm[start..end], nl, side, &mut self.tmp);
+        let right = |_, p: u32| self.side[p as usize] == 1;
+        stable_split(&mut self.perm[start..end], nl, &mut self.tmp, right);
         for o in &mut self.ord {
-            stable_split(&mut o[start..end], nl, side, &mut self.tmp);
+            stable_split(&mut o[start..end], nl, &mut self.tmp, right);
         }
         self.sorted[start] = true;
         self.sorted[start + nl] = true;
