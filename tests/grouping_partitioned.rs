@@ -491,10 +491,29 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
         "{err}"
     );
     old.remove("chunk_delta");
+    // The largest range that tries every partition: 0 by default, 4 on the fast path; a
+    // recording without it was cut by sweeps.
+    assert_eq!(rec.metadata.get("chunk_few").map(String::as_str), Some("0"));
+    old.insert("chunk_few".into(), "5".into());
+    let err = wraptree::record::mcap::metadata::params(&old).unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("chunk_few must be at most 4, got 5"),
+        "{err}"
+    );
+    old.remove("chunk_few");
     let out = wraptree(&["record", "s.obj", "--fast", "-o", "q"], dir.path());
     let rec_q = recorded(&out, &dir.path().join("q.mcap"));
     assert_eq!(rec_q.params.mode.chunk_delta, Chunking::FAST.delta);
     assert_eq!(Chunking::FAST.delta, 2);
+    assert_eq!(
+        rec_q.metadata.get("chunk_few").map(String::as_str),
+        Some("4")
+    );
+    let mut fast_old = rec_q.metadata.clone();
+    fast_old.remove("chunk_few");
+    let params = wraptree::record::mcap::metadata::params(&fast_old).unwrap();
+    assert_eq!(params.mode.chunk_few, 0);
     let out = wraptree(&["replay", "q.mcap", "--verify"], dir.path());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success() && text.contains("verified"), "{text}");

@@ -253,6 +253,7 @@ impl GroupArgs {
                 chunk_epsilon: self.chunk_epsilon.unwrap_or(Mode::default().chunk_epsilon),
                 chunk_sah: self.chunk_sah.unwrap_or(Mode::default().chunk_sah),
                 chunk_max: Mode::default().chunk_max,
+                chunk_few: Mode::default().chunk_few,
             },
         };
         if self.fast {

@@ -173,6 +173,11 @@ pub struct Mode {
     /// The partitioned schedule's largest chunk
     /// ([`Chunking::chunk_max`](crate::grouping::partitioned::Chunking::chunk_max)); 0 = δ.
     pub chunk_max: u32,
+    /// The partitioned schedule's smallest cuts: ranges of 3 up to this many primitives (at
+    /// most 4) that are cut try every partition
+    /// ([`Chunking::few`](crate::grouping::partitioned::Chunking::few)); 0 = the SAH sweep. The
+    /// fast path sets 4.
+    pub chunk_few: u32,
 }
 
 impl Default for Mode {
@@ -188,6 +193,7 @@ impl Default for Mode {
             chunk_epsilon: crate::grouping::partitioned::Chunking::DEFAULT.epsilon,
             chunk_sah: crate::grouping::partitioned::Chunking::DEFAULT.sah_below,
             chunk_max: crate::grouping::partitioned::Chunking::DEFAULT.chunk_max,
+            chunk_few: crate::grouping::partitioned::Chunking::DEFAULT.few,
         }
     }
 }
@@ -204,6 +210,7 @@ impl Mode {
             chunk_delta: ch.delta,
             chunk_epsilon: ch.epsilon,
             chunk_sah: ch.sah_below,
+            chunk_few: ch.few,
             ..self
         }
     }
@@ -226,6 +233,12 @@ impl Mode {
             return Err(format!(
                 "chunk_delta (δ) must be at least 2, got {}",
                 self.chunk_delta
+            ));
+        }
+        if self.chunk_few > 4 {
+            return Err(format!(
+                "chunk_few must be at most 4, got {}",
+                self.chunk_few
             ));
         }
         if !(0.0..=0.5).contains(&self.chunk_epsilon) {

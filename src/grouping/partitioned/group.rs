@@ -30,6 +30,7 @@ fn chunking_of(params: &ResolvedParams) -> Chunking {
         sah_below: params.mode.chunk_sah,
         chunk_max: params.mode.chunk_max,
         delta: params.mode.chunk_delta,
+        few: params.mode.chunk_few,
     }
 }
 

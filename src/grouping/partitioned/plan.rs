@@ -29,6 +29,10 @@ pub struct Chunking {
     /// cut is saved (about 5 % of the fast path's time, SAH and node tests within 0.2 % on 37
     /// scenes).
     pub chunk_max: u32,
+    /// Ranges of 3 up to this many primitives (at most 4) that are cut, not chunks, try every
+    /// partition for the best binary tree over their leaves instead of the SAH sweep (`split`);
+    /// 0 = the sweep. Only δ = 2 (or `chunk_max` below 4) leaves such ranges to be cut.
+    pub few: u32,
 }
 
 impl Chunking {
@@ -42,6 +46,7 @@ impl Chunking {
         top: 8192,
         sah_below: 256,
         chunk_max: 0,
+        few: 0,
     };
 
     /// The fast path's split (`--fast`, bench method `fast`): the default's with a root share
@@ -57,6 +62,7 @@ impl Chunking {
     pub const FAST: Chunking = Chunking {
         top: 32,
         delta: 2,
+        few: 4,
         ..Chunking::DEFAULT
     };
 
@@ -276,7 +282,7 @@ impl Planner<'_> {
     ) -> (u32, u32) {
         let size = codes.len() as u32;
         if self.sah(size) {
-            let mut zone = Zone::new(codes, leaves);
+            let mut zone = Zone::new(codes, leaves, self.keep.chunking.few);
             let planned = self.build_with(
                 &mut |start, len| zone.cut(start, len),
                 0,
@@ -438,7 +444,10 @@ pub(super) mod tests {
                 top: 0,
                 sah_below: 0,
                 chunk_max: 7,
+                few: 0,
             },
+            // The fast path's split: ranges of 3 and 4 try every partition.
+            Chunking::FAST,
             // SAH cuts in the parallel part of the plan too.
             Chunking {
                 sah_below: 4 * PLAN_GRAIN,

@@ -209,6 +209,8 @@ pub(super) struct Zone<'z> {
     /// Side (0 left, 1 right) of each primitive of the range a sweep cuts, by position on
     /// entry.
     side: Vec<u8>,
+    /// Ranges of 3 up to this many primitives try every partition ([`Zone::few`]).
+    few: usize,
 }
 
 /// Surface area of the box `lo..hi`.
@@ -317,8 +319,9 @@ fn stable_split(
 }
 
 impl<'z> Zone<'z> {
-    /// A zone over `codes` and `leaves` (the same order, Morton-sorted).
-    pub(super) fn new(codes: &'z mut [(u64, u32)], leaves: &'z mut [Body]) -> Zone<'z> {
+    /// A zone over `codes` and `leaves` (the same order, Morton-sorted), whose ranges of 3 up to
+    /// `few` primitives (at most [`FEW`]) try every partition.
+    pub(super) fn new(codes: &'z mut [(u64, u32)], leaves: &'z mut [Body], few: u32) -> Zone<'z> {
         let m = leaves.len();
         let cen: Vec<[f64; 3]> = leaves
             .iter()
@@ -337,6 +340,7 @@ impl<'z> Zone<'z> {
             ord: [vec![0; m], vec![0; m], vec![0; m]],
             sorted: vec![false; m],
             side: vec![0; m],
+            few: (few as usize).min(FEW),
         }
     }
 
@@ -357,7 +361,7 @@ impl<'z> Zone<'z> {
 
     /// The SAH cut of `start..start + len`, if any (moving the left side to the front).
     fn sah(&mut self, start: usize, len: usize) -> Option<usize> {
-        if (3..=FEW).contains(&len) {
+        if (3..=self.few).contains(&len) {
             return Some(self.few(start, len));
         }
         let part = &self.perm[start..start + len];
@@ -454,7 +458,7 @@ impl<'z> Zone<'z> {
         Some(nl)
     }
 
-    /// The cut of a range of 3 or [`FEW`] primitives whose subtree has the least sum of
+    /// The cut of a range of 3 or [`FEW`] primitives (the fast path's split, [`Chunking::few`](super::Chunking::few)) whose subtree has the least sum of
     /// interior areas: every partition is tried, each side then cut the same way, so the
     /// subtree is the best binary tree over these leaves, not only the best of the axis sweeps
     /// (which it never loses to), in about a third of a sweep's time. The partitions are tried
@@ -642,7 +646,7 @@ mod tests {
     fn cut_once(mut leaves: Vec<Body>) -> (usize, Vec<(u64, u32)>, Vec<Body>) {
         let mut codes: Vec<(u64, u32)> =
             leaves.iter().map(|l| (u64::from(l.id) * 3, l.id)).collect();
-        let mut zone = Zone::new(&mut codes, &mut leaves);
+        let mut zone = Zone::new(&mut codes, &mut leaves, FEW as u32);
         let nl = zone.cut(0, zone.perm.len());
         zone.apply();
         (nl, codes, leaves)
@@ -756,6 +760,8 @@ mod tests {
     #[test]
     fn ranges_of_three_and_four_get_the_best_tree_over_their_leaves() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
+        // Without `few` the sweep cuts them, and misses the best tree on some.
+        let mut sweep_missed = 0;
         for m in [3u32, 4] {
             for _ in 0..300 {
                 // Slivers and cubes in random places, so that no one axis orders the best tree.
@@ -778,15 +784,22 @@ mod tests {
                 let boxes: Vec<Aabb> = leaves.iter().map(|l| l.aabb).collect();
                 let mut l = leaves.clone();
                 let mut codes: Vec<(u64, u32)> = (0..m).map(|i| (u64::from(i), i)).collect();
-                let mut zone = Zone::new(&mut codes, &mut l);
+                let mut zone = Zone::new(&mut codes, &mut l, FEW as u32);
                 let got = interior(&mut zone, 0, m as usize);
                 let want = best_interior(&boxes);
+                let mut l = leaves.clone();
+                let mut codes: Vec<(u64, u32)> = (0..m).map(|i| (u64::from(i), i)).collect();
+                let mut zone = Zone::new(&mut codes, &mut l, 0);
+                let swept = interior(&mut zone, 0, m as usize);
+                assert!(swept >= want * (1.0 - 1e-12));
+                sweep_missed += usize::from(swept > want * (1.0 + 1e-12));
                 assert!(
                     (got - want).abs() <= 1e-12 * want,
                     "{m} leaves: {got} {want}"
                 );
             }
         }
+        assert!(sweep_missed > 0);
         // A NaN coordinate: a cut, and every leaf kept once.
         let mut nan: Vec<Body> = (0..4)
             .map(|i| leaf(i, [f64::from(i), 0.0, 0.0], 0.5))

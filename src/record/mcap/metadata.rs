@@ -61,15 +61,17 @@ pub const LOAD_KEYS: &[&str] = &["up"];
 
 /// Keys the `wraptree` record adds for the partitioned schedule ([`Chunking`]): its chunk size
 /// δ (4, or 2 on the fast path), the reduction function's ε (`--chunk-epsilon`), the root's
-/// share `top` (`--chunk-top`), the SAH cuts' range size (`--chunk-sah`) and the largest chunk
-/// (0 = δ), all read back by `replay` (a recording without `chunk_sah` was cut at Morton bits
-/// only, one without `chunk_max` into chunks of fewer than δ).
+/// share `top` (`--chunk-top`), the SAH cuts' range size (`--chunk-sah`), the largest chunk
+/// (0 = δ) and the largest range cut by trying every partition (4 on the fast path, else 0),
+/// all read back by `replay` (a recording without `chunk_sah` was cut at Morton bits only, one
+/// without `chunk_max` into chunks of fewer than δ, one without `chunk_few` by sweeps).
 pub const PARTITIONED_KEYS: &[&str] = &[
     "chunk_delta",
     "chunk_epsilon",
     "chunk_top",
     "chunk_sah",
     "chunk_max",
+    "chunk_few",
 ];
 
 /// Keys the `wraptree` record adds when a cover is logged (`cover_budget` only for a cover
@@ -211,6 +213,7 @@ pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String,
         put("chunk_top", p.mode.chunk_top.to_string());
         put("chunk_sah", p.mode.chunk_sah.to_string());
         put("chunk_max", p.mode.chunk_max.to_string());
+        put("chunk_few", p.mode.chunk_few.to_string());
     }
     put("detail", value_name(&info.detail));
     put("scene", info.scene.name.clone());
@@ -343,6 +346,11 @@ fn mode(m: &BTreeMap<String, String>) -> Result<Mode> {
             (true, _) => parse(m, "chunk_max")?,
             (false, true) => Chunking::DEFAULT.delta - 1,
             (false, false) => d.chunk_max,
+        },
+        // A recording without `chunk_few` cut every range by the SAH sweep.
+        chunk_few: match m.contains_key("chunk_few") {
+            true => parse(m, "chunk_few")?,
+            false => 0,
         },
     })
 }
