@@ -483,25 +483,22 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
     old.remove("chunk_delta");
     let params = wraptree::record::mcap::metadata::params(&old).unwrap();
     assert_eq!(params.mode.chunk_delta, Chunking::DEFAULT.delta);
-    old.insert("chunk_delta".into(), "1".into());
-    let err = wraptree::record::mcap::metadata::params(&old).unwrap_err();
-    assert!(
-        err.to_string()
-            .contains("chunk_delta (δ) must be at least 2, got 1"),
-        "{err}"
+    // A bad value gives one error naming the key.
+    let rejects = |key: &str, value: &str, why: &str| {
+        let mut bad = old.clone();
+        bad.insert(key.into(), value.into());
+        let err = wraptree::record::mcap::metadata::params(&bad).unwrap_err();
+        assert!(err.to_string().contains(why), "{err}");
+    };
+    rejects(
+        "chunk_delta",
+        "1",
+        "chunk_delta (δ) must be at least 2, got 1",
     );
-    old.remove("chunk_delta");
     // The largest range that tries every partition: 0 by default, 4 on the fast path; a
     // recording without it was cut by sweeps.
     assert_eq!(rec.metadata.get("chunk_few").map(String::as_str), Some("0"));
-    old.insert("chunk_few".into(), "5".into());
-    let err = wraptree::record::mcap::metadata::params(&old).unwrap_err();
-    assert!(
-        err.to_string()
-            .contains("chunk_few must be at most 4, got 5"),
-        "{err}"
-    );
-    old.remove("chunk_few");
+    rejects("chunk_few", "5", "chunk_few must be at most 4, got 5");
     let out = wraptree(&["record", "s.obj", "--fast", "-o", "q"], dir.path());
     let rec_q = recorded(&out, &dir.path().join("q.mcap"));
     assert_eq!(rec_q.params.mode.chunk_delta, Chunking::FAST.delta);

@@ -628,17 +628,25 @@ mod tests {
     use crate::geom::P3;
     use rand::{Rng, SeedableRng};
 
-    fn leaf(id: u32, c: [f64; 3], r: f64) -> Body {
-        let aabb = Aabb {
-            min: P3::new(c[0] - r, c[1] - r, c[2] - r),
-            max: P3::new(c[0] + r, c[1] + r, c[2] + r),
-        };
+    /// Primitive `id` with box `aabb`.
+    fn body(id: u32, aabb: Aabb) -> Body {
         Body {
             id,
             first_round: 0,
             aabb,
             diameter: aabb.diameter(),
         }
+    }
+
+    /// Primitive `id`, a cube of half-edge `r` centred at `c`.
+    fn leaf(id: u32, c: [f64; 3], r: f64) -> Body {
+        body(
+            id,
+            Aabb {
+                min: P3::new(c[0] - r, c[1] - r, c[2] - r),
+                max: P3::new(c[0] + r, c[1] + r, c[2] + r),
+            },
+        )
     }
 
     /// Cuts a fresh zone over `leaves` (codes = 3 × position, so sorted) once, applies it,
@@ -688,12 +696,7 @@ mod tests {
                         min: P3::new(x - 5.0, y, 0.0),
                         max: P3::new(x + 5.0, y + 0.01, 0.01),
                     };
-                    Body {
-                        id: i,
-                        first_round: 0,
-                        aabb,
-                        diameter: aabb.diameter(),
-                    }
+                    body(i, aabb)
                 })
                 .collect();
             let (nl, _, leaves) = cut_once(leaves);
@@ -773,24 +776,18 @@ mod tests {
                             min: P3::new(c[0] - h[0], c[1] - h[1], c[2] - h[2]),
                             max: P3::new(c[0] + h[0], c[1] + h[1], c[2] + h[2]),
                         };
-                        Body {
-                            id: i,
-                            first_round: 0,
-                            aabb,
-                            diameter: aabb.diameter(),
-                        }
+                        body(i, aabb)
                     })
                     .collect();
                 let boxes: Vec<Aabb> = leaves.iter().map(|l| l.aabb).collect();
-                let mut l = leaves.clone();
-                let mut codes: Vec<(u64, u32)> = (0..m).map(|i| (u64::from(i), i)).collect();
-                let mut zone = Zone::new(&mut codes, &mut l, FEW as u32);
-                let got = interior(&mut zone, 0, m as usize);
+                // Σ interior area of the zone's tree over these leaves with `few`.
+                let tree = |few: u32| {
+                    let mut l = leaves.clone();
+                    let mut codes: Vec<(u64, u32)> = (0..m).map(|i| (u64::from(i), i)).collect();
+                    interior(&mut Zone::new(&mut codes, &mut l, few), 0, m as usize)
+                };
+                let (got, swept) = (tree(FEW as u32), tree(0));
                 let want = best_interior(&boxes);
-                let mut l = leaves.clone();
-                let mut codes: Vec<(u64, u32)> = (0..m).map(|i| (u64::from(i), i)).collect();
-                let mut zone = Zone::new(&mut codes, &mut l, 0);
-                let swept = interior(&mut zone, 0, m as usize);
                 assert!(swept >= want * (1.0 - 1e-12));
                 sweep_missed += usize::from(swept > want * (1.0 + 1e-12));
                 assert!(
