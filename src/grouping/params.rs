@@ -235,9 +235,10 @@ impl Mode {
                 self.chunk_delta
             ));
         }
-        if self.chunk_few > 4 {
+        let few_max = crate::grouping::partitioned::Chunking::FEW_MAX;
+        if self.chunk_few > few_max {
             return Err(format!(
-                "chunk_few must be at most 4, got {}",
+                "chunk_few must be at most {few_max}, got {}",
                 self.chunk_few
             ));
         }

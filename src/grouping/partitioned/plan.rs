@@ -29,13 +29,17 @@ pub struct Chunking {
     /// cut is saved (about 5 % of the fast path's time, SAH and node tests within 0.2 % on 37
     /// scenes).
     pub chunk_max: u32,
-    /// Ranges of 3 up to this many primitives (at most 4) that are cut, not chunks, try every
-    /// partition for the best binary tree over their leaves instead of the SAH sweep (`split`);
-    /// 0 = the sweep. Only δ = 2 (or `chunk_max` below 4) leaves such ranges to be cut.
+    /// Ranges of 3 up to this many primitives (at most [`Chunking::FEW_MAX`]) that are cut, not
+    /// chunks, try every partition for the best binary tree over their leaves instead of the
+    /// SAH sweep (`split`); 0 = the sweep. Only δ = 2 (or `chunk_max` below 4) leaves such ranges to be cut.
     pub few: u32,
 }
 
 impl Chunking {
+    /// The largest [`Chunking::few`]: the split tries every partition only in ranges of 3 or 4
+    /// primitives (at most 7 partitions).
+    pub const FEW_MAX: u32 = 4;
+
     /// δ = 4 and ε = 1/2, so that f(n) = δ/2 = 2: every node below the root share leaves two
     /// bodies, and the nodes above it leave ⌈top·n/N⌉, with a root step of about 8,192 bodies;
     /// ranges of up to 256 primitives are cut by SAH. Faster than AAC's ε = 0.2 for trees as

@@ -182,7 +182,7 @@ const SWEEP: usize = 16;
 
 /// Ranges of at most this many primitives (and at least 3: two are a chunk or merge) are cut
 /// by trying every partition ([`Zone::few`]).
-const FEW: usize = 4;
+const FEW: usize = super::Chunking::FEW_MAX as usize;
 
 /// A range of at most [`Chunking::sah_below`](super::Chunking::sah_below) primitives, planned
 /// as a permutation of its leaves (moving 4-byte positions, not 64-byte bodies, at each cut)
