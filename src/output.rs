@@ -171,12 +171,21 @@ pub fn check_new(paths: &[&Path], input: &Path, force: bool) -> Result<()> {
         if input.is_some() && std::fs::canonicalize(p).ok() == input {
             anyhow::bail!("{}: is the input scene; choose another -o", p.display());
         }
-        if p.exists() && !force {
-            anyhow::bail!(
-                "{}: already exists (use --force to replace it)",
-                p.display()
-            );
-        }
     }
-    Ok(())
+    check_absent(paths, force)
+}
+
+/// Checks, before the work that produces them, that none of the files `paths` exists unless
+/// `force`.
+pub fn check_absent<P: AsRef<Path>>(paths: &[P], force: bool) -> Result<()> {
+    if force {
+        return Ok(());
+    }
+    match paths.iter().map(AsRef::as_ref).find(|p| p.exists()) {
+        Some(p) => anyhow::bail!(
+            "{}: already exists (use --force to replace it)",
+            p.display()
+        ),
+        None => Ok(()),
+    }
 }

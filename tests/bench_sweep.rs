@@ -140,9 +140,32 @@ fn bench_writes_one_row_per_method_and_wrapper_with_charts_and_rrd() {
         "{e:?}"
     );
     assert!(e.contains("/bench/soup-300/table"), "{e:?}");
-    // Results are not replaced without --force.
+    // Results are not replaced without --force, and the refusal comes before any measuring:
+    // no table printed, every file as it was.
+    let csv_before = std::fs::read(out.join("results.csv")).unwrap();
     let again = wraptree(&["bench", "robot-base", "-o", o, "--repeat", "1"]);
     common::assert_one_line_error(&again, "already exists");
+    assert!(
+        again.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&again.stdout)
+    );
+    assert_eq!(std::fs::read(out.join("results.csv")).unwrap(), csv_before);
+    // A chart left from an earlier run is refused too, before a new results.csv is written
+    // beside it.
+    let charts = dir.path().join("charts");
+    std::fs::create_dir(&charts).unwrap();
+    let stale = charts.join("soup-300-wrapper_time_vs_tightness.png");
+    std::fs::write(&stale, "an earlier run's chart").unwrap();
+    let c = charts.to_str().unwrap();
+    let refused = wraptree(&["bench", "robot-base", "soup:300", "-o", c, "--repeat", "1"]);
+    common::assert_one_line_error(
+        &refused,
+        "soup-300-wrapper_time_vs_tightness.png: already exists",
+    );
+    assert!(refused.stdout.is_empty());
+    assert!(!charts.join("results.csv").exists());
+    assert_eq!(std::fs::read(&stale).unwrap(), b"an earlier run's chart");
     // By default: the default builders × the default wrappers, in their order.
     let d = dir.path().join("defaults");
     let r = wraptree(&[

@@ -10,10 +10,10 @@ use std::process::ExitCode;
 use wraptree::metrics::bench::{record_costs, target_rows, target_scenes};
 use wraptree::metrics::compare::{Options, Step, Wrapper, evaluate};
 use wraptree::metrics::report::{
-    bench_table, record_cost_header, record_cost_line, record_cost_notes, refine_table,
-    speedup_table, target_line, targets_header, targets_notes, write_bench,
+    bench_outputs, bench_table, record_cost_header, record_cost_line, record_cost_notes,
+    refine_table, speedup_table, target_line, targets_header, targets_notes, write_bench,
 };
-use wraptree::output::output_dir;
+use wraptree::output::{check_absent, output_dir};
 use wraptree::peers::Method;
 use wraptree::scene::generate;
 use wraptree::scene::spec::scene_spec;
@@ -30,7 +30,8 @@ pub struct BenchCmd {
     /// parents if missing [default: recordings/bench].
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// Replace existing result files.
+    /// Replace existing result files (without it, a run refuses them before it measures
+    /// anything).
     #[arg(long)]
     force: bool,
     /// Hierarchy builders to compare (comma list, or `all`) [default:
@@ -157,6 +158,8 @@ impl BenchCmd {
             opts.wrappers = chosen(&self.wrappers, &Wrapper::ALL);
         }
         let output = output_dir(self.output.as_deref(), "recordings/bench")?;
+        let names: Vec<&str> = scenes.iter().map(|s| s.name.as_str()).collect();
+        check_absent(&bench_outputs(&output, &names), self.force)?;
         let stop = Stop::on_signals();
         let mut rows = Vec::new();
         for scene in &scenes {

@@ -50,6 +50,24 @@ fn bench_record(r: &Row) -> Vec<String> {
     fields
 }
 
+/// Names of the bench charts of a scene (files `SCENE-NAME.svg` and `.png`), in
+/// [`bench_charts`]'s order; the second is drawn only when some wrapper's tightness was measured.
+pub const CHARTS: [&str; 2] = ["time_vs_query", "wrapper_time_vs_tightness"];
+
+/// Every file [`write_bench`] may write into `dir` for the scenes named `scenes`, so that a
+/// run can refuse an existing one before it measures anything.
+pub fn bench_outputs(dir: &Path, scenes: &[&str]) -> Vec<PathBuf> {
+    let mut paths = vec![dir.join("results.csv"), dir.join("bench.rrd")];
+    for scene in scenes {
+        for name in CHARTS {
+            for ext in ["svg", "png"] {
+                paths.push(dir.join(format!("{}-{name}.{ext}", sanitize(scene))));
+            }
+        }
+    }
+    paths
+}
+
 /// The two bench charts for one scene: build time against node tests per query (hierarchy +
 /// query wrapper, Pareto front marked), and wrapper build time against tightness.
 pub fn bench_charts(scene: &str, rows: &[Row]) -> Result<Vec<(String, String)>> {
@@ -88,12 +106,12 @@ pub fn bench_charts(scene: &str, rows: &[Row]) -> Result<Vec<(String, String)>> 
         ..Scatter::default()
     };
     let mut out = vec![(
-        "time_vs_query".to_string(),
+        CHARTS[0].to_string(),
         query.to_svg(SIZE.0, SIZE.1).map_err(|e| anyhow!(e))?,
     )];
     if !tight.series.is_empty() {
         out.push((
-            "wrapper_time_vs_tightness".into(),
+            CHARTS[1].to_string(),
             tight.to_svg(SIZE.0, SIZE.1).map_err(|e| anyhow!(e))?,
         ));
     }
