@@ -128,3 +128,37 @@ fn exact_timing_prints_one_tree_hash_for_both_thread_counts() {
     assert_eq!(rows[0][3], "1");
     assert_eq!(rows[1][3], "2");
 }
+
+#[test]
+fn partitioned_levels_sums_each_tree_s_interior_areas_by_node_size() {
+    let husky = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/husky.obj");
+    let out = run("partitioned_levels", &[husky.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<Vec<&str>> = stdout
+        .lines()
+        .filter(|l| l.starts_with("| ") && !l.starts_with("| leaves"))
+        .map(|l| l.split('|').map(str::trim).collect())
+        .collect();
+    assert_eq!(rows[0][1], "2–3", "{stdout}");
+    let (all, sizes) = rows.split_last().unwrap();
+    assert_eq!(all[1], "all", "{stdout}");
+    // The exact column is the exact tree's interior area over its root's, split by size.
+    let scene = wraptree::scene::load_path(&husky, &Default::default())
+        .unwrap()
+        .scene;
+    let tree = group(&scene, &Params::default(), ()).tree;
+    let root = wraptree::geom::area(&tree.aabb[tree.root() as usize]);
+    let interior: f64 = tree.aabb[tree.leaves()..]
+        .iter()
+        .map(wraptree::geom::area)
+        .sum();
+    let cell = |r: &[&str], i: usize| r[i].parse::<f64>().unwrap();
+    assert_eq!(all[2], format!("{:.2}", interior / root), "{stdout}");
+    let split: f64 = sizes.iter().map(|r| cell(r, 2)).sum();
+    assert!(
+        (split - interior / root).abs() < 0.01 * sizes.len() as f64,
+        "{stdout}"
+    );
+    // The partitioned tree is another tree (husky is split: 35,902 primitives).
+    assert_ne!(all[2], all[3], "{stdout}");
+}
