@@ -9,6 +9,7 @@ use std::process::Command;
 use wraptree::geom::Aabb;
 use wraptree::grouping::{Params, SubsetTree, group};
 use wraptree::scene::{LoadOptions, load_bytes, load_path};
+use wraptree::stop::Stop;
 use wraptree::wrap::cover::{
     Candidate, CoverKind, Fits, budget_tolerance, compare_levels, min_cut, query_cost,
 };
@@ -149,7 +150,7 @@ fn robot_base_covers_beat_uniform_levels() {
     let tree = &g.tree;
     let kinds = [WrapperKind::Sphere, WrapperKind::Box, WrapperKind::Hull];
     let w = Wrappers::build(tree, &scene, &kinds, SphereMethod::Minimum);
-    let fits = Fits::measure(tree, &scene, &w, None, DEFAULT_SAMPLES);
+    let fits = Fits::measure(tree, &scene, &w, None, DEFAULT_SAMPLES, &Stop::new()).unwrap();
     assert!(fits.best[..tree.leaves()].iter().all(|&e| e == 0.0));
     let levels = compare_levels(tree, &fits.best);
     let mut strictly_smaller = 0;

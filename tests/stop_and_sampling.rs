@@ -1,4 +1,5 @@
-//! A requested [`Stop`] ends `bench` and `stress` early without their output, a `sweep` setting
+//! A requested [`Stop`] ends `bench`, `stress`, `snapshot`, `cover`, `wrap` and `compare`
+//! early without their output, a `sweep` setting
 //! over its grouping limits is left out, and the sampled tightness of `bench` and `wrap` is
 //! deterministic for any thread count and near the value over every node.
 
@@ -216,4 +217,73 @@ fn sweep_leaves_out_settings_over_their_limits() {
         .0
         .expect_err("a requested stop ends the sweep");
     assert!(is_interrupted(&e), "{e}");
+}
+
+#[test]
+fn snapshot_cover_and_wrap_obey_a_stop_and_write_nothing() {
+    use wraptree::render::snapshot::{SnapshotOptions, draw, regroup};
+    use wraptree::wrap::cover::solve::{CoverLimit, cover_scene};
+    use wraptree::wrap::report::{Measured, report};
+    let scene = scene();
+    let params = Params::default();
+    let tree = group(&scene, &params, ()).tree;
+    let (go, stopped) = (Stop::new(), Stop::new());
+    stopped.request();
+    // Snapshot: the grouping, then the pictures; an earlier frame is left as it was.
+    let resolved = params.resolve(&scene);
+    let e = regroup(&scene, &resolved, None, &stopped).expect_err("stopped");
+    assert!(is_interrupted(&e), "{e}");
+    assert_eq!(regroup(&scene, &resolved, None, &go).unwrap().0.tree, tree);
+    let dir = tempfile::tempdir().unwrap();
+    let earlier = dir.path().join("frame-00-input.png");
+    std::fs::write(&earlier, "an earlier frame").unwrap();
+    let opts = SnapshotOptions {
+        force: true,
+        ..SnapshotOptions::default()
+    };
+    let e = draw(&scene, &tree, &opts, dir.path(), &stopped).expect_err("stopped");
+    assert!(is_interrupted(&e), "{e}");
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(left.len(), 1, "{left:?}");
+    assert_eq!(std::fs::read(&earlier).unwrap(), b"an earlier frame");
+    assert!(draw(&scene, &tree, &opts, dir.path(), &go).is_ok());
+    // Cover: grouping, wrappers, their measuring.
+    let kinds = [WrapperKind::Sphere, WrapperKind::Box];
+    let e =
+        cover_scene(&scene, &params, CoverLimit::Budget(8), &kinds, &stopped).expect_err("stopped");
+    assert!(is_interrupted(&e), "{e}");
+    assert!(cover_scene(&scene, &params, CoverLimit::Budget(8), &kinds, &go).is_ok());
+    // Wrap: each kind's report.
+    let how = Measured {
+        method: SphereMethod::AabbCenter,
+        samples: 16,
+        per_depth: 4,
+    };
+    assert!(report(&tree, &scene, &kinds, how, &stopped).is_err());
+    assert_eq!(report(&tree, &scene, &kinds, how, &go).unwrap().len(), 2);
+}
+
+#[test]
+fn a_comparison_stopped_before_both_files_are_complete_writes_neither() {
+    use std::sync::atomic::AtomicBool;
+    use wraptree::grouping::EventLog;
+    use wraptree::record::compare::{CompareRun, write_comparison};
+    let scene = scene();
+    let mut log = EventLog::default();
+    let tree = group(&scene, &Params::default(), &mut log).tree;
+    let run = |label: &str| CompareRun {
+        label: label.into(),
+        merges: &log.merges,
+        tree: Some(&tree),
+    };
+    let runs = [run("a"), run("b")];
+    let dir = tempfile::tempdir().unwrap();
+    let prefix = dir.path().join("pair");
+    let e = write_comparison(&prefix, &scene, "s", &runs, false, &AtomicBool::new(true))
+        .expect_err("stopped");
+    assert!(is_interrupted(&e), "{e}");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    let written =
+        write_comparison(&prefix, &scene, "s", &runs, false, &AtomicBool::new(false)).unwrap();
+    assert!(written.iter().all(|p| p.is_file()));
 }

@@ -6,6 +6,7 @@ use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use wraptree::replay::{self, Replay};
+use wraptree::stop::Stop;
 
 /// Arguments of `wraptree compare`.
 #[derive(Args, Debug)]
@@ -26,11 +27,13 @@ pub struct CompareCmd {
 impl CompareCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
+        let stop = Stop::on_signals();
         let status = super::progress::Status::new("compare", "reading");
         let replays = self
             .files
             .iter()
             .map(|f| {
+                stop.check()?;
                 status.set_message(format!("reading {}", f.display()));
                 replay::open(f)
             })
@@ -50,7 +53,7 @@ impl CompareCmd {
             .unwrap_or_else(|| self.files[0].with_extension("compare"));
         let refs: Vec<&Replay> = replays.iter().collect();
         status.set_message("writing the comparison");
-        let c = replay::compare(&refs, &labels, &prefix, self.force)?;
+        let c = replay::compare(&refs, &labels, &prefix, self.force, &stop)?;
         drop(status);
         for (i, label) in c.labels.iter().enumerate() {
             println!("run {i}: {label}");

@@ -57,10 +57,9 @@ impl CoverCmd {
         };
         let stop = wraptree::stop::Stop::on_signals();
         let bar = super::progress::spinner("cover");
-        let out = cover_scene(scene, &params, limit, &self.kinds);
+        let out = cover_scene(scene, &params, limit, &self.kinds, &stop);
         bar.finish_and_clear();
         let out = out?;
-        stop.check()?;
         let json = serde_json::to_vec_pretty(&out).context("cover: cannot serialise")?;
         write_atomic(&json_path, &json, self.force)?;
         let obj = export::to_obj(&out.wrappers, &scene.name);

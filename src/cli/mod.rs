@@ -321,7 +321,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Group(c) => c.run(),
         Command::Record(c) => c.run(),
         Command::Replay(c) => c.run(),
-        Command::Compare(c) => c.run(),
+        Command::Compare(c) => progress::or_stopped("compare", c.run()),
         Command::Scene(c) => c.run(),
         Command::Bench(c) => progress::or_stopped("bench", c.run()),
         Command::Sweep(c) => progress::or_stopped("sweep", c.run()),

@@ -80,8 +80,7 @@ impl SnapshotCmd {
         let stop = wraptree::stop::Stop::on_signals();
         let (scene, params, recorded) = load(&self)?;
         let status = super::progress::Status::new("snapshot", "grouping");
-        let (g, differs) = regroup(&scene, &params, recorded.as_deref())?;
-        stop.check()?;
+        let (g, differs) = regroup(&scene, &params, recorded.as_deref(), &stop)?;
         if differs {
             status.suspend(|| {
                 eprintln!(
@@ -100,7 +99,7 @@ impl SnapshotCmd {
             size: self.size,
             force: self.force,
         };
-        let s = draw(&scene, &g.tree, &opts, &self.output)?;
+        let s = draw(&scene, &g.tree, &opts, &self.output, &stop)?;
         drop(status);
         print!("{}", s.text(&scene, &g.tree));
         Ok(ExitCode::SUCCESS)

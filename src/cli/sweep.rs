@@ -109,7 +109,8 @@ impl SweepCmd {
             })
             .collect();
         let compare = dir.join("compare");
-        let pair = write_sweep_comparison(&compare, &scene, &rows, &merges, &names, self.force)?;
+        let pair =
+            write_sweep_comparison(&compare, &scene, &rows, &merges, &names, self.force, &stop)?;
         written.extend(pair.into_iter().flatten());
         for p in written {
             eprintln!("wrote {}", p.display());

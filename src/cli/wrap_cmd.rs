@@ -60,9 +60,9 @@ impl WrapCmd {
             per_depth: self.tightness_nodes,
         };
         bar.set_message("wrappers and their tightness");
-        let reports = report(tree, scene, &self.wrapper, how);
+        let reports = report(tree, scene, &self.wrapper, how, &stop);
         bar.finish_and_clear();
-        stop.check()?;
+        let reports = reports?;
         let t = group_seconds;
         if self.json {
             println!("{}", report_json(scene, tree, t, how, &reports));

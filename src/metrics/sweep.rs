@@ -192,7 +192,8 @@ fn same_pairs(a: &[Merge], b: &[Merge]) -> bool {
 
 /// Writes `PREFIX.rrd` and `PREFIX.mcap`: the [`compared`] settings' runs side by side, the
 /// lowest SAH first as the reference ([`write_comparison`]); `names` label the settings.
-/// Replaces existing files only with `force`. `None` when fewer than two settings differ.
+/// Replaces existing files only with `force`. `None` when fewer than two settings differ;
+/// [`Interrupted`] when `stop` is requested before both files are complete.
 pub fn write_sweep_comparison(
     prefix: &Path,
     scene: &Scene,
@@ -200,6 +201,7 @@ pub fn write_sweep_comparison(
     merges: &[Vec<Merge>],
     names: &[String],
     force: bool,
+    stop: &Stop,
 ) -> anyhow::Result<Option<[PathBuf; 2]>> {
     let shown = compared(rows, merges);
     if shown.len() < 2 {
@@ -227,7 +229,7 @@ pub fn write_sweep_comparison(
             tree: Some(t),
         })
         .collect();
-    write_comparison(prefix, scene, &scene.name, &runs, force).map(Some)
+    write_comparison(prefix, scene, &scene.name, &runs, force, stop.flag()).map(Some)
 }
 
 #[cfg(test)]

@@ -332,7 +332,8 @@ impl Extras {
             .map(|w| w.spheres.take().unwrap_or_default());
         let cover = match (grouping, &opts.cover) {
             (Some(g), Some((limit, kinds))) => {
-                let s = solve(&g.tree, scene, *limit, kinds)?;
+                // After a finished grouping the recording is completed, not stopped.
+                let s = solve(&g.tree, scene, *limit, kinds, &crate::stop::Stop::new())?;
                 Some((s.cover, s.records))
             }
             _ => None,

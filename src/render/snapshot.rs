@@ -4,10 +4,12 @@
 //! ```no_run
 //! use wraptree::grouping::Params;
 //! use wraptree::render::snapshot::{SnapshotOptions, draw, regroup};
+//! use wraptree::stop::Stop;
 //! let loaded = wraptree::scene::load_path("scenes/lamp.obj".as_ref(), &Default::default())?;
 //! let params = Params::default().resolve(&loaded.scene);
-//! let (g, _) = regroup(&loaded.scene, &params, None)?;
-//! let s = draw(&loaded.scene, &g.tree, &SnapshotOptions::default(), "/tmp/lamp-figures".as_ref())?;
+//! let stop = Stop::new();
+//! let (g, _) = regroup(&loaded.scene, &params, None, &stop)?;
+//! let s = draw(&loaded.scene, &g.tree, &SnapshotOptions::default(), "/tmp/lamp-figures".as_ref(), &stop)?;
 //! println!("{}", s.captions.join(" | "));
 //! # Ok::<(), anyhow::Error>(())
 //! ```
@@ -17,10 +19,10 @@ use crate::grouping::{self, EventLog, Grouping, Merge, ResolvedParams, SubsetTre
 use crate::output::Pending;
 use crate::replay;
 use crate::scene::Scene;
+use crate::stop::{Interrupted, Stop};
 use crate::wrap::{SphereMethod, WrapperKind, Wrappers};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
 
 /// What a kind is called in titles and captions.
 fn kind_title(k: WrapperKind) -> &'static str {
@@ -78,16 +80,20 @@ pub fn from_recording(path: &Path) -> Result<(Scene, ResolvedParams, Option<Vec<
 
 /// Groups `scene` with `params`; also says whether its merges make another decision than
 /// `recorded`, when given ([`replay::first_divergence`]: the MPairs length is not compared).
+/// Fails with [`Interrupted`] when `stop` is requested during the grouping.
 pub fn regroup(
     scene: &Scene,
     params: &ResolvedParams,
     recorded: Option<&[Merge]>,
+    stop: &Stop,
 ) -> Result<(Grouping, bool)> {
+    let Some(recorded) = recorded else {
+        let g = grouping::group_until(scene, params, (), stop.flag()).map_err(|_| Interrupted)?;
+        return Ok((g, false));
+    };
     let mut log = EventLog::default();
-    let never = AtomicBool::new(false);
-    let g = grouping::group_until(scene, params, &mut log, &never)
-        .map_err(|_| anyhow::anyhow!("grouping stopped unexpectedly"))?;
-    let differs = recorded.is_some_and(|m| replay::first_divergence(m, &log.merges).is_some());
+    let g = grouping::group_until(scene, params, &mut log, stop.flag()).map_err(|_| Interrupted)?;
+    let differs = replay::first_divergence(recorded, &log.merges).is_some();
     Ok((g, differs))
 }
 
@@ -197,12 +203,14 @@ pub fn parse_angle(s: &str, lo: f64, hi: f64) -> Result<f64, String> {
 
 /// Draws the input and the chosen levels of `tree` over `scene` into `dir` (created with its
 /// parents if missing): `frame-NN-….{png,svg}` per frame and `figure.{png,svg}`, the sheet of
-/// them all.
+/// them all. Every picture is drawn before any file is moved into place, and `stop` is obeyed
+/// between the wrappers and each picture ([`Interrupted`], nothing written).
 pub fn draw(
     scene: &Scene,
     tree: &SubsetTree,
     opts: &SnapshotOptions,
     dir: &Path,
+    stop: &Stop,
 ) -> Result<Snapshot> {
     let levels = choose_levels(tree, &opts.levels, &opts.nodes)?;
     let mut kinds: Vec<WrapperKind> = Vec::new();
@@ -212,6 +220,7 @@ pub fn draw(
         }
     }
     let built = Wrappers::build(tree, scene, &kinds, SphereMethod::AabbCenter);
+    stop.check()?;
     let mut frames: Vec<Frame> = vec![super::input_frame(scene)];
     let mut names = vec!["frame-00-input".to_string()];
     for &kind in &kinds {
@@ -251,11 +260,15 @@ pub fn draw(
         super::sheet_columns(frames.len()),
         &title,
     ));
-    let mut written = Vec::new();
-    for ((png, svg), text) in outs.into_iter().zip(&svgs) {
+    let mut pngs = Vec::with_capacity(svgs.len());
+    for ((png, _), text) in outs.iter().zip(&svgs) {
+        stop.check()?;
         let dest = png.dest().display().to_string();
-        let bytes = super::svg_to_png(text).map_err(|e| anyhow::anyhow!("{dest}: {e}"))?;
-        let p = write(png, &bytes)?;
+        pngs.push(super::svg_to_png(text).map_err(|e| anyhow::anyhow!("{dest}: {e}"))?);
+    }
+    let mut written = Vec::new();
+    for (((png, svg), text), bytes) in outs.into_iter().zip(&svgs).zip(&pngs) {
+        let p = write(png, bytes)?;
         let s = write(svg, text.as_bytes())?;
         written.push((p, s));
     }

@@ -353,12 +353,15 @@ pub struct Compared {
 
 /// Writes `PREFIX.rrd` and `PREFIX.mcap`, the runs of `replays` (recordings of one scene) side
 /// by side ([`write_comparison`]); `labels` name them. Replaces existing files only with
-/// `force`. Err: recordings of different scenes, or a write that fails (old files are kept).
+/// `force`. Err: recordings of different scenes, a write that fails (old files are kept), or
+/// [`Interrupted`](crate::stop::Interrupted) when `stop` is requested before both files are
+/// complete (none written).
 pub fn compare(
     replays: &[&Replay],
     labels: &[String],
     prefix: &Path,
     force: bool,
+    stop: &crate::stop::Stop,
 ) -> Result<Compared> {
     let Some(first) = replays.first() else {
         bail!("{}: nothing to compare", prefix.display());
@@ -389,7 +392,8 @@ pub fn compare(
         })
         .collect();
     let scene = &first.loaded.scene;
-    let paths = write_comparison(prefix, scene, &first.rec.scene_file_name, &runs, force)?;
+    let name = &first.rec.scene_file_name;
+    let paths = write_comparison(prefix, scene, name, &runs, force, stop.flag())?;
     let divergence = runs
         .get(1)
         .and_then(|b| divergence(runs[0].merges, b.merges));
@@ -437,7 +441,11 @@ pub fn reweight<O: Observer>(
             let scene = &replay.loaded.scene;
             let name = &replay.rec.scene_file_name;
             let prefix = with_ext(prefix, ".compare");
-            Some(write_comparison(&prefix, scene, name, &runs, opts.force)?)
+            // The new recording is complete by now: its comparison is completed too.
+            let never = AtomicBool::new(false);
+            Some(write_comparison(
+                &prefix, scene, name, &runs, opts.force, &never,
+            )?)
         }
         _ => None,
     };

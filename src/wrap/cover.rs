@@ -19,6 +19,7 @@ use super::kind::{WrapperKind, Wrappers};
 use super::tightness::node_tightness;
 use crate::grouping::SubsetTree;
 use crate::scene::Scene;
+use crate::stop::{Interrupted, Stop};
 
 /// Kinds within this fraction of the smallest error count as tied (then the cheapest wins).
 pub const TIE_REL: f64 = 0.10;
@@ -144,14 +145,16 @@ pub struct Fits {
 impl Fits {
     /// Measures every kind of `wrappers` on every node with `samples` surface samples
     /// ([`node_tightness`]); leaves also get [`CoverKind::Primitive`]. `hulls` are the hulls of
-    /// the same tree (reference volumes, hull vertex counts); built when `None`.
+    /// the same tree (reference volumes, hull vertex counts); built when `None`. `stop` is
+    /// obeyed before each kind is measured.
     pub fn measure(
         tree: &SubsetTree,
         scene: &Scene,
         wrappers: &Wrappers,
         hulls: Option<&[Hull]>,
         samples: usize,
-    ) -> Fits {
+        stop: &Stop,
+    ) -> Result<Fits, Interrupted> {
         let built;
         let hulls = match hulls.or(wrappers.hulls.as_deref()) {
             Some(h) => h,
@@ -175,6 +178,7 @@ impl Fits {
             })
             .collect();
         for w in wrappers.trees() {
+            stop.check()?;
             let kind = CoverKind::of(w.kind());
             let stats = node_tightness(tree, scene, w, hulls, samples);
             for (x, s) in stats.iter().enumerate() {
@@ -190,7 +194,10 @@ impl Fits {
                 });
             }
         }
-        Fits::from_options(options, scene.aabb().diameter() * TIE_ABS_REL)
+        Ok(Fits::from_options(
+            options,
+            scene.aabb().diameter() * TIE_ABS_REL,
+        ))
     }
 
     /// Fits from given candidates (each node needs at least one; leaves are always taken).

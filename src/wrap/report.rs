@@ -13,7 +13,8 @@
 //!     samples: DEFAULT_SAMPLES,
 //!     per_depth: NODES_PER_DEPTH,
 //! };
-//! for r in report(tree, scene, &kinds, how) {
+//! let stop = wraptree::stop::Stop::new();
+//! for r in report(tree, scene, &kinds, how, &stop).expect("nobody asked to stop") {
 //!     println!("{}: containment holds: {}", r.kind.name(), r.containment.holds);
 //! }
 //! # }
@@ -26,6 +27,7 @@ use super::{
 use crate::geom::Aabb;
 use crate::grouping::SubsetTree;
 use crate::scene::Scene;
+use crate::stop::{Interrupted, Stop};
 use std::fmt::Write as _;
 use std::time::Instant;
 
@@ -159,13 +161,15 @@ pub fn containment(tree: &SubsetTree, scene: &Scene, w: WrapperTree<'_>) -> Cont
 /// `how.samples` surface samples per wrapper, the error measured on every leaf and at most
 /// `how.per_depth` interior nodes per depth ([`level_tightness_sampled`], seed
 /// [`SAMPLE_SEED`]; 0: every node), spheres by `how.method`. The reference volumes are the
-/// hulls', built untimed when not asked for.
+/// hulls', built untimed when not asked for. `stop` is obeyed after the wrappers are built and
+/// before each kind is measured.
 pub fn report(
     tree: &SubsetTree,
     scene: &Scene,
     kinds: &[WrapperKind],
     how: Measured,
-) -> Vec<KindReport> {
+    stop: &Stop,
+) -> Result<Vec<KindReport>, Interrupted> {
     let Measured {
         method,
         samples,
@@ -186,18 +190,21 @@ pub fn report(
     built
         .trees()
         .into_iter()
-        .map(|(w, build_seconds)| KindReport {
-            kind: w.kind(),
-            build_seconds,
-            containment: containment(tree, scene, w),
-            levels: level_tightness_sampled(
-                tree,
-                scene,
-                w,
-                hulls,
-                samples,
-                (per_depth, SAMPLE_SEED),
-            ),
+        .map(|(w, build_seconds)| {
+            stop.check()?;
+            Ok(KindReport {
+                kind: w.kind(),
+                build_seconds,
+                containment: containment(tree, scene, w),
+                levels: level_tightness_sampled(
+                    tree,
+                    scene,
+                    w,
+                    hulls,
+                    samples,
+                    (per_depth, SAMPLE_SEED),
+                ),
+            })
         })
         .collect()
 }

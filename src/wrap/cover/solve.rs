@@ -7,6 +7,7 @@ use super::export::{self, WrapperRecord};
 use super::{Cover, Fits, LevelRow, compare_levels};
 use crate::grouping::{self, Params, SubsetTree};
 use crate::scene::Scene;
+use crate::stop::{Interrupted, Stop};
 use crate::wrap::{DEFAULT_SAMPLES, SphereMethod, WrapperKind, Wrappers};
 use anyhow::{Context, Result};
 use std::fmt::Write as _;
@@ -82,24 +83,34 @@ pub struct Solved {
 
 /// The cover of `tree` within `limit`, choosing among `kinds` (spheres by
 /// [`SphereMethod::Minimum`], [`DEFAULT_SAMPLES`] surface samples per wrapper). Hulls are always
-/// built, as the reference the errors need. Err: a budget of 0.
+/// built, as the reference the errors need. Err: a budget of 0, or [`Interrupted`] when `stop`
+/// is requested (checked after the wrappers are built and before each kind is measured).
 pub fn solve(
     tree: &SubsetTree,
     scene: &Scene,
     limit: CoverLimit,
     kinds: &[WrapperKind],
+    stop: &Stop,
 ) -> Result<Solved> {
     let mut build = kinds.to_vec();
     if !build.contains(&WrapperKind::Hull) {
         build.push(WrapperKind::Hull);
     }
     let mut wrappers = Wrappers::build(tree, scene, &build, SphereMethod::Minimum);
+    stop.check()?;
     let hulls = if kinds.contains(&WrapperKind::Hull) {
         None
     } else {
         wrappers.hulls.take()
     };
-    let fits = Fits::measure(tree, scene, &wrappers, hulls.as_deref(), DEFAULT_SAMPLES);
+    let fits = Fits::measure(
+        tree,
+        scene,
+        &wrappers,
+        hulls.as_deref(),
+        DEFAULT_SAMPLES,
+        stop,
+    )?;
     let cover = match limit {
         CoverLimit::Tolerance(t) => fits.cover_tolerance(tree, t.length(scene.aabb().diameter())),
         CoverLimit::Budget(k) => fits.cover_budget(tree, k).map_err(anyhow::Error::msg)?,
@@ -149,17 +160,20 @@ pub struct CoverSummary {
     pub wrappers: Vec<WrapperRecord>,
 }
 
-/// Groups `scene` with `params` and computes its cover within `limit` from `kinds`.
+/// Groups `scene` with `params` and computes its cover within `limit` from `kinds`; stops with
+/// [`Interrupted`] when `stop` is requested (the grouping obeys it too).
 pub fn cover_scene(
     scene: &Scene,
     params: &Params,
     limit: CoverLimit,
     kinds: &[WrapperKind],
+    stop: &Stop,
 ) -> Result<CoverSummary> {
     let start = Instant::now();
-    let g = grouping::group(scene, params, ());
+    let resolved = params.resolve(scene);
+    let g = grouping::group_until(scene, &resolved, (), stop.flag()).map_err(|_| Interrupted)?;
     let tree = &g.tree;
-    let s = solve(tree, scene, limit, kinds)?;
+    let s = solve(tree, scene, limit, kinds, stop)?;
     let levels = compare_levels(tree, &s.fits.best);
     let seconds = start.elapsed().as_secs_f64();
     let c = &s.cover;
