@@ -162,3 +162,26 @@ fn partitioned_levels_sums_each_tree_s_interior_areas_by_node_size() {
     // The partitioned tree is another tree (husky is split: 35,902 primitives).
     assert_ne!(all[2], all[3], "{stdout}");
 }
+
+#[test]
+fn exact_prefix_splices_a_tree_that_is_the_exact_one_when_the_rest_is_grouped_whole() {
+    // husky (35,902 primitives): with a quarter of the bodies left (under the 12,288 that the
+    // partitioned schedule groups whole), the second stage is the exact run's continuation in
+    // all but the rounds it starts from, so both measures stay within 2 % of the exact tree's.
+    let husky = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/husky.obj");
+    let out = run("exact_prefix", &["0.25", husky.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let row: Vec<&str> = stdout
+        .lines()
+        .find(|l| l.starts_with("| husky |"))
+        .unwrap_or_else(|| panic!("{stdout}"))
+        .split('|')
+        .map(str::trim)
+        .collect();
+    assert_eq!(row[2], "35902", "{stdout}");
+    let ratios: Vec<f64> = row[4].split(" / ").map(|v| v.parse().unwrap()).collect();
+    assert_eq!(ratios.len(), 2, "{stdout}");
+    assert!(ratios.iter().all(|r| (0.98..=1.02).contains(r)), "{stdout}");
+    let times: Vec<f64> = row[5].split(", ").map(|v| v.parse().unwrap()).collect();
+    assert!(times.iter().all(|&t| t > 0.0), "{stdout}");
+}
