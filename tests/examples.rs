@@ -185,3 +185,33 @@ fn exact_prefix_splices_a_tree_that_is_the_exact_one_when_the_rest_is_grouped_wh
     let times: Vec<f64> = row[5].split(", ").map(|v| v.parse().unwrap()).collect();
     assert!(times.iter().all(|&t| t > 0.0), "{stdout}");
 }
+
+#[test]
+fn exact_rounds_accounts_for_every_merge_and_the_whole_time() {
+    let lamp = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/lamp.obj");
+    let out = run("exact_rounds", &[lamp.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<Vec<&str>> = stdout
+        .lines()
+        .filter(|l| l.starts_with("| ") && !l.starts_with("| round"))
+        .map(|l| l.split('|').map(str::trim).collect())
+        .collect();
+    assert!(rows.len() >= 2, "{stdout}");
+    assert_eq!(rows[0][1], "0", "{stdout}");
+    let scene = wraptree::scene::load_path(&lamp, &Default::default())
+        .unwrap()
+        .scene;
+    let g = group(&scene, &Params::default(), ());
+    assert_eq!(rows.len(), g.rounds as usize, "{stdout}");
+    let merges: usize = rows
+        .iter()
+        .map(|r| r[4].split(' ').next().unwrap().parse::<usize>().unwrap())
+        .sum();
+    assert_eq!(merges, scene.len() - 1, "{stdout}");
+    let share: f64 = rows
+        .iter()
+        .map(|r| r[7].trim_end_matches(" %").parse::<f64>().unwrap())
+        .sum();
+    // The rest of the run is the tree's assembly after the last merge.
+    assert!((80.0..=100.5).contains(&share), "{stdout}");
+}
