@@ -44,6 +44,31 @@ fn run(name: &str, args: &[&str]) -> Output {
     out
 }
 
+/// A bundled scene's path.
+fn bundled(file: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(file)
+}
+
+/// What example `name` printed, run with `args` and then the bundled scene `file`.
+fn printed(name: &str, args: &[&str], file: &str) -> String {
+    let path = bundled(file);
+    let mut all = args.to_vec();
+    all.push(path.to_str().expect("a UTF-8 path"));
+    String::from_utf8_lossy(&run(name, &all).stdout).into_owned()
+}
+
+/// The cells of the markdown table rows of `stdout` (header, rule and other lines left out:
+/// rows start with `| ` and do not start with `header`).
+fn table_rows<'a>(stdout: &'a str, header: &str) -> Vec<Vec<&'a str>> {
+    stdout
+        .lines()
+        .filter(|l| l.starts_with("| ") && !l.starts_with(header))
+        .map(|l| l.split('|').map(str::trim).collect())
+        .collect()
+}
+
 #[test]
 fn record_scene_writes_both_recordings_of_the_lamp_and_they_replay() {
     let dir = tempfile::tempdir().unwrap();
@@ -131,19 +156,13 @@ fn exact_timing_prints_one_tree_hash_for_both_thread_counts() {
 
 #[test]
 fn partitioned_levels_sums_each_tree_s_interior_areas_by_node_size() {
-    let husky = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/husky.obj");
-    let out = run("partitioned_levels", &[husky.to_str().unwrap()]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let rows: Vec<Vec<&str>> = stdout
-        .lines()
-        .filter(|l| l.starts_with("| ") && !l.starts_with("| leaves"))
-        .map(|l| l.split('|').map(str::trim).collect())
-        .collect();
+    let stdout = printed("partitioned_levels", &[], "husky.obj");
+    let rows = table_rows(&stdout, "| leaves");
     assert_eq!(rows[0][1], "2–3", "{stdout}");
     let (all, sizes) = rows.split_last().unwrap();
     assert_eq!(all[1], "all", "{stdout}");
     // The exact column is the exact tree's interior area over its root's, split by size.
-    let scene = wraptree::scene::load_path(&husky, &Default::default())
+    let scene = wraptree::scene::load_path(&bundled("husky.obj"), &Default::default())
         .unwrap()
         .scene;
     let tree = group(&scene, &Params::default(), ()).tree;
@@ -168,9 +187,7 @@ fn exact_prefix_splices_a_tree_that_is_the_exact_one_when_the_rest_is_grouped_wh
     // husky (35,902 primitives): with a quarter of the bodies left (under the 12,288 that the
     // partitioned schedule groups whole), the second stage is the exact run's continuation in
     // all but the rounds it starts from, so both measures stay within 2 % of the exact tree's.
-    let husky = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/husky.obj");
-    let out = run("exact_prefix", &["0.25", husky.to_str().unwrap()]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stdout = printed("exact_prefix", &["0.25"], "husky.obj");
     let row: Vec<&str> = stdout
         .lines()
         .find(|l| l.starts_with("| husky |"))
@@ -188,17 +205,11 @@ fn exact_prefix_splices_a_tree_that_is_the_exact_one_when_the_rest_is_grouped_wh
 
 #[test]
 fn exact_rounds_accounts_for_every_merge_and_the_whole_time() {
-    let lamp = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/lamp.obj");
-    let out = run("exact_rounds", &[lamp.to_str().unwrap()]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let rows: Vec<Vec<&str>> = stdout
-        .lines()
-        .filter(|l| l.starts_with("| ") && !l.starts_with("| round"))
-        .map(|l| l.split('|').map(str::trim).collect())
-        .collect();
+    let stdout = printed("exact_rounds", &[], "lamp.obj");
+    let rows = table_rows(&stdout, "| round");
     assert!(rows.len() >= 2, "{stdout}");
     assert_eq!(rows[0][1], "0", "{stdout}");
-    let scene = wraptree::scene::load_path(&lamp, &Default::default())
+    let scene = wraptree::scene::load_path(&bundled("lamp.obj"), &Default::default())
         .unwrap()
         .scene;
     let g = group(&scene, &Params::default(), ());
@@ -212,6 +223,5 @@ fn exact_rounds_accounts_for_every_merge_and_the_whole_time() {
         .iter()
         .map(|r| r[7].trim_end_matches(" %").parse::<f64>().unwrap())
         .sum();
-    // The rest of the run is the tree's assembly after the last merge.
-    assert!((80.0..=100.5).contains(&share), "{stdout}");
+    assert!((share - 100.0).abs() < 1.0, "{stdout}");
 }
