@@ -265,7 +265,6 @@ fn snapshot_cover_and_wrap_obey_a_stop_and_write_nothing() {
 
 #[test]
 fn a_comparison_stopped_before_both_files_are_complete_writes_neither() {
-    use std::sync::atomic::AtomicBool;
     use wraptree::grouping::EventLog;
     use wraptree::record::compare::{CompareRun, write_comparison};
     let scene = scene();
@@ -279,11 +278,11 @@ fn a_comparison_stopped_before_both_files_are_complete_writes_neither() {
     let runs = [run("a"), run("b")];
     let dir = tempfile::tempdir().unwrap();
     let prefix = dir.path().join("pair");
-    let e = write_comparison(&prefix, &scene, "s", &runs, false, &AtomicBool::new(true))
-        .expect_err("stopped");
+    let (go, stopped) = (Stop::new(), Stop::new());
+    stopped.request();
+    let e = write_comparison(&prefix, &scene, "s", &runs, false, &stopped).expect_err("stopped");
     assert!(is_interrupted(&e), "{e}");
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
-    let written =
-        write_comparison(&prefix, &scene, "s", &runs, false, &AtomicBool::new(false)).unwrap();
+    let written = write_comparison(&prefix, &scene, "s", &runs, false, &go).unwrap();
     assert!(written.iter().all(|p| p.is_file()));
 }

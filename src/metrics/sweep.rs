@@ -229,7 +229,7 @@ pub fn write_sweep_comparison(
             tree: Some(t),
         })
         .collect();
-    write_comparison(prefix, scene, &scene.name, &runs, force, stop.flag()).map(Some)
+    write_comparison(prefix, scene, &scene.name, &runs, force, stop).map(Some)
 }
 
 #[cfg(test)]

@@ -11,8 +11,7 @@ use std::path::{Path, PathBuf};
 use crate::grouping::{Merge, SubsetTree, sah};
 use crate::output::{Pending, with_ext};
 use crate::scene::Scene;
-use crate::stop::Interrupted;
-use std::sync::atomic::{AtomicBool, Ordering};
+use crate::stop::Stop;
 
 /// One run of a comparison.
 pub struct CompareRun<'a> {
@@ -117,28 +116,24 @@ pub fn log_lines(runs: &[CompareRun<'_>]) -> Vec<LogLine> {
 
 /// Writes `PREFIX.rrd` and `PREFIX.mcap`, the comparison of `runs` (at least two) over `scene`
 /// (named `scene_name`). Each file appears whole or not at all; existing files are replaced
-/// only with `force`. Returns both paths. When `stop` is set before both are complete, neither
-/// is moved into place and the error is [`Interrupted`].
+/// only with `force`. Returns both paths. When `stop` is requested before both are complete,
+/// neither is moved into place and the error is [`Interrupted`](crate::stop::Interrupted).
 pub fn write_comparison(
     prefix: &Path,
     scene: &Scene,
     scene_name: &str,
     runs: &[CompareRun<'_>],
     force: bool,
-    stop: &AtomicBool,
+    stop: &Stop,
 ) -> anyhow::Result<[PathBuf; 2]> {
-    let check = || match stop.load(Ordering::Relaxed) {
-        true => Err(Interrupted),
-        false => Ok(()),
-    };
     let (rrd, mcap) = (with_ext(prefix, ".rrd"), with_ext(prefix, ".mcap"));
     let rrd_file = Pending::create(&rrd, force)?;
     let mcap_file = Pending::create(&mcap, force)?;
-    check()?;
+    stop.check()?;
     super::rrd::write_comparison_rrd(rrd_file.path(), &rrd, scene, scene_name, runs)?;
-    check()?;
+    stop.check()?;
     super::mcap::write_comparison_mcap(&mcap_file, scene, scene_name, runs)?;
-    check()?;
+    stop.check()?;
     Ok([rrd_file.commit()?, mcap_file.commit()?])
 }
 

@@ -393,7 +393,7 @@ pub fn compare(
         .collect();
     let scene = &first.loaded.scene;
     let name = &first.rec.scene_file_name;
-    let paths = write_comparison(prefix, scene, name, &runs, force, stop.flag())?;
+    let paths = write_comparison(prefix, scene, name, &runs, force, stop)?;
     let divergence = runs
         .get(1)
         .and_then(|b| divergence(runs[0].merges, b.merges));
@@ -442,7 +442,7 @@ pub fn reweight<O: Observer>(
             let name = &replay.rec.scene_file_name;
             let prefix = with_ext(prefix, ".compare");
             // The new recording is complete by now: its comparison is completed too.
-            let never = AtomicBool::new(false);
+            let never = crate::stop::Stop::new();
             Some(write_comparison(
                 &prefix, scene, name, &runs, opts.force, &never,
             )?)

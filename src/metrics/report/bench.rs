@@ -52,7 +52,7 @@ fn bench_record(r: &Row) -> Vec<String> {
 
 /// Names of the bench charts of a scene (files `SCENE-NAME.svg` and `.png`), in
 /// [`bench_charts`]'s order; the second is drawn only when some wrapper's tightness was measured.
-pub const CHARTS: [&str; 2] = ["time_vs_query", "wrapper_time_vs_tightness"];
+const CHARTS: [&str; 2] = ["time_vs_query", "wrapper_time_vs_tightness"];
 
 /// Every file [`write_bench`] may write into `dir` for the scenes named `scenes`, so that a
 /// run can refuse an existing one before it measures anything.

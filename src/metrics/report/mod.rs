@@ -15,7 +15,7 @@ mod stress;
 mod sweep;
 mod targets;
 
-pub use bench::{CHARTS, bench_charts, bench_csv, bench_outputs, bench_table, write_bench};
+pub use bench::{bench_charts, bench_csv, bench_outputs, bench_table, write_bench};
 pub use group::{group_json, group_text, pregrouping_lines};
 pub use partitioned::{
     partitioned_header, partitioned_line, partitioned_notes, partitioned_record_line,
