@@ -5,7 +5,8 @@
 //!
 //! `cargo run --release --example partitioned_chunking [MAX_SOUP] [DELTA:EPSILON[:TOP[:SAH]] ...]
 //! [FILE ...]` — default 100000 and the default chunking and 20:0.1 (AAC's high-quality
-//! setting); scene files are grouped after the targets scenes (held-out scenes).
+//! setting); scene files are grouped after the targets scenes (held-out scenes). `THREADS=T` runs
+//! every build in a pool of T threads instead of one.
 
 use std::time::Instant;
 use wraptree::grouping::partitioned::{Chunking, group_with};
@@ -36,7 +37,13 @@ fn main() -> anyhow::Result<()> {
     if chunkings.is_empty() {
         chunkings = vec![Chunking::DEFAULT, parse("20:0.1")?];
     }
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    let threads = std::env::var("THREADS")
+        .ok()
+        .and_then(|t| t.parse().ok())
+        .unwrap_or(1);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()?;
     let budget = Budget::default();
     print!("{:<18} {:>8} {:>9}", "scene", "N", "exact ms");
     for ch in &chunkings {

@@ -225,3 +225,27 @@ fn exact_rounds_accounts_for_every_merge_and_the_whole_time() {
         .sum();
     assert!((share - 100.0).abs() < 1.0, "{stdout}");
 }
+
+#[test]
+fn exact_order_maps_each_order_s_tree_back_to_the_input_ids() {
+    // random-urdf-782 has no equal Costs: every order gives the input order's exact tree, so
+    // each tree mapped back has the same SAH and node tests. robot-base (276 primitives, a CAD
+    // part of congruent faces) has ties, which break by id: another order gives another tree.
+    // Both are grouped whole by the partitioned schedule, so its tree of each order is that
+    // order's exact tree.
+    let urdf = printed("exact_order", &[], "random-urdf-782.obj");
+    let rows = table_rows(&urdf, "| scene");
+    assert_eq!(rows.len(), 1, "{urdf}");
+    assert!(
+        rows[0][3..10].iter().all(|c| *c == "1.000 / 1.000"),
+        "{urdf}"
+    );
+    let base = printed("exact_order", &[], "robot-base.obj");
+    let rows = table_rows(&base, "| scene");
+    assert_eq!(rows.len(), 1, "{base}");
+    let r = &rows[0];
+    assert_eq!((r[1], r[2]), ("robot-base", "276"), "{base}");
+    assert_eq!(r[6], "1.000 / 1.000", "{base}");
+    assert_eq!(r[3..6], r[7..10], "{base}");
+    assert!(r[3..6].iter().any(|c| *c != "1.000 / 1.000"), "{base}");
+}

@@ -493,7 +493,7 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
     rejects(
         "chunk_delta",
         "1",
-        "chunk_delta (δ) must be at least 2, got 1",
+        "--chunk-delta (δ) must be at least 2, got 1",
     );
     // The largest range that tries every partition: 0 by default, 4 on the fast path; a
     // recording without it was cut by sweeps.
@@ -530,4 +530,54 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
     common::assert_one_line_error(&out, "--chunk-epsilon needs --schedule partitioned");
     let out = wraptree(&["group", "s.obj", "--chunk-sah", "0"], dir.path());
     common::assert_one_line_error(&out, "--chunk-sah needs --schedule partitioned");
+}
+
+#[test]
+fn a_chosen_chunk_size_is_recorded_replayed_and_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut obj = Vec::new();
+    generate::soup(3_000, 6).write_obj(&mut obj).unwrap();
+    std::fs::write(dir.path().join("s.obj"), obj).unwrap();
+    let args = [
+        "record",
+        "s.obj",
+        "--schedule",
+        "partitioned",
+        "--chunk-top",
+        "256",
+    ];
+    let out = wraptree(&[&args[..], &["-o", "d"]].concat(), dir.path());
+    let rec_d = recorded(&out, &dir.path().join("d.mcap"));
+    let out = wraptree(
+        &[&args[..], &["--chunk-delta", "64", "-o", "c"]].concat(),
+        dir.path(),
+    );
+    let rec = recorded(&out, &dir.path().join("c.mcap"));
+    assert_eq!(rec.params.mode.chunk_delta, 64);
+    assert_eq!(
+        rec.metadata.get("chunk_delta").map(String::as_str),
+        Some("64")
+    );
+    // Chunks of up to 64 primitives, each grouped by the exact step: other merges, fewer parts.
+    assert_ne!(rec.merges, rec_d.merges);
+    assert!(rec.parts.len() < rec_d.parts.len());
+    let out = wraptree(&["replay", "c.mcap", "--verify"], dir.path());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains("verified"), "{text}");
+    // A chunk as large as the scene is the exact schedule's run.
+    let out = wraptree(
+        &[&args[..], &["--chunk-delta", "3000", "-o", "w"]].concat(),
+        dir.path(),
+    );
+    let whole = recorded(&out, &dir.path().join("w.mcap"));
+    let out = wraptree(&["record", "s.obj", "-o", "e"], dir.path());
+    let exact = recorded(&out, &dir.path().join("e.mcap"));
+    assert_eq!(whole.merges, exact.merges);
+    let out = wraptree(&["group", "s.obj", "--chunk-delta", "64"], dir.path());
+    common::assert_one_line_error(&out, "--chunk-delta needs --schedule partitioned");
+    let out = wraptree(
+        &["group", "s.obj", "--fast", "--chunk-delta", "1"],
+        dir.path(),
+    );
+    common::assert_one_line_error(&out, "--chunk-delta (δ) must be at least 2, got 1");
 }

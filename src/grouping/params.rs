@@ -231,7 +231,7 @@ impl Mode {
         }
         if self.chunk_delta < 2 {
             return Err(format!(
-                "chunk_delta (δ) must be at least 2, got {}",
+                "--chunk-delta (δ) must be at least 2, got {}",
                 self.chunk_delta
             ));
         }
