@@ -581,3 +581,27 @@ fn a_chosen_chunk_size_is_recorded_replayed_and_checked() {
     );
     common::assert_one_line_error(&out, "--chunk-delta (δ) must be at least 2, got 1");
 }
+
+#[test]
+fn larger_chunks_bring_an_assembly_s_tree_back_to_the_exact_one() {
+    // 20 rigid copies of the robot base (5,520 polygons), split under a root share of 256: with
+    // chunks of 4 the Morton split forces merges across copies that the exact run keeps apart;
+    // chunks of 1,024, each grouped by the exact step, make those merges its own.
+    let scene = generate::replicate(&generate::robot_base(), 20, 1);
+    let resolved = Params::default().resolve(&scene);
+    let exact = wraptree::grouping::sah(&group(&scene, &Params::default(), ()).tree);
+    let sah_with = |delta: u32| {
+        let chunking = Chunking {
+            delta,
+            top: 256,
+            ..Chunking::DEFAULT
+        };
+        let mut log = EventLog::default();
+        let g = group_with(&scene, &resolved, &chunking, &mut log, &Budget::default()).unwrap();
+        check_tree(&scene, &g, &log);
+        wraptree::grouping::sah(&g.tree) / exact
+    };
+    let (small, large) = (sah_with(4), sah_with(1024));
+    assert!(small > 1.03, "δ = 4: {small}");
+    assert!((0.99..=1.01).contains(&large), "δ = 1024: {large}");
+}
