@@ -69,10 +69,7 @@ fn the_fast_path_is_a_valid_tree_and_the_same_on_1_and_2_threads() {
 
 #[test]
 fn the_fast_flag_groups_partitioned_with_the_fast_split_and_parses_like_the_others() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut obj = Vec::new();
-    generate::soup(2_000, 6).write_obj(&mut obj).unwrap();
-    std::fs::write(dir.path().join("s.obj"), obj).unwrap();
+    let dir = common::soup_dir(2_000, 6);
     let out = wraptree(&["group", "s.obj", "--fast", "--threads", "1"], dir.path());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(

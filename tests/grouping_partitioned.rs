@@ -357,13 +357,10 @@ fn recorded(
 
 #[test]
 fn replay_verifies_a_partitioned_recording() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut obj = Vec::new();
     // More primitives than one subproblem takes (`Chunking::whole`), so chunks are recorded.
     let n = 13_000;
     assert!(!Chunking::DEFAULT.whole(n));
-    generate::soup(n, 4).write_obj(&mut obj).unwrap();
-    std::fs::write(dir.path().join("s.obj"), obj).unwrap();
+    let dir = common::soup_dir(n, 4);
     let scene = wraptree::scene::load_path(&dir.path().join("s.obj"), &LoadOptions::default())
         .unwrap()
         .scene;
@@ -417,13 +414,10 @@ fn replay_verifies_a_partitioned_recording() {
 
 #[test]
 fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut obj = Vec::new();
     // Whole under the default share (`Chunking::whole`), split under a share of 256.
     let n = 3_000;
     assert!(Chunking::DEFAULT.whole(n));
-    generate::soup(n, 6).write_obj(&mut obj).unwrap();
-    std::fs::write(dir.path().join("s.obj"), obj).unwrap();
+    let dir = common::soup_dir(n, 6);
     let args = ["record", "s.obj", "--schedule", "partitioned", "-o"];
     let out = wraptree(
         &[&args[..], &["p", "--chunk-top", "256"]].concat(),
@@ -534,10 +528,7 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
 
 #[test]
 fn a_chosen_chunk_size_is_recorded_replayed_and_checked() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut obj = Vec::new();
-    generate::soup(3_000, 6).write_obj(&mut obj).unwrap();
-    std::fs::write(dir.path().join("s.obj"), obj).unwrap();
+    let dir = common::soup_dir(3_000, 6);
     let args = [
         "record",
         "s.obj",

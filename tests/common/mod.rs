@@ -205,6 +205,17 @@ pub fn grid_obj(nx: usize, ny: usize, dy: f64, lift: f64) -> Vec<u8> {
     s.into_bytes()
 }
 
+/// A temporary directory holding `s.obj`, a generated soup of `n` triangles (seed `seed`).
+pub fn soup_dir(n: usize, seed: u64) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let mut obj = Vec::new();
+    wraptree::scene::generate::soup(n, seed)
+        .write_obj(&mut obj)
+        .unwrap();
+    std::fs::write(dir.path().join("s.obj"), obj).unwrap();
+    dir
+}
+
 /// Asserts a failed run with exactly one `error:` line on stderr mentioning `needle`, no panic.
 pub fn assert_one_line_error(out: &std::process::Output, needle: &str) {
     assert!(!out.status.success(), "must fail");
