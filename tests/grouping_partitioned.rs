@@ -317,6 +317,38 @@ fn hull_pset_runs_the_exact_schedule() {
 }
 
 #[test]
+fn the_cli_refuses_a_partitioned_schedule_of_hulls_instead_of_reporting_one() {
+    // The library runs the exact schedule for hulls (above); `group` used to print a
+    // partitioned schedule with its chunks for that run.
+    let dir = common::soup_dir(300, 2);
+    for args in [
+        &["--schedule", "partitioned"][..],
+        &["--schedule", "partitioned", "--chunk-delta", "64"],
+        &["--fast"],
+    ] {
+        let out = wraptree(
+            &[&["group", "s.obj", "--pset", "hull"][..], args].concat(),
+            dir.path(),
+        );
+        common::assert_one_line_error(&out, "needs --pset aabb (the hull p-set has no partitioned");
+    }
+    let out = wraptree(
+        &["record", "s.obj", "--fast", "--pset", "hull", "-o", "h"],
+        dir.path(),
+    );
+    common::assert_one_line_error(&out, "--fast needs --pset aabb");
+    assert!(!dir.path().join("h.mcap").exists() && !dir.path().join("h.rrd").exists());
+    let out = wraptree(&["group", "s.obj", "--pset", "hull"], dir.path());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("schedule    Exact"), "{text}");
+}
+
+#[test]
 fn a_stopped_run_reports_a_prefix_of_the_merges() {
     let scene = generate::soup(5_000, 9);
     let params = partitioned(Params::default()).resolve(&scene);

@@ -285,6 +285,19 @@ impl GroupArgs {
         {
             anyhow::bail!("{flag} needs --schedule partitioned or --fast");
         }
+        if params.mode.schedule == Schedule::Partitioned && params.pset == PSet::Hull {
+            // The library groups hulls with the exact schedule whatever the mode says; a run
+            // that reported a partitioned schedule (and its chunks) would not be the run made.
+            let flag = if self.fast {
+                "--fast"
+            } else {
+                "--schedule partitioned"
+            };
+            anyhow::bail!(
+                "{flag} needs --pset aabb (the hull p-set has no partitioned form: \
+                 drop it to group hulls with the exact schedule)"
+            );
+        }
         params.check().map_err(anyhow::Error::msg)?;
         Ok(params)
     }
