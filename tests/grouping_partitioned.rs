@@ -436,6 +436,7 @@ fn replay_verifies_a_partitioned_recording() {
     );
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("Partitioned on 1 thread"), "{text}");
+    assert!(!text.contains("grouped whole"), "{text}");
     assert!(
         text.contains("δ = 4, ε = 0.5, root share 8192, SAH cuts up to 256 primitives"),
         "{text}"
@@ -596,6 +597,30 @@ fn a_chosen_chunk_size_is_recorded_replayed_and_checked() {
     let out = wraptree(&["record", "s.obj", "-o", "e"], dir.path());
     let exact = recorded(&out, &dir.path().join("e.mcap"));
     assert_eq!(whole.merges, exact.merges);
+    // `group` says when the scene is one subproblem (at most 1.5 × the root share), where no
+    // chunk setting changes the tree.
+    let out = wraptree(
+        &[
+            "group",
+            "s.obj",
+            "--schedule",
+            "partitioned",
+            "--chunk-delta",
+            "64",
+        ],
+        dir.path(),
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("δ = 64") && text.contains("grouped whole"),
+        "{text}"
+    );
+    let out = wraptree(&["group", "s.obj", "--fast"], dir.path());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("δ = 2") && !text.contains("grouped whole"),
+        "{text}"
+    );
     let out = wraptree(&["group", "s.obj", "--chunk-delta", "64"], dir.path());
     common::assert_one_line_error(&out, "--chunk-delta needs --schedule partitioned");
     let out = wraptree(
