@@ -338,13 +338,7 @@ fn the_cli_refuses_a_partitioned_schedule_of_hulls_instead_of_reporting_one() {
     );
     common::assert_one_line_error(&out, "--fast needs --pset aabb");
     assert!(!dir.path().join("h.mcap").exists() && !dir.path().join("h.rrd").exists());
-    let out = wraptree(&["group", "s.obj", "--pset", "hull"], dir.path());
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8_lossy(&out.stdout);
+    let text = common::printed(&["group", "s.obj", "--pset", "hull"], dir.path());
     assert!(text.contains("schedule    Exact"), "{text}");
 }
 
@@ -599,24 +593,16 @@ fn a_chosen_chunk_size_is_recorded_replayed_and_checked() {
     assert_eq!(whole.merges, exact.merges);
     // `group` says when the scene is one subproblem (at most 1.5 × the root share), where no
     // chunk setting changes the tree.
-    let out = wraptree(
-        &[
-            "group",
-            "s.obj",
-            "--schedule",
-            "partitioned",
-            "--chunk-delta",
-            "64",
-        ],
+    let partitioned = ["group", "s.obj", "--schedule", "partitioned"];
+    let text = common::printed(
+        &[&partitioned[..], &["--chunk-delta", "64"]].concat(),
         dir.path(),
     );
-    let text = String::from_utf8_lossy(&out.stdout);
     assert!(
         text.contains("δ = 64") && text.contains("grouped whole"),
         "{text}"
     );
-    let out = wraptree(&["group", "s.obj", "--fast"], dir.path());
-    let text = String::from_utf8_lossy(&out.stdout);
+    let text = common::printed(&["group", "s.obj", "--fast"], dir.path());
     assert!(
         text.contains("δ = 2") && !text.contains("grouped whole"),
         "{text}"

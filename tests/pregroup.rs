@@ -314,17 +314,14 @@ fn pregrouped_recordings_replay_identically() {
     assert_eq!(p["classes"].as_u64(), Some(1));
     assert_eq!(p["primitives_saved"].as_u64(), Some(552));
     assert_eq!(v["parent"].as_array().unwrap().len(), 2 * 828 - 1);
-    let out = wraptree(
-        &[
-            "group",
-            "rb3.obj",
-            "--pregroup",
-            "connected",
-            "--instancing",
-        ],
-        dir.path(),
-    );
-    let text = String::from_utf8_lossy(&out.stdout);
+    let args = [
+        "group",
+        "rb3.obj",
+        "--pregroup",
+        "connected",
+        "--instancing",
+    ];
+    let text = common::printed(&args, dir.path());
     assert!(
         text.contains("instancing") && text.contains("copies"),
         "{text}"

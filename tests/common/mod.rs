@@ -30,6 +30,18 @@ pub fn wraptree(args: &[&str], dir: &std::path::Path) -> std::process::Output {
         .expect("the binary runs")
 }
 
+/// What the `wraptree` binary printed on stdout, run with `args` in `dir`; panics (with its
+/// stderr) if it failed.
+pub fn printed(args: &[&str], dir: &std::path::Path) -> String {
+    let out = wraptree(args, dir);
+    assert!(
+        out.status.success(),
+        "wraptree {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
 /// Runs `cmd` to its end like `Command::output`, but panics (naming `what`) if it has not
 /// ended within `limit`, after killing it: a stuck child fails its test instead of holding the
 /// whole run.
