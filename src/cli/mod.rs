@@ -288,6 +288,8 @@ impl GroupArgs {
         if params.mode.schedule == Schedule::Partitioned && params.pset == PSet::Hull {
             // The library groups hulls with the exact schedule whatever the mode says; a run
             // that reported a partitioned schedule (and its chunks) would not be the run made.
+            // Refused here, not in `Mode::check`, which recordings' metadata also passes:
+            // recordings made with this pair still replay (as the exact run they were).
             let flag = if self.fast {
                 "--fast"
             } else {

@@ -23,7 +23,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 const GATHER_AHEAD: usize = 16;
 
 /// The [`Chunking`] `params.mode` names.
-fn chunking_of(params: &ResolvedParams) -> Chunking {
+pub(crate) fn chunking_of(params: &ResolvedParams) -> Chunking {
     Chunking {
         top: params.mode.chunk_top,
         epsilon: params.mode.chunk_epsilon,

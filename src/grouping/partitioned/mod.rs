@@ -25,6 +25,6 @@ mod subproblem;
 mod tests;
 mod voxel_step;
 
+pub(crate) use group::{chunking_of, run, run_boxes};
 pub use group::{group_boxes, group_with};
-pub(crate) use group::{run, run_boxes};
 pub use plan::Chunking;
