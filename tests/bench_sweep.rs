@@ -204,6 +204,86 @@ fn bench_writes_one_row_per_method_and_wrapper_with_charts_and_rrd() {
     );
 }
 
+/// The SAH column of each method's row in `dir`'s results.csv.
+fn sah_by_method(dir: &Path) -> Vec<(String, f64)> {
+    let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    csv.lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[col("method")].to_string(), f[col("sah")].parse().unwrap())
+        })
+        .collect()
+}
+
+#[test]
+fn bench_sets_the_partitioned_chunks_and_refuses_them_where_they_set_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    // 3,000 triangles under a root share of 256 are split; chunks as large as the scene make
+    // the partitioned run the exact one, chunks of 4 do not.
+    let run = |name: &str, delta: &str| {
+        let out = dir.path().join(name);
+        let r = wraptree(&[
+            "bench",
+            "soup:3000",
+            "--methods",
+            "grouping,grouping-partitioned",
+            "--wrappers",
+            "box",
+            "--tightness-max-n",
+            "0",
+            "--repeat",
+            "1",
+            "--chunk-top",
+            "256",
+            "--chunk-delta",
+            delta,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(err.contains(&format!("chunks of δ = {delta}")), "{err}");
+        sah_by_method(&out)
+    };
+    let whole = run("whole", "3000");
+    assert_eq!(whole[0].0, "grouping");
+    assert_eq!(whole[1].0, "grouping-partitioned");
+    assert_eq!(whole[0].1, whole[1].1);
+    let small = run("small", "4");
+    assert_eq!(small[0].1, whole[0].1);
+    assert_ne!(small[1].1, small[0].1);
+    let o = dir.path().join("refused");
+    let o = o.to_str().unwrap();
+    let out = wraptree(&[
+        "bench",
+        "soup:300",
+        "--methods",
+        "grouping,fast",
+        "--chunk-delta",
+        "64",
+        "-o",
+        o,
+    ]);
+    common::assert_one_line_error(&out, "--chunk-delta sets grouping-partitioned's chunks");
+    let out = wraptree(&["bench", "--partitioned", "--chunk-top", "64", "-o", o]);
+    common::assert_one_line_error(&out, "--chunk-top needs SCENEs");
+    let out = wraptree(&[
+        "bench",
+        "soup:300",
+        "--methods",
+        "grouping-partitioned",
+        "--chunk-delta",
+        "1",
+        "-o",
+        o,
+    ]);
+    common::assert_one_line_error(&out, "--chunk-delta (δ) must be at least 2, got 1");
+    assert!(!Path::new(o).exists());
+}
+
 #[test]
 fn sweep_writes_every_setting_to_csv_heat_maps_and_one_rrd() {
     let dir = tempfile::tempdir().unwrap();

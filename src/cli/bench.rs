@@ -2,7 +2,7 @@
 //! the targets table against obvhs PLOC and parry Binned measured in the same run, and (with
 //! `--record`) what recording costs ([`wraptree::metrics::bench`]).
 
-use super::progress;
+use super::{ChunkArgs, progress};
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
@@ -36,6 +36,7 @@ pub struct BenchCmd {
     force: bool,
     /// Hierarchy builders to compare (comma list, or `all`) [default:
     /// grouping,fast,grouping+refine,grouping-partitioned,parry-binned,obvhs-ploc,obvhs-ploc-reinsert].
+    /// The --chunk-* flags set grouping-partitioned's chunks (`fast` keeps its own).
     #[arg(long, value_delimiter = ',', value_parser = method_choice)]
     methods: Vec<Choice<Method>>,
     /// Wrappers to build on each hierarchy (comma list, or `all`) [default:
@@ -71,6 +72,9 @@ pub struct BenchCmd {
     /// scenes on the targets scenes (and a 10^7 soup with --max-soup 10000000).
     #[arg(long, conflicts_with = "record")]
     partitioned: bool,
+    /// The chunks of grouping-partitioned and grouping-partitioned+refine.
+    #[command(flatten)]
+    chunks: ChunkArgs,
 }
 
 /// A `--methods` or `--wrappers` item: one name, or `all`.
@@ -131,6 +135,13 @@ impl BenchCmd {
     pub fn run(self) -> Result<ExitCode> {
         let threads = super::build_pool(self.threads)?;
         eprintln!("threads: {threads} (rayon pool)");
+        if let Some(flag) = self.chunks.first_set()
+            && (self.record || self.partitioned || self.scenes.is_empty())
+        {
+            anyhow::bail!(
+                "{flag} needs SCENEs (it sets grouping-partitioned's chunks in their table)"
+            );
+        }
         if self.record {
             return self.run_record();
         }
@@ -156,6 +167,25 @@ impl BenchCmd {
         }
         if !self.wrappers.is_empty() {
             opts.wrappers = chosen(&self.wrappers, &Wrapper::ALL);
+        }
+        if let Some(flag) = self.chunks.first_set() {
+            let partitioned = [
+                Method::GroupingPartitioned,
+                Method::GroupingPartitionedRefine,
+            ];
+            if !opts.methods.iter().any(|m| partitioned.contains(m)) {
+                anyhow::bail!(
+                    "{flag} sets grouping-partitioned's chunks: name grouping-partitioned \
+                     or grouping-partitioned+refine in --methods"
+                );
+            }
+            opts.params.mode = self.chunks.apply(opts.params.mode);
+            opts.params.check().map_err(anyhow::Error::msg)?;
+            let m = opts.params.mode;
+            eprintln!(
+                "grouping-partitioned: chunks of δ = {}, ε = {}, root share {}, SAH cuts up to {}",
+                m.chunk_delta, m.chunk_epsilon, m.chunk_top, m.chunk_sah
+            );
         }
         let output = output_dir(self.output.as_deref(), "recordings/bench")?;
         let names: Vec<&str> = scenes.iter().map(|s| s.name.as_str()).collect();

@@ -199,31 +199,9 @@ pub struct GroupArgs {
     /// Size measure in the Cost: diameter (the paper's) or area (surface area of the box).
     #[arg(long, value_enum, default_value_t = CostMeasure::Diameter)]
     pub cost: CostMeasure,
-    /// Partitioned schedule: about how many bodies its root step (the exact schedule's) starts
-    /// from; scenes of at most 1.5× this are grouped whole. Smaller is faster on scenes of
-    /// 10^4–10^5 primitives and further from the exact tree; 0 = AAC's reduction alone
-    /// [default: 8192].
-    #[arg(long, value_name = "N")]
-    pub chunk_top: Option<u32>,
-    /// Partitioned schedule: δ, the largest range of primitives grouped as one chunk (by the
-    /// exact step, down to δ/2 bodies at ε = 0.5), at least 2 [default: 4, 2 with --fast].
-    /// Larger chunks make more of the merges the exact run's own: 4096 kept every real mesh
-    /// tried within 2 % of the exact tree's SAH and node tests, at about the exact schedule's
-    /// time on one thread, spread over the threads above 3·10^4 primitives (0.4–0.8× its time
-    /// on two).
-    #[arg(long, value_name = "N")]
-    pub chunk_delta: Option<u32>,
-    /// Partitioned schedule: ε of AAC's reduction f(n) = ⌈c·n^(1/2 − ε)⌉, c = δ^(1/2 + ε)/2
-    /// (δ = 4, 2 with --fast), the bodies a node of n primitives leaves below the root share:
-    /// 0.5 leaves 2 per node (1 with --fast), AAC's fast setting 0.2 more (slower)
-    /// [default: 0.5].
-    #[arg(long, value_name = "E")]
-    pub chunk_epsilon: Option<f64>,
-    /// Partitioned schedule: ranges of at most N primitives are cut where binned SAH on the
-    /// best axis of their centres puts the cut, not at a Morton bit (which runs through
-    /// clusters); 0 = Morton cuts throughout [default: 256].
-    #[arg(long, value_name = "N")]
-    pub chunk_sah: Option<u32>,
+    /// The partitioned schedule's chunking.
+    #[command(flatten)]
+    pub chunks: ChunkArgs,
     /// Threads for the parallel steps (partitioned chunks, the exact run's round-start scans);
     /// the tree is the same for any count [default: all cores].
     #[arg(long, value_name = "N")]
@@ -256,31 +234,14 @@ impl GroupArgs {
                 pregroup: self.pregroup,
                 instancing: self.instancing,
                 cost: self.cost,
-                chunk_top: self.chunk_top.unwrap_or(Mode::default().chunk_top),
-                chunk_delta: self.chunk_delta.unwrap_or(Mode::default().chunk_delta),
-                chunk_epsilon: self.chunk_epsilon.unwrap_or(Mode::default().chunk_epsilon),
-                chunk_sah: self.chunk_sah.unwrap_or(Mode::default().chunk_sah),
-                chunk_max: Mode::default().chunk_max,
-                chunk_few: Mode::default().chunk_few,
+                ..Mode::default()
             },
         };
         if self.fast {
-            let fast = params.mode.fast();
-            params.mode = Mode {
-                chunk_top: self.chunk_top.unwrap_or(fast.chunk_top),
-                chunk_delta: self.chunk_delta.unwrap_or(fast.chunk_delta),
-                chunk_epsilon: self.chunk_epsilon.unwrap_or(fast.chunk_epsilon),
-                chunk_sah: self.chunk_sah.unwrap_or(fast.chunk_sah),
-                ..fast
-            };
+            params.mode = params.mode.fast();
         }
-        let chunking = [
-            (self.chunk_top.is_some(), "--chunk-top"),
-            (self.chunk_delta.is_some(), "--chunk-delta"),
-            (self.chunk_epsilon.is_some(), "--chunk-epsilon"),
-            (self.chunk_sah.is_some(), "--chunk-sah"),
-        ];
-        if let Some((_, flag)) = chunking.iter().find(|(set, _)| *set)
+        params.mode = self.chunks.apply(params.mode);
+        if let Some(flag) = self.chunks.first_set()
             && params.mode.schedule != Schedule::Partitioned
         {
             anyhow::bail!("{flag} needs --schedule partitioned or --fast");
@@ -302,6 +263,62 @@ impl GroupArgs {
         }
         params.check().map_err(anyhow::Error::msg)?;
         Ok(params)
+    }
+}
+
+/// The partitioned schedule's chunking flags (`--chunk-*`); unset ones keep the schedule's own
+/// setting (the default partitioned one, or the fast path's).
+#[derive(Args, Debug, Clone, Default)]
+pub struct ChunkArgs {
+    /// Partitioned schedule: about how many bodies its root step (the exact schedule's) starts
+    /// from; scenes of at most 1.5× this are grouped whole. Smaller is faster on scenes of
+    /// 10^4–10^5 primitives and further from the exact tree; 0 = AAC's reduction alone
+    /// [default: 8192].
+    #[arg(long, value_name = "N")]
+    pub chunk_top: Option<u32>,
+    /// Partitioned schedule: δ, the largest range of primitives grouped as one chunk (by the
+    /// exact step, down to δ/2 bodies at ε = 0.5), at least 2 [default: 4, 2 with --fast].
+    /// Larger chunks make more of the merges the exact run's own: 4096 kept every real mesh
+    /// tried within 2 % of the exact tree's SAH and node tests, at about the exact schedule's
+    /// time on one thread, spread over the threads above 3·10^4 primitives (0.4–0.8× its time
+    /// on two).
+    #[arg(long, value_name = "N")]
+    pub chunk_delta: Option<u32>,
+    /// Partitioned schedule: ε of AAC's reduction f(n) = ⌈c·n^(1/2 − ε)⌉, c = δ^(1/2 + ε)/2
+    /// (δ = 4, 2 with --fast), the bodies a node of n primitives leaves below the root share:
+    /// 0.5 leaves 2 per node (1 with --fast), AAC's fast setting 0.2 more (slower)
+    /// [default: 0.5].
+    #[arg(long, value_name = "E")]
+    pub chunk_epsilon: Option<f64>,
+    /// Partitioned schedule: ranges of at most N primitives are cut where binned SAH on the
+    /// best axis of their centres puts the cut, not at a Morton bit (which runs through
+    /// clusters); 0 = Morton cuts throughout [default: 256].
+    #[arg(long, value_name = "N")]
+    pub chunk_sah: Option<u32>,
+}
+
+impl ChunkArgs {
+    /// `mode` with the flags that are set in place of its chunk settings.
+    pub fn apply(&self, mode: Mode) -> Mode {
+        Mode {
+            chunk_top: self.chunk_top.unwrap_or(mode.chunk_top),
+            chunk_delta: self.chunk_delta.unwrap_or(mode.chunk_delta),
+            chunk_epsilon: self.chunk_epsilon.unwrap_or(mode.chunk_epsilon),
+            chunk_sah: self.chunk_sah.unwrap_or(mode.chunk_sah),
+            ..mode
+        }
+    }
+
+    /// The first flag that is set, if any (for errors naming it).
+    pub fn first_set(&self) -> Option<&'static str> {
+        [
+            (self.chunk_top.is_some(), "--chunk-top"),
+            (self.chunk_delta.is_some(), "--chunk-delta"),
+            (self.chunk_epsilon.is_some(), "--chunk-epsilon"),
+            (self.chunk_sah.is_some(), "--chunk-sah"),
+        ]
+        .into_iter()
+        .find_map(|(set, flag)| set.then_some(flag))
     }
 }
 
