@@ -204,8 +204,8 @@ fn bench_writes_one_row_per_method_and_wrapper_with_charts_and_rrd() {
     );
 }
 
-/// The SAH column of each method's row in `dir`'s results.csv.
-fn sah_by_method(dir: &Path) -> Vec<(String, f64)> {
+/// The SAH and chunking columns of each method's row in `dir`'s results.csv.
+fn sah_by_method(dir: &Path) -> Vec<(String, f64, String)> {
     let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
     let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
     let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
@@ -213,7 +213,11 @@ fn sah_by_method(dir: &Path) -> Vec<(String, f64)> {
         .skip(1)
         .map(|l| {
             let f: Vec<&str> = l.split(',').collect();
-            (f[col("method")].to_string(), f[col("sah")].parse().unwrap())
+            (
+                f[col("method")].to_string(),
+                f[col("sah")].parse().unwrap(),
+                f[col("chunking")].to_string(),
+            )
         })
         .collect()
 }
@@ -252,6 +256,9 @@ fn bench_sets_the_partitioned_chunks_and_refuses_them_where_they_set_nothing() {
     assert_eq!(whole[0].0, "grouping");
     assert_eq!(whole[1].0, "grouping-partitioned");
     assert_eq!(whole[0].1, whole[1].1);
+    // The CSV names the chunks each partitioned row grouped with.
+    assert_eq!(whole[0].2, "");
+    assert_eq!(whole[1].2, "delta=3000 epsilon=0.5 top=256 sah=256");
     let small = run("small", "4");
     assert_eq!(small[0].1, whole[0].1);
     assert_ne!(small[1].1, small[0].1);

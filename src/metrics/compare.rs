@@ -148,6 +148,9 @@ pub struct Row {
     pub tightness_levels: Vec<f64>,
     /// Query cost with this wrapper as bounding volume (`None`: not a query volume).
     pub query: Option<QueryCost>,
+    /// The partitioned schedule's chunks the method grouped with ([`Method::chunking`];
+    /// empty for the methods that do not run it).
+    pub chunking: String,
 }
 
 /// Seconds after which a case is not repeated further: a run this long is timed well enough
@@ -299,6 +302,7 @@ pub fn evaluate(
                 tightness: w.tightness,
                 tightness_levels: w.tightness_levels,
                 query: w.query,
+                chunking: method.chunking(&opts.params).unwrap_or_default(),
             });
         }
     }

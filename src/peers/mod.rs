@@ -178,6 +178,23 @@ impl Method {
     }
 }
 
+impl Method {
+    /// The partitioned schedule's settings this method groups with under `params`, for the
+    /// methods that run it (`grouping-partitioned` with `params`' chunks, `fast` with its own):
+    /// `delta=… epsilon=… top=… sah=…`, as the `--chunk-*` flags name them.
+    pub fn chunking(self, params: &Params) -> Option<String> {
+        let mode = match self.base() {
+            Method::GroupingPartitioned => params.mode,
+            Method::GroupingFast => params.mode.fast(),
+            _ => return None,
+        };
+        Some(format!(
+            "delta={} epsilon={} top={} sah={}",
+            mode.chunk_delta, mode.chunk_epsilon, mode.chunk_top, mode.chunk_sah
+        ))
+    }
+}
+
 /// A built hierarchy.
 #[derive(Clone, Debug)]
 pub struct Built {
@@ -358,6 +375,22 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
 mod tests {
     use super::*;
     use crate::scene::generate;
+
+    #[test]
+    fn the_partitioned_methods_name_their_chunks_and_the_others_none() {
+        let mut p = Params::default();
+        p.mode.chunk_delta = 4096;
+        let d = "delta=4096 epsilon=0.5 top=8192 sah=256";
+        assert_eq!(Method::GroupingPartitioned.chunking(&p).as_deref(), Some(d));
+        assert_eq!(Method::GroupingPartitionedRefine.chunking(&p).as_deref(), Some(d));
+        // The fast path keeps its own chunks whatever `params` say.
+        let f = "delta=2 epsilon=0.5 top=32 sah=256";
+        assert_eq!(Method::Fast.chunking(&p).as_deref(), Some(f));
+        assert_eq!(Method::GroupingFast.chunking(&p).as_deref(), Some(f));
+        for m in [Method::Grouping, Method::GroupingRefine, Method::ObvhsPloc] {
+            assert_eq!(m.chunking(&p), None, "{}", m.name());
+        }
+    }
 
     #[test]
     fn every_method_builds_a_valid_tree() {

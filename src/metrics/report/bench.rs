@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 pub fn bench_csv(rows: &[Row]) -> Result<Vec<u8>> {
     let header = format!(
         "scene,n,method,wrapper,build_s,refine_s,wrapper_s,sah,depth_max,depth_mean,structural_balance,\
-spatial_balance,tightness,tightness_per_level,{QUERY_COLUMNS}"
+spatial_balance,tightness,tightness_per_level,{QUERY_COLUMNS},chunking"
     );
     csv_bytes(&header, rows.iter().map(bench_record))
 }
@@ -47,6 +47,7 @@ fn bench_record(r: &Row) -> Vec<String> {
             .join(";"),
     ];
     fields.extend(query_fields(r.query.as_ref()));
+    fields.push(r.chunking.clone());
     fields
 }
 
@@ -354,6 +355,7 @@ mod tests {
             tightness: Some(0.25),
             tightness_levels: vec![0.5, 0.25],
             query: None,
+            chunking: String::new(),
         }
     }
 
