@@ -382,7 +382,10 @@ mod tests {
         p.mode.chunk_delta = 4096;
         let d = "delta=4096 epsilon=0.5 top=8192 sah=256";
         assert_eq!(Method::GroupingPartitioned.chunking(&p).as_deref(), Some(d));
-        assert_eq!(Method::GroupingPartitionedRefine.chunking(&p).as_deref(), Some(d));
+        assert_eq!(
+            Method::GroupingPartitionedRefine.chunking(&p).as_deref(),
+            Some(d)
+        );
         // The fast path keeps its own chunks whatever `params` say.
         let f = "delta=2 epsilon=0.5 top=32 sah=256";
         assert_eq!(Method::Fast.chunking(&p).as_deref(), Some(f));
