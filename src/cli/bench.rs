@@ -169,11 +169,11 @@ impl BenchCmd {
             opts.wrappers = chosen(&self.wrappers, &Wrapper::ALL);
         }
         if let Some(flag) = self.chunks.first_set() {
-            let partitioned = [
-                Method::GroupingPartitioned,
-                Method::GroupingPartitionedRefine,
-            ];
-            if !opts.methods.iter().any(|m| partitioned.contains(m)) {
+            if !opts
+                .methods
+                .iter()
+                .any(|m| m.base() == Method::GroupingPartitioned)
+            {
                 anyhow::bail!(
                     "{flag} sets grouping-partitioned's chunks: name grouping-partitioned \
                      or grouping-partitioned+refine in --methods"

@@ -176,9 +176,7 @@ impl Method {
             m => m,
         }
     }
-}
 
-impl Method {
     /// The partitioned schedule's settings this method groups with under `params`, for the
     /// methods that run it (`grouping-partitioned` with `params`' chunks, `fast` with its own):
     /// `delta=… epsilon=… top=… sah=…`, as the `--chunk-*` flags name them.
