@@ -4,6 +4,10 @@
 //! (all queries, and the point and distance queries alone); with `LOOP=SECONDS` set it instead builds
 //! the first method on the first file over and over for that long (a target for `perf`).
 //!
+//! With `MIRROR=1` every method's tree (the peers' too) is measured a second time with each
+//! node's two children swapped, and a second table gives both node tests: the queries that
+//! stop at their first touching pair depend on which child is visited first, the others not.
+//!
 //! The fast path's settings can be varied through the environment: `TOP`, `SAH`, `EPS`, `MAX`
 //! (its split: root share, SAH-cut size, ε, largest chunk) and `PASSES`, `BATCH` (its reinsertion passes).
 //!
@@ -106,11 +110,14 @@ fn main() -> anyhow::Result<()> {
         Method::ObvhsPloc,
         Method::ObvhsPlocReinsert,
     ];
+    let mut mirrored_rows = Vec::new();
     for f in &files {
         let scene = load_path(Path::new(f), &LoadOptions::default())?.scene;
         let workload = Workload::standard(&scene, 1);
         // Best time of the repeats, with its refinement share, SAH and node tests per query.
-        let best = |m: Method| -> (f64, f64, f64, f64, f64) {
+        let mirror = env::<u32>("MIRROR") == Some(1);
+        let mut mirrored = Vec::new();
+        let mut best = |m: Method| -> (f64, f64, f64, f64, f64) {
             pool.install(|| {
                 let mut best: Option<Built> = None;
                 for _ in 0..repeat {
@@ -126,6 +133,12 @@ fn main() -> anyhow::Result<()> {
                 let far = (v[0] * workload.points.len() as f64
                     + v[2] * workload.poses_near.len() as f64)
                     / queries;
+                if mirror {
+                    let mut t = b.tree.clone();
+                    t.children.iter_mut().for_each(|k| k.swap(0, 1));
+                    let w = query_values(&measure(&t, &scene, Bv::Aabb, &workload));
+                    mirrored.push((scene.name.clone(), m.name(), v[6], w[6], far));
+                }
                 (b.seconds, b.refine_seconds, sah(&b.tree), v[6], far)
             })
         };
@@ -148,6 +161,20 @@ fn main() -> anyhow::Result<()> {
                 q / best_sah,
                 t / best_tests,
                 f / best_far
+            );
+        }
+        mirrored_rows.append(&mut mirrored);
+    }
+    if !mirrored_rows.is_empty() {
+        println!();
+        println!(
+            "| scene | method | node tests | children swapped | swapped / stored | point and distance queries |"
+        );
+        println!("|---|---|---|---|---|---|");
+        for (name, m, a, b, far) in &mirrored_rows {
+            println!(
+                "| {name} | {m} | {a:.1} | {b:.1} | {:.3} | {far:.1} |",
+                b / a
             );
         }
     }

@@ -78,7 +78,7 @@ fn the_fast_flag_groups_partitioned_with_the_fast_split_and_parses_like_the_othe
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(text.contains("Partitioned on 1 thread"), "{text}");
-    assert!(text.contains("root share 32,"), "{text}");
+    assert!(text.contains("root share 16,"), "{text}");
     assert!(text.contains("chunks of δ = 2,"), "{text}");
     // The --chunk-* flags apply on the fast path.
     let out = wraptree(

@@ -385,7 +385,7 @@ mod tests {
             Some(d)
         );
         // The fast path keeps its own chunks whatever `params` say.
-        let f = "delta=2 epsilon=0.5 top=32 sah=256";
+        let f = "delta=2 epsilon=0.5 top=16 sah=256";
         assert_eq!(Method::Fast.chunking(&p).as_deref(), Some(f));
         assert_eq!(Method::GroupingFast.chunking(&p).as_deref(), Some(f));
         for m in [Method::Grouping, Method::GroupingRefine, Method::ObvhsPloc] {

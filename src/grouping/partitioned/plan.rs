@@ -54,17 +54,18 @@ impl Chunking {
     };
 
     /// The fast path's split (`--fast`, bench method `fast`): the default's with a root share
-    /// of 32 bodies and δ = 2, so that f(n) = 1: below the root share every node merges its two
+    /// of 16 bodies and δ = 2, so that f(n) = 1: below the root share every node merges its two
     /// halves, and the tree there is the split's own (SAH cuts in ranges of up to 256
-    /// primitives, Morton cuts above), under a root step of about 32 bodies; only scenes of at
-    /// most 48 primitives are grouped whole. Its trees are further from the exact schedule's
+    /// primitives, Morton cuts above), under a root step of about 16 bodies; only scenes of at
+    /// most 24 primitives are grouped whole. Its trees are further from the exact schedule's
     /// than the default's; the fast path's refinement (`refine::FAST`) takes their SAH back
     /// down. Root shares of 16–256 gave the same SAH and node tests after the refinement on 37
-    /// scenes, the smaller ones in less time; δ = 2 against 4 (with the executor's lean
-    /// recursion for such subtrees) took about a fifth off the time and left as good trees
-    /// (`docs/benchmarks.md`, "Users' sizes").
+    /// scenes; 16 against 32 took 10–23 % off scenes under 1,000 primitives (the root step's
+    /// Cost table is a quarter the size) and left the larger ones as they were, on 69 real
+    /// meshes. δ = 2 against 4 (with the executor's lean recursion for such subtrees) took about
+    /// a fifth off the time and left as good trees (`docs/benchmarks.md`, "Users' sizes").
     pub const FAST: Chunking = Chunking {
-        top: 32,
+        top: 16,
         delta: 2,
         few: 4,
         ..Chunking::DEFAULT
