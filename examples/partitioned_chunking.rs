@@ -5,7 +5,7 @@
 //!
 //! `cargo run --release --example partitioned_chunking [MAX_SOUP] [DELTA:EPSILON[:TOP[:SAH]] ...]
 //! [FILE ...]` — default 100000 and the default chunking and 20:0.1 (AAC's high-quality
-//! setting); scene files are grouped after the targets scenes (held-out scenes). `THREADS=T` runs
+//! setting); δ = 0 is the default's δ by the scene's size (`Chunking::delta_for`); scene files are grouped after the targets scenes (held-out scenes). `THREADS=T` runs
 //! every build in a pool of T threads instead of one.
 
 use std::time::Instant;
@@ -35,7 +35,7 @@ fn main() -> anyhow::Result<()> {
         .map(|a| parse(a))
         .collect::<anyhow::Result<Vec<_>>>()?;
     if chunkings.is_empty() {
-        chunkings = vec![Chunking::DEFAULT, parse("20:0.1")?];
+        chunkings = vec![parse("0")?, parse("20:0.1")?];
     }
     let threads = std::env::var("THREADS")
         .ok()
@@ -69,6 +69,10 @@ fn main() -> anyhow::Result<()> {
         print!("{:<18} {:>8} {:>9.2}", scene.name, scene.len(), te * 1e3);
         let params = Params::default().resolve(scene);
         for (ch, sum) in chunkings.iter().zip(&mut sums) {
+            let ch = &Chunking {
+                delta: Chunking::delta_for(ch.delta, scene.len()),
+                ..*ch
+            };
             let t = Instant::now();
             let g = pool
                 .install(|| group_with(scene, &params, ch, (), &budget))

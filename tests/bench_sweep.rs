@@ -287,7 +287,10 @@ fn bench_sets_the_partitioned_chunks_and_refuses_them_where_they_set_nothing() {
         "-o",
         o,
     ]);
-    common::assert_one_line_error(&out, "--chunk-delta (δ) must be at least 2, got 1");
+    common::assert_one_line_error(
+        &out,
+        "--chunk-delta (δ) must be at least 2 (or 0: by the scene's size), got 1",
+    );
     assert!(!Path::new(o).exists());
 }
 

@@ -407,7 +407,9 @@ fn replay_verifies_a_partitioned_recording() {
     );
     let rec = recorded(&out, &dir.path().join("p.mcap"));
     assert_eq!(rec.params.mode.schedule, Schedule::Partitioned);
-    assert!(rec.parts.len() > 10, "{} parts recorded", rec.parts.len());
+    // δ by the scene's size: chunks of up to 4,096 primitives.
+    assert_eq!(rec.params.mode.chunk_delta, 4096);
+    assert!(rec.parts.len() > 2, "{} parts recorded", rec.parts.len());
     let (_, log) = run(&scene, &partitioned(Params::default()));
     assert_eq!(rec.parts, log.parts);
     let out = wraptree(&["replay", "p.mcap", "--verify"], dir.path());
@@ -432,7 +434,7 @@ fn replay_verifies_a_partitioned_recording() {
     assert!(text.contains("Partitioned on 1 thread"), "{text}");
     assert!(!text.contains("grouped whole"), "{text}");
     assert!(
-        text.contains("δ = 4, ε = 0.5, root share 8192, SAH cuts up to 256 primitives"),
+        text.contains("δ = 4096, ε = 0.5, root share 8192, SAH cuts up to 256 primitives"),
         "{text}"
     );
     let out = wraptree(&["group", "s.obj", "--threads", "0"], dir.path());
@@ -441,11 +443,20 @@ fn replay_verifies_a_partitioned_recording() {
 
 #[test]
 fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
-    // Whole under the default share (`Chunking::whole`), split under a share of 256.
+    // Whole under the default share (`Chunking::whole`), split under a share of 256 into
+    // chunks of 4.
     let n = 3_000;
     assert!(Chunking::DEFAULT.whole(n));
     let dir = common::soup_dir(n, 6);
-    let args = ["record", "s.obj", "--schedule", "partitioned", "-o"];
+    let args = [
+        "record",
+        "s.obj",
+        "--schedule",
+        "partitioned",
+        "--chunk-delta",
+        "4",
+        "-o",
+    ];
     let out = wraptree(
         &[&args[..], &["p", "--chunk-top", "256"]].concat(),
         dir.path(),
@@ -495,8 +506,8 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
     old.remove("chunk_max");
     let params = wraptree::record::mcap::metadata::params(&old).unwrap();
     assert_eq!(params.mode.chunk_max, Chunking::DEFAULT.delta - 1);
-    // δ is recorded and read back: 4 by default, 2 on the fast path, and a recording without
-    // it was made with 4.
+    // δ is recorded and read back as the run used it (4 here, 2 on the fast path), and a
+    // partitioned recording without it was made with 4.
     assert_eq!(
         rec.metadata.get("chunk_delta").map(String::as_str),
         Some("4")
@@ -514,7 +525,7 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
     rejects(
         "chunk_delta",
         "1",
-        "--chunk-delta (δ) must be at least 2, got 1",
+        "--chunk-delta (δ) must be at least 2 (or 0: by the scene's size), got 1",
     );
     // The largest range that tries every partition: 0 by default, 4 on the fast path; a
     // recording without it was cut by sweeps.
@@ -564,7 +575,10 @@ fn a_chosen_chunk_size_is_recorded_replayed_and_checked() {
         "--chunk-top",
         "256",
     ];
-    let out = wraptree(&[&args[..], &["-o", "d"]].concat(), dir.path());
+    let out = wraptree(
+        &[&args[..], &["--chunk-delta", "4", "-o", "d"]].concat(),
+        dir.path(),
+    );
     let rec_d = recorded(&out, &dir.path().join("d.mcap"));
     let out = wraptree(
         &[&args[..], &["--chunk-delta", "64", "-o", "c"]].concat(),
@@ -591,6 +605,12 @@ fn a_chosen_chunk_size_is_recorded_replayed_and_checked() {
     let out = wraptree(&["record", "s.obj", "-o", "e"], dir.path());
     let exact = recorded(&out, &dir.path().join("e.mcap"));
     assert_eq!(whole.merges, exact.merges);
+    // δ by the scene's size (the default) is 4,096 here: one chunk, the exact run's merges,
+    // recorded as the δ used.
+    let out = wraptree(&[&args[..], &["-o", "s"]].concat(), dir.path());
+    let by_size = recorded(&out, &dir.path().join("s.mcap"));
+    assert_eq!(by_size.params.mode.chunk_delta, 4096);
+    assert_eq!(by_size.merges, exact.merges);
     // `group` says when the scene is one subproblem (at most 1.5 × the root share), where no
     // chunk setting changes the tree.
     let partitioned = ["group", "s.obj", "--schedule", "partitioned"];
@@ -613,7 +633,10 @@ fn a_chosen_chunk_size_is_recorded_replayed_and_checked() {
         &["group", "s.obj", "--fast", "--chunk-delta", "1"],
         dir.path(),
     );
-    common::assert_one_line_error(&out, "--chunk-delta (δ) must be at least 2, got 1");
+    common::assert_one_line_error(
+        &out,
+        "--chunk-delta (δ) must be at least 2 (or 0: by the scene's size), got 1",
+    );
 }
 
 #[test]
@@ -638,4 +661,28 @@ fn larger_chunks_bring_an_assembly_s_tree_back_to_the_exact_one() {
     let (small, large) = (sah_with(4), sah_with(1024));
     assert!(small > 1.03, "δ = 4: {small}");
     assert!((0.99..=1.01).contains(&large), "δ = 1024: {large}");
+}
+
+#[test]
+fn the_default_chunk_size_is_resolved_by_the_scene_s_size() {
+    // δ = 0 (the default) is 4,096 up to 2^18 primitives and 4 above, resolved before the run
+    // so that recordings hold the δ used; the exact schedule does not read it, and a given δ
+    // stays as given.
+    let boxes =
+        |n: usize| vec![wraptree::geom::Aabb::from_points([&wraptree::geom::P3::origin()]); n];
+    let p = partitioned(Params::default());
+    assert_eq!(p.mode.chunk_delta, 0);
+    let at = Chunking::BY_SIZE_UP_TO;
+    assert_eq!(p.resolve_boxes(&boxes(at)).mode.chunk_delta, 4096);
+    assert_eq!(p.resolve_boxes(&boxes(at + 1)).mode.chunk_delta, 4);
+    assert_eq!(
+        Params::default().resolve_boxes(&boxes(10)).mode.chunk_delta,
+        0
+    );
+    let mut given = partitioned(Params::default());
+    given.mode.chunk_delta = 16;
+    assert_eq!(given.resolve_boxes(&boxes(10)).mode.chunk_delta, 16);
+    let mut fast = Params::default();
+    fast.mode = fast.mode.fast();
+    assert_eq!(fast.resolve_boxes(&boxes(10)).mode.chunk_delta, 2);
 }

@@ -182,9 +182,13 @@ impl BenchCmd {
             opts.params.mode = self.chunks.apply(opts.params.mode);
             opts.params.check().map_err(anyhow::Error::msg)?;
             let m = opts.params.mode;
+            let delta = match m.chunk_delta {
+                0 => "by the scene's size".to_string(),
+                d => d.to_string(),
+            };
             eprintln!(
-                "grouping-partitioned: chunks of δ = {}, ε = {}, root share {}, SAH cuts up to {}",
-                m.chunk_delta, m.chunk_epsilon, m.chunk_top, m.chunk_sah
+                "grouping-partitioned: chunks of δ = {delta}, ε = {}, root share {}, SAH cuts up to {}",
+                m.chunk_epsilon, m.chunk_top, m.chunk_sah
             );
         }
         let output = output_dir(self.output.as_deref(), "recordings/bench")?;

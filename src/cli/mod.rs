@@ -277,16 +277,17 @@ pub struct ChunkArgs {
     #[arg(long, value_name = "N")]
     pub chunk_top: Option<u32>,
     /// Partitioned schedule: δ, the largest range of primitives grouped as one chunk (by the
-    /// exact step, down to δ/2 bodies at ε = 0.5), at least 2 [default: 4, 2 with --fast].
-    /// Larger chunks make more of the merges the exact run's own: 4096 kept every real mesh
-    /// tried within 2 % of the exact tree's SAH and node tests, at about the exact schedule's
-    /// time on one thread, spread over the threads above 3·10^4 primitives (0.4–0.8× its time
-    /// on two).
+    /// exact step, down to δ/2 bodies at ε = 0.5), at least 2; 0 = by the scene's size
+    /// [default: 0, 2 with --fast]. By size, scenes of up to 262,144 (2^18) primitives take
+    /// 4096, which kept every real mesh tried within 2 % of the exact tree's SAH and node tests,
+    /// at about the exact schedule's time on one thread, spread over the threads (0.4–0.8× its
+    /// time on two above 3·10^4 primitives); larger scenes take 4, several times faster there
+    /// (use --fast for speed on smaller ones).
     #[arg(long, value_name = "N")]
     pub chunk_delta: Option<u32>,
-    /// Partitioned schedule: ε of AAC's reduction f(n) = ⌈c·n^(1/2 − ε)⌉, c = δ^(1/2 + ε)/2
-    /// (δ = 4, 2 with --fast), the bodies a node of n primitives leaves below the root share:
-    /// 0.5 leaves 2 per node (1 with --fast), AAC's fast setting 0.2 more (slower)
+    /// Partitioned schedule: ε of AAC's reduction f(n) = ⌈c·n^(1/2 − ε)⌉, c = δ^(1/2 + ε)/2,
+    /// the bodies a node of n primitives leaves below the root share: 0.5 leaves δ/2 per node
+    /// (1 with --fast), AAC's fast setting 0.2 more (slower)
     /// [default: 0.5].
     #[arg(long, value_name = "E")]
     pub chunk_epsilon: Option<f64>,

@@ -160,7 +160,10 @@ pub struct Mode {
     /// does not read it.
     pub chunk_top: u32,
     /// The partitioned schedule's chunk size δ
-    /// ([`Chunking::delta`](crate::grouping::partitioned::Chunking::delta)), at least 2.
+    /// ([`Chunking::delta`](crate::grouping::partitioned::Chunking::delta)), at least 2; 0 (the
+    /// default) = by the scene's size, 4,096 up to 2^18 primitives and 4 above
+    /// ([`Chunking::delta_for`](crate::grouping::partitioned::Chunking::delta_for)). Resolved
+    /// parameters hold the δ the run uses.
     pub chunk_delta: u32,
     /// The partitioned schedule's ε in AAC's reduction f(n) = ⌈c·n^(1/2 − ε)⌉
     /// ([`Chunking::epsilon`](crate::grouping::partitioned::Chunking::epsilon)), in [0, 1/2].
@@ -181,7 +184,7 @@ pub struct Mode {
 }
 
 impl Default for Mode {
-    /// The literal §2.2 run; the partitioned schedule's default root share.
+    /// The literal §2.2 run; the partitioned schedule's default root share, δ by the scene's size.
     fn default() -> Self {
         Mode {
             schedule: Schedule::default(),
@@ -189,7 +192,7 @@ impl Default for Mode {
             instancing: false,
             cost: CostMeasure::default(),
             chunk_top: crate::grouping::partitioned::Chunking::DEFAULT.top,
-            chunk_delta: crate::grouping::partitioned::Chunking::DEFAULT.delta,
+            chunk_delta: 0,
             chunk_epsilon: crate::grouping::partitioned::Chunking::DEFAULT.epsilon,
             chunk_sah: crate::grouping::partitioned::Chunking::DEFAULT.sah_below,
             chunk_max: crate::grouping::partitioned::Chunking::DEFAULT.chunk_max,
@@ -229,11 +232,11 @@ impl Mode {
         if self.pregroup != Pregroup::None && pset != PSet::Aabb {
             return Err("--pregroup needs --pset aabb (parts are grouped as boxes)".to_string());
         }
-        if self.chunk_delta < 2 {
-            return Err(format!(
-                "--chunk-delta (δ) must be at least 2, got {}",
-                self.chunk_delta
-            ));
+        if self.chunk_delta == 1 {
+            return Err(
+                "--chunk-delta (δ) must be at least 2 (or 0: by the scene's size), got 1"
+                    .to_string(),
+            );
         }
         let few_max = crate::grouping::partitioned::Chunking::FEW_MAX;
         if self.chunk_few > few_max {
@@ -343,9 +346,11 @@ impl Params {
     /// GLimit0 = DLimit0 / 4. When that median is 0 (point-like primitives) DLimit0 falls back
     /// to 1e-6 × the scene diagonal, and to 1 for a scene that is a single point. A given
     /// DLimit ≤ 0 (or not finite) becomes 1; a given GLimit ≤ 0 becomes 1e-9 × DLimit0, since
-    /// the paper's GLimit must be positive for scenes of several connected components.
+    /// the paper's GLimit must be positive for scenes of several connected components. The
+    /// partitioned schedule's δ of 0 becomes the one for the scene's size.
     pub fn resolve(&self, scene: &Scene) -> ResolvedParams {
         self.resolve_with(
+            scene.len(),
             || {
                 (0..scene.len())
                     .map(|i| scene.prim_aabb(i).diameter())
@@ -360,6 +365,7 @@ impl Params {
     /// scene's.
     pub fn resolve_boxes(&self, boxes: &[Aabb]) -> ResolvedParams {
         self.resolve_with(
+            boxes.len(),
             || {
                 boxes
                     .par_iter()
@@ -371,10 +377,11 @@ impl Params {
         )
     }
 
-    /// The resolution from the primitives' diameters and the scene's diagonal, each computed
-    /// only when needed.
+    /// The resolution for `n` primitives from their diameters and the scene's diagonal, each
+    /// computed only when needed.
     fn resolve_with(
         &self,
+        n: usize,
         diameters: impl FnOnce() -> Vec<f64>,
         diagonal: impl FnOnce() -> f64,
     ) -> ResolvedParams {
@@ -417,7 +424,16 @@ impl Params {
             glimit0,
             pset: self.pset,
             seed: self.seed,
-            mode: self.mode,
+            mode: match self.mode.schedule {
+                Schedule::Partitioned => Mode {
+                    chunk_delta: crate::grouping::partitioned::Chunking::delta_for(
+                        self.mode.chunk_delta,
+                        n,
+                    ),
+                    ..self.mode
+                },
+                Schedule::Exact => self.mode,
+            },
         }
     }
 }

@@ -302,7 +302,9 @@ pub fn evaluate(
                 tightness: w.tightness,
                 tightness_levels: w.tightness_levels,
                 query: w.query,
-                chunking: method.chunking(&opts.params).unwrap_or_default(),
+                chunking: method
+                    .chunking(&opts.params, scene.len())
+                    .unwrap_or_default(),
             });
         }
     }

@@ -177,10 +177,11 @@ impl Method {
         }
     }
 
-    /// The partitioned schedule's settings this method groups with under `params`, for the
-    /// methods that run it (`grouping-partitioned` with `params`' chunks, `fast` with its own):
-    /// `delta=… epsilon=… top=… sah=…`, as the `--chunk-*` flags name them.
-    pub fn chunking(self, params: &Params) -> Option<String> {
+    /// The partitioned schedule's settings this method groups a scene of `n` primitives with
+    /// under `params`, for the methods that run it (`grouping-partitioned` with `params`'
+    /// chunks, `fast` with its own): `delta=… epsilon=… top=… sah=…`, as the `--chunk-*` flags
+    /// name them, with δ as the run uses it ([`Chunking::delta_for`](crate::grouping::partitioned::Chunking::delta_for)).
+    pub fn chunking(self, params: &Params, n: usize) -> Option<String> {
         let mode = match self.base() {
             Method::GroupingPartitioned => params.mode,
             Method::GroupingFast => params.mode.fast(),
@@ -188,7 +189,10 @@ impl Method {
         };
         Some(format!(
             "delta={} epsilon={} top={} sah={}",
-            mode.chunk_delta, mode.chunk_epsilon, mode.chunk_top, mode.chunk_sah
+            crate::grouping::partitioned::Chunking::delta_for(mode.chunk_delta, n),
+            mode.chunk_epsilon,
+            mode.chunk_top,
+            mode.chunk_sah
         ))
     }
 }
@@ -377,19 +381,33 @@ mod tests {
     #[test]
     fn the_partitioned_methods_name_their_chunks_and_the_others_none() {
         let mut p = Params::default();
-        p.mode.chunk_delta = 4096;
+        // δ by the scene's size by default: 4,096 up to 2^18 primitives, 4 above.
+        let by_size = |n| Method::GroupingPartitioned.chunking(&p, n);
         let d = "delta=4096 epsilon=0.5 top=8192 sah=256";
-        assert_eq!(Method::GroupingPartitioned.chunking(&p).as_deref(), Some(d));
+        assert_eq!(by_size(1 << 18).as_deref(), Some(d));
+        let above = "delta=4 epsilon=0.5 top=8192 sah=256";
+        assert_eq!(by_size((1 << 18) + 1).as_deref(), Some(above));
+        p.mode.chunk_delta = 16;
+        let d = "delta=16 epsilon=0.5 top=8192 sah=256";
         assert_eq!(
-            Method::GroupingPartitionedRefine.chunking(&p).as_deref(),
+            Method::GroupingPartitioned.chunking(&p, 10).as_deref(),
+            Some(d)
+        );
+        assert_eq!(
+            Method::GroupingPartitionedRefine
+                .chunking(&p, 1 << 20)
+                .as_deref(),
             Some(d)
         );
         // The fast path keeps its own chunks whatever `params` say.
         let f = "delta=2 epsilon=0.5 top=16 sah=256";
-        assert_eq!(Method::Fast.chunking(&p).as_deref(), Some(f));
-        assert_eq!(Method::GroupingFast.chunking(&p).as_deref(), Some(f));
+        assert_eq!(Method::Fast.chunking(&p, 10).as_deref(), Some(f));
+        assert_eq!(
+            Method::GroupingFast.chunking(&p, 1 << 20).as_deref(),
+            Some(f)
+        );
         for m in [Method::Grouping, Method::GroupingRefine, Method::ObvhsPloc] {
-            assert_eq!(m.chunking(&p), None, "{}", m.name());
+            assert_eq!(m.chunking(&p, 10), None, "{}", m.name());
         }
     }
 

@@ -22,14 +22,15 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// How many leaves ahead the gather asks for the box it will read (its reads are random).
 const GATHER_AHEAD: usize = 16;
 
-/// The [`Chunking`] `params.mode` names.
-pub(crate) fn chunking_of(params: &ResolvedParams) -> Chunking {
+/// The [`Chunking`] `params.mode` names for a scene of `n` primitives (δ by
+/// [`Chunking::delta_for`]).
+pub(crate) fn chunking_of(params: &ResolvedParams, n: usize) -> Chunking {
     Chunking {
         top: params.mode.chunk_top,
         epsilon: params.mode.chunk_epsilon,
         sah_below: params.mode.chunk_sah,
         chunk_max: params.mode.chunk_max,
-        delta: params.mode.chunk_delta,
+        delta: Chunking::delta_for(params.mode.chunk_delta, n),
         few: params.mode.chunk_few,
     }
 }
@@ -41,7 +42,13 @@ pub(crate) fn run<O: Observer>(
     observer: O,
     budget: &Budget<'_>,
 ) -> Result<Grouping, Stopped> {
-    group_with(scene, params, &chunking_of(params), observer, budget)
+    group_with(
+        scene,
+        params,
+        &chunking_of(params, scene.len()),
+        observer,
+        budget,
+    )
 }
 
 /// Runs the partitioned schedule on primitive boxes (see [`group_boxes`]) with the default
@@ -52,7 +59,8 @@ pub(crate) fn run_boxes<O: Observer>(
     observer: O,
     budget: &Budget<'_>,
 ) -> Result<Grouping, Stopped> {
-    group_boxes(aabb, params, &chunking_of(params), observer, budget)
+    let chunking = chunking_of(params, aabb.len());
+    group_boxes(aabb, params, &chunking, observer, budget)
 }
 
 /// Runs the partitioned schedule with `chunking` instead of [`Chunking::DEFAULT`] (see the module

@@ -16,7 +16,7 @@ pub fn group_text(scene: &Scene, g: &Grouping, threads: usize, seconds: f64) -> 
     );
     // Without pre-grouping, a scene of at most 1.5 × the root share is one subproblem.
     let whole = p.mode.pregroup == Pregroup::None
-        && grouping::partitioned::chunking_of(p).whole(scene.len());
+        && grouping::partitioned::chunking_of(p, scene.len()).whole(scene.len());
     let chunking = match p.mode.schedule {
         grouping::Schedule::Partitioned => format!(
             " (chunks of δ = {}, ε = {}, root share {}, {}{})",

@@ -324,9 +324,12 @@ fn mode(m: &BTreeMap<String, String>) -> Result<Mode> {
             true => parse(m, "chunk_top")?,
             false => d.chunk_top,
         },
-        chunk_delta: match m.contains_key("chunk_delta") {
-            true => parse(m, "chunk_delta")?,
-            false => d.chunk_delta,
+        // A partitioned recording without `chunk_delta` (it has `chunk_top`) was made when δ
+        // was 4; other schedules do not write the chunking.
+        chunk_delta: match (m.contains_key("chunk_delta"), m.contains_key("chunk_top")) {
+            (true, _) => parse(m, "chunk_delta")?,
+            (false, true) => Chunking::DEFAULT.delta,
+            (false, false) => d.chunk_delta,
         },
         // A recording without `chunk_epsilon` was made with the default ε.
         chunk_epsilon: match m.contains_key("chunk_epsilon") {
