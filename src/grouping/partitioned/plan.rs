@@ -43,7 +43,9 @@ impl Chunking {
     /// δ = 4 and ε = 1/2, so that f(n) = δ/2 = 2: every node below the root share leaves two
     /// bodies, and the nodes above it leave ⌈top·n/N⌉, with a root step of about 8,192 bodies;
     /// ranges of up to 256 primitives are cut by SAH. Faster than AAC's ε = 0.2 for trees as
-    /// close to the exact schedule's (the measurements: docs/benchmarks.md).
+    /// close to the exact schedule's (the measurements: docs/benchmarks.md). The partitioned
+    /// schedule's default for scenes of more than [`Chunking::BY_SIZE_UP_TO`] primitives;
+    /// smaller ones take [`Chunking::FAITHFUL_DELTA`] ([`Chunking::delta_for`]).
     pub const DEFAULT: Chunking = Chunking {
         delta: 4,
         epsilon: 0.5,
