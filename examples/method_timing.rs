@@ -1,5 +1,6 @@
-//! Time bench methods on scene files against obvhs PLOC, best of the repeats, in one rayon pool
-//! of the given size, with the refinement's share, and their SAH and node tests per query of
+//! Time bench methods on scene files against obvhs PLOC, best of the repeats (run in rounds of
+//! every peer and method in turn, so that the machine's slow spells fall on all alike), in one
+//! rayon pool of the given size, with the refinement's share, and their SAH and node tests per query of
 //! the standard workload against the best of parry Binned, obvhs PLOC and PLOC + reinsertion
 //! (all queries, and the point and distance queries alone); with `LOOP=SECONDS` set it instead builds
 //! the first method on the first file over and over for that long (a target for `perf`).
@@ -114,41 +115,48 @@ fn main() -> anyhow::Result<()> {
     for f in &files {
         let scene = load_path(Path::new(f), &LoadOptions::default())?.scene;
         let workload = Workload::standard(&scene, 1);
-        // Best time of the repeats, with its refinement share, SAH and node tests per query.
-        let mirror = env::<u32>("MIRROR") == Some(1);
-        let mut mirrored = Vec::new();
-        let mut best = |m: Method| -> (f64, f64, f64, f64, f64) {
-            pool.install(|| {
-                let mut best: Option<Built> = None;
-                for _ in 0..repeat {
+        // The repeats in rounds, each building every peer and method once in turn, so that a
+        // slow spell of the machine falls on all of them alike; each keeps its fastest build.
+        let all: Vec<Method> = peers.iter().chain(&methods).copied().collect();
+        let mut fastest: Vec<Option<Built>> = vec![None; all.len()];
+        pool.install(|| {
+            for _ in 0..repeat {
+                for (slot, &m) in fastest.iter_mut().zip(&all) {
                     let b = build_varied(m, &scene, &params);
-                    if best.as_ref().is_none_or(|x| b.seconds < x.seconds) {
-                        best = Some(b);
+                    if slot.as_ref().is_none_or(|x| b.seconds < x.seconds) {
+                        *slot = Some(b);
                     }
                 }
-                let b = best.expect("at least one repeat");
-                let q = measure(&b.tree, &scene, Bv::Aabb, &workload);
-                let v = query_values(&q);
-                let queries = (workload.points.len() + workload.poses_near.len()) as f64;
-                let far = (v[0] * workload.points.len() as f64
-                    + v[2] * workload.poses_near.len() as f64)
-                    / queries;
-                if mirror {
-                    let mut t = b.tree.clone();
-                    t.children.iter_mut().for_each(|k| k.swap(0, 1));
-                    let w = query_values(&measure(&t, &scene, Bv::Aabb, &workload));
-                    mirrored.push((scene.name.clone(), m.name(), v[6], w[6], far));
-                }
-                (b.seconds, b.refine_seconds, sah(&b.tree), v[6], far)
-            })
+            }
+        });
+        // Each fastest build's time, refinement share, SAH and node tests per query.
+        let mirror = env::<u32>("MIRROR") == Some(1);
+        let mut mirrored = Vec::new();
+        let mut measured = |b: Built| -> (f64, f64, f64, f64, f64) {
+            let q = measure(&b.tree, &scene, Bv::Aabb, &workload);
+            let v = query_values(&q);
+            let queries = (workload.points.len() + workload.poses_near.len()) as f64;
+            let far = (v[0] * workload.points.len() as f64
+                + v[2] * workload.poses_near.len() as f64)
+                / queries;
+            if mirror {
+                let mut t = b.tree.clone();
+                t.children.iter_mut().for_each(|k| k.swap(0, 1));
+                let w = query_values(&measure(&t, &scene, Bv::Aabb, &workload));
+                mirrored.push((scene.name.clone(), b.method.name(), v[6], w[6], far));
+            }
+            (b.seconds, b.refine_seconds, sah(&b.tree), v[6], far)
         };
-        let peer: Vec<_> = peers.iter().map(|&m| best(m)).collect();
+        let rows: Vec<_> = fastest
+            .into_iter()
+            .map(|b| measured(b.expect("at least one repeat")))
+            .collect();
+        let (peer, ours) = rows.split_at(peers.len());
         let ploc = peer[1].0;
         let best_sah = peer.iter().map(|p| p.2).fold(f64::INFINITY, f64::min);
         let best_tests = peer.iter().map(|p| p.3).fold(f64::INFINITY, f64::min);
         let best_far = peer.iter().map(|p| p.4).fold(f64::INFINITY, f64::min);
-        for &m in &methods {
-            let (s, r, q, t, f) = best(m);
+        for (&m, &(s, r, q, t, f)) in methods.iter().zip(ours) {
             println!(
                 "| {} | {} | {:.3} | {} | {:.3} ({:.3}) | {:.2} | {:.3} | {:.3} | {:.3} |",
                 scene.name,
