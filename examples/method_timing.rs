@@ -1,9 +1,10 @@
 //! Time bench methods on scene files against obvhs PLOC, best of the repeats (run in rounds of
 //! every peer and method in turn, so that the machine's slow spells fall on all alike), in one
-//! rayon pool of the given size, with the refinement's share, and their SAH and node tests per query of
-//! the standard workload against the best of parry Binned, obvhs PLOC and PLOC + reinsertion
-//! (all queries, and the point and distance queries alone); with `LOOP=SECONDS` set it instead builds
-//! the first method on the first file over and over for that long (a target for `perf`).
+//! rayon pool of the given size, with the refinement's share, and their SAH and node tests per
+//! query of the standard workload against the best of parry Binned, obvhs PLOC and PLOC +
+//! reinsertion (all queries, and the point and distance queries alone); with `LOOP=SECONDS` set
+//! it instead builds the first method on the first file over and over for that long (a target
+//! for `perf`).
 //!
 //! With `MIRROR=1` every method's tree (the peers' too) is measured a second time with each
 //! node's two children swapped, and a second table gives both node tests: the queries that
