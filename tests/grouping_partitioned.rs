@@ -14,6 +14,7 @@ use wraptree::grouping::{
     Budget, EventLog, Mode, PSet, Params, PartKind, Schedule, StopReason, Weights, group,
     group_boxes, group_within,
 };
+use wraptree::scene::pathological as path;
 use wraptree::scene::{LoadOptions, generate};
 
 fn partitioned(mut p: Params) -> Params {
@@ -55,12 +56,20 @@ fn arb_params() -> impl Strategy<Value = Params> {
 }
 
 /// Parts come before their merges: each part's `first_step` is the number of merges before it,
-/// it makes `bodies - keep` merges (all the rest for the top, which comes last), ids in order.
+/// it makes `bodies - keep` merges (all the rest for the top, which comes last; the merges of
+/// identical boxes, first, up to the next part), ids in order.
 fn check_parts(n: usize, log: &EventLog) {
     let mut step = 0u32;
     for (i, p) in log.parts.iter().enumerate() {
         assert_eq!(p.id as usize, i);
         assert_eq!(p.first_step, step, "part {i} starts where the last ended");
+        if p.kind == PartKind::Twins {
+            assert_eq!(i, 0, "identical boxes come first");
+            let end = log.parts.get(1).map_or(n as u32 - 1, |q| q.first_step);
+            assert!(end > 0 && end < p.bodies, "part {i} merges something");
+            step = end;
+            continue;
+        }
         let keep = match p.kind {
             PartKind::Chunk { keep, .. } => keep,
             PartKind::Top => {
@@ -267,6 +276,67 @@ fn with_delta_2_nodes_merge_their_halves_and_larger_chunks_still_group_whole() {
         );
     }
     assert_ne!(run(0, 1), run(6, 1));
+}
+
+#[test]
+fn the_fast_path_merges_identical_boxes_first_the_same_on_any_thread_count() {
+    // Every triangle twice (double-sided faces), three times, and 300 copies of one triangle:
+    // the fast path merges identical boxes first, announced as one part, then splits the rest.
+    let mut fast = Params::default();
+    fast.mode = fast.mode.fast();
+    let cases = [
+        (path::duplicates(4_000, 2, 3), 2_000, 4_000),
+        (path::duplicates(900, 3, 5), 600, 900),
+        (path::coincident(300), 299, 300),
+    ];
+    for (scene, merges, bodies) in cases {
+        let (g1, log1) = on(1, || run(&scene, &fast));
+        check_tree(&scene, &g1, &log1);
+        check_parts(scene.len(), &log1);
+        let twins = &log1.parts[0];
+        assert_eq!((twins.kind, twins.bodies), (PartKind::Twins, bodies));
+        let end = log1
+            .parts
+            .get(1)
+            .map_or(scene.len() - 1, |p| p.first_step as usize);
+        assert_eq!(end, merges, "{}", scene.name);
+        assert_eq!(g1.stats.identical, merges as u64, "{}", scene.name);
+        for m in &log1.merges[..end] {
+            let aabb = &g1.tree.aabb;
+            assert_eq!(aabb[m.a as usize], aabb[m.b as usize], "{}", scene.name);
+            assert_eq!((m.round, m.fill), (0, 0.5));
+        }
+        let (g2, log2) = on(2, || run(&scene, &fast));
+        assert_eq!(g1.tree, g2.tree, "{}", scene.name);
+        assert_eq!(log1, log2, "{}", scene.name);
+        let silent = on(2, || group(&scene, &fast, ()));
+        assert_eq!(silent.tree, g1.tree, "{}", scene.name);
+    }
+    // A scene without identical boxes gets the tree it got without the twins step; with them
+    // off, a doubled scene is split whole (another valid tree, no twins part).
+    let mut off = fast.clone();
+    off.mode.chunk_twins = false;
+    let soup = generate::soup(3_000, 9);
+    let (with, log) = run(&soup, &fast);
+    assert_eq!(with.tree, group(&soup, &off, ()).tree);
+    assert!(log.parts.iter().all(|p| p.kind != PartKind::Twins));
+    let doubled = path::duplicates(2_000, 2, 4);
+    let (g, log) = run(&doubled, &off);
+    check_tree(&doubled, &g, &log);
+    assert!(log.parts.iter().all(|p| p.kind != PartKind::Twins));
+    assert_eq!((with.stats.identical, g.stats.identical), (0, 0));
+    // `group` says how many such merges the fast path made, and only when it made some.
+    let dir = tempfile::tempdir().unwrap();
+    let mut obj = Vec::new();
+    doubled.write_obj(&mut obj).unwrap();
+    std::fs::write(dir.path().join("d.obj"), obj).unwrap();
+    let text = common::printed(&["group", "d.obj", "--fast"], dir.path());
+    assert!(
+        text.contains("identical   1000 merges of neighbours with identical boxes"),
+        "{text}"
+    );
+    let text = common::printed(&["group", "d.obj", "--schedule", "partitioned"], dir.path());
+    assert!(!text.contains("identical"), "{text}");
 }
 
 proptest! {
@@ -539,10 +609,23 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
         rec_q.metadata.get("chunk_few").map(String::as_str),
         Some("4")
     );
+    // Identical neighbours merged first: false by default, true on the fast path; a recording
+    // without the key merged none first.
+    assert_eq!(
+        rec.metadata.get("chunk_twins").map(String::as_str),
+        Some("false")
+    );
+    assert_eq!(
+        rec_q.metadata.get("chunk_twins").map(String::as_str),
+        Some("true")
+    );
+    assert!(rec_q.params.mode.chunk_twins);
     let mut fast_old = rec_q.metadata.clone();
     fast_old.remove("chunk_few");
+    fast_old.remove("chunk_twins");
     let params = wraptree::record::mcap::metadata::params(&fast_old).unwrap();
     assert_eq!(params.mode.chunk_few, 0);
+    assert!(!params.mode.chunk_twins);
     let out = wraptree(&["replay", "q.mcap", "--verify"], dir.path());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success() && text.contains("verified"), "{text}");

@@ -185,8 +185,9 @@ pub struct GroupArgs {
     #[arg(long, value_enum, default_value_t = Schedule::Exact)]
     pub schedule: Schedule,
     /// The fast path: the partitioned schedule whose split is the tree below a root share of
-    /// 32 (chunks of δ = 2; the --chunk-* flags still apply); with `record`, `--refine
-    /// --refine-treelet-passes 0` adds its refinement.
+    /// 16 (chunks of δ = 2; the --chunk-* flags still apply), after merging neighbours with
+    /// identical boxes; with `record`, `--refine --refine-treelet-passes 0` adds its
+    /// refinement.
     #[arg(long, conflicts_with = "schedule")]
     pub fast: bool,
     /// Components grouped on their own first: none, objects (the file's o/g), connected

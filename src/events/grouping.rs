@@ -62,11 +62,14 @@ pub enum PartKind {
     },
     /// The top level: the roots of the parts (and any bodies left out of parts) grouped together.
     Top,
+    /// Bodies with identical boxes merged in pairs before the partitioned schedule's split
+    /// (`Chunking::twins`, the fast path): double-sided faces, duplicated parts.
+    Twins,
 }
 
 /// A part of a grouping run: the merges that follow it, up to the next `Part` or `Finish`,
-/// group the bodies of this part (a chunk of the partitioned schedule, a component, a copy, or
-/// the top level).
+/// group the bodies of this part (a chunk of the partitioned schedule, a component, a copy, the
+/// top level, or bodies with identical boxes).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Part {
     /// 0-based index of the part in the run, in event order.
@@ -100,6 +103,7 @@ impl std::fmt::Display for Part {
                 self.bodies, translation[0], translation[1], translation[2]
             )?,
             PartKind::Top => write!(f, "top level ({} bodies)", self.bodies)?,
+            PartKind::Twins => write!(f, "identical boxes ({} bodies)", self.bodies)?,
         }
         write!(f, " from merge {}", self.first_step)
     }

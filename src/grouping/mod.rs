@@ -62,6 +62,9 @@ pub struct Stats {
     pub stale_pops: u64,
     /// Largest MPairs length.
     pub peak_queue: u64,
+    /// Merges of neighbours with identical boxes made before the partitioned schedule's split
+    /// (`Chunking::twins`, the fast path).
+    pub identical: u64,
 }
 
 /// The outcome of the grouping phase.

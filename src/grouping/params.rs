@@ -181,6 +181,11 @@ pub struct Mode {
     /// ([`Chunking::few`](crate::grouping::partitioned::Chunking::few)); 0 = the SAH sweep. The
     /// fast path sets 4.
     pub chunk_few: u32,
+    /// The partitioned schedule's twins: bodies with identical boxes side by side in the Morton
+    /// order are merged in pairs before the split
+    /// ([`Chunking::twins`](crate::grouping::partitioned::Chunking::twins)). The fast path
+    /// sets it.
+    pub chunk_twins: bool,
 }
 
 impl Default for Mode {
@@ -197,6 +202,7 @@ impl Default for Mode {
             chunk_sah: crate::grouping::partitioned::Chunking::DEFAULT.sah_below,
             chunk_max: crate::grouping::partitioned::Chunking::DEFAULT.chunk_max,
             chunk_few: crate::grouping::partitioned::Chunking::DEFAULT.few,
+            chunk_twins: crate::grouping::partitioned::Chunking::DEFAULT.twins,
         }
     }
 }
@@ -214,6 +220,7 @@ impl Mode {
             chunk_epsilon: ch.epsilon,
             chunk_sah: ch.sah_below,
             chunk_few: ch.few,
+            chunk_twins: ch.twins,
             ..self
         }
     }

@@ -6,6 +6,7 @@ use super::executor::Executor;
 use super::plan::{Chunking, Node, plan};
 use super::split::morton_order;
 use super::subproblem::{Body, Counters, Leftover, MergeInfo, MergeSlots, RunInputs};
+use super::twins::{self, Twins};
 use crate::events::{Event, Observer};
 use crate::geom::Aabb;
 use crate::grouping::cluster;
@@ -32,6 +33,7 @@ pub(crate) fn chunking_of(params: &ResolvedParams, n: usize) -> Chunking {
         chunk_max: params.mode.chunk_max,
         delta: Chunking::delta_for(params.mode.chunk_delta, n),
         few: params.mode.chunk_few,
+        twins: params.mode.chunk_twins,
     }
 }
 
@@ -112,6 +114,8 @@ pub fn group_boxes<O: Observer>(
     let emitted = if listens || g.result.is_none() {
         let made = Built {
             n,
+            twins: g.twins.children.len(),
+            twin_bodies: g.twins.bodies,
             children: &g.children,
             aabb: &g.aabb,
             diameter: &g.diameter,
@@ -131,7 +135,7 @@ pub fn group_boxes<O: Observer>(
         rounds: g.sub.rounds,
         merges: (n - 1) as u32,
     });
-    Ok(finished(tree, params, &g.sub))
+    Ok(finished(tree, params, &g.sub, g.twins.children.len()))
 }
 
 /// What the split and the subproblems leave: the tree's arrays (the merges' details when the
@@ -141,6 +145,8 @@ struct Grouped {
     diameter: Vec<f64>,
     children: Vec<[u32; 2]>,
     info: Vec<MergeInfo>,
+    /// The merges of identical neighbours, made before the split (the first steps).
+    twins: Twins,
     nodes: Vec<Node>,
     done: Vec<AtomicBool>,
     /// `None` when the budget stopped the run.
@@ -164,19 +170,44 @@ fn split_and_group(
             .map(Aabb::diameter),
     );
     let mut codes = morton_order(&aabb);
+    let twins = if chunking.twins {
+        twins::pair(&mut codes, &mut aabb, &mut diameter)
+    } else {
+        Twins::default()
+    };
+    // The split's first new body follows the twins.
+    let first = aabb.len();
     let mut leaves = gather_leaves(&aabb, &codes);
     // Planned on the leaves themselves: the SAH cuts read their boxes in order, and reorder
     // them with their codes.
     let nodes = plan(&mut codes, &mut leaves, chunking);
     drop(codes);
     let merges = n - 1;
+    let made = twins.children.len();
     let mut children = vec![[0u32; 2]; merges];
+    children[..made].copy_from_slice(&twins.children);
     // The merges' slots, filled on every thread (fresh pages are written, and faulted in, in
     // parallel).
-    aabb.par_extend(rayon::iter::repeat_n(Aabb::EMPTY, n - 1).with_min_len(PAR_MIN_LEN));
-    diameter.par_extend(rayon::iter::repeat_n(0.0, n - 1).with_min_len(PAR_MIN_LEN));
+    let rest = merges - made;
+    aabb.par_extend(rayon::iter::repeat_n(Aabb::EMPTY, rest).with_min_len(PAR_MIN_LEN));
+    diameter.par_extend(rayon::iter::repeat_n(0.0, rest).with_min_len(PAR_MIN_LEN));
     let mut info = if listens {
-        vec![MergeInfo::default(); merges]
+        let mut info = vec![MergeInfo::default(); merges];
+        let w = ctx.params.weights;
+        for (i, &[a, b]) in twins.children.iter().enumerate() {
+            let d = diameter[n + i];
+            let (fill, balance) =
+                cluster::fill_balance(d, diameter[a as usize], diameter[b as usize]);
+            info[i] = MergeInfo {
+                round: 0,
+                fill,
+                balance,
+                cost: w.cost(d, fill, balance),
+                queue_len: 0,
+                active: true,
+            };
+        }
+        info
     } else {
         Vec::new()
     };
@@ -186,14 +217,18 @@ fn split_and_group(
         nodes: &nodes,
         done: &done,
     };
-    let (_, new_aabb) = aabb.split_at_mut(n);
-    let (_, new_d) = diameter.split_at_mut(n);
+    let (_, new_aabb) = aabb.split_at_mut(first);
+    let (_, new_d) = diameter.split_at_mut(first);
     let out = MergeSlots {
-        first_new: n as u32,
-        children: &mut children,
+        first_new: first as u32,
+        children: &mut children[made..],
         aabb: new_aabb,
         diameter: new_d,
-        info: listens.then_some(&mut info[..]),
+        info: if listens {
+            Some(&mut info[made..])
+        } else {
+            None
+        },
         stats: Counters::default(),
     };
     let (result, sub) = exec.node(0, &mut leaves, out, false);
@@ -202,6 +237,7 @@ fn split_and_group(
         diameter,
         children,
         info,
+        twins,
         nodes,
         done,
         result,
@@ -247,8 +283,14 @@ fn stopped(ctx: &RunInputs, emitted: u32) -> Stopped {
     }
 }
 
-/// The outcome of a finished run: the tree with the subproblems' summed counters.
-fn finished(tree: SubsetTree, params: &ResolvedParams, sub: &Counters) -> Grouping {
+/// The outcome of a finished run: the tree with the subproblems' summed counters and the
+/// number of merges of identical neighbours.
+fn finished(
+    tree: SubsetTree,
+    params: &ResolvedParams,
+    sub: &Counters,
+    identical: usize,
+) -> Grouping {
     Grouping {
         tree,
         rounds: sub.rounds,
@@ -259,6 +301,7 @@ fn finished(tree: SubsetTree, params: &ResolvedParams, sub: &Counters) -> Groupi
             pops: sub.pops,
             stale_pops: sub.stale_pops,
             peak_queue: sub.peak_queue,
+            identical: identical as u64,
         },
         pregrouping: None,
     }

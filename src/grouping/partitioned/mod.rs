@@ -2,7 +2,8 @@
 //! bottom-up and in parallel (approximate agglomerative clustering, AAC: Gu, He, Fatahalian and
 //! Blelloch 2013, "Efficient BVH Construction via Approximate Agglomerative Clustering").
 //!
-//! The primitives are sorted by Morton code (`split`), the sorted range is split into chunks
+//! The primitives are sorted by Morton code (`split`), neighbours with identical boxes are
+//! merged first where the chunking asks (`twins`), the sorted range is split into chunks
 //! (`plan`, with what each node keeps for its parent from `keep`), and each chunk and each
 //! node of the split groups its bodies with the paper's Cost and limits (`executor`): by brute
 //! force up to 64 bodies (`brute_force`, `all_pairs`), with the exact run's voxel hash and
@@ -23,6 +24,7 @@ mod split;
 mod subproblem;
 #[cfg(test)]
 mod tests;
+mod twins;
 mod voxel_step;
 
 pub(crate) use group::{chunking_of, run, run_boxes};

@@ -33,6 +33,10 @@ pub struct Chunking {
     /// chunks, try every partition for the best binary tree over their leaves instead of the
     /// SAH sweep (`split`); 0 = the sweep. Only δ = 2 (or `chunk_max` below 4) leaves such ranges to be cut.
     pub few: u32,
+    /// Whether bodies with identical boxes that the Morton order puts side by side are merged
+    /// in pairs before the split, and again while such pairs remain (`twins`): a mesh of
+    /// double-sided faces is then split as one of half the size. The fast path sets it.
+    pub twins: bool,
 }
 
 impl Chunking {
@@ -53,6 +57,7 @@ impl Chunking {
         sah_below: 256,
         chunk_max: 0,
         few: 0,
+        twins: false,
     };
 
     /// δ for scenes of up to [`Chunking::BY_SIZE_UP_TO`] primitives when none is given:
@@ -94,6 +99,7 @@ impl Chunking {
         top: 16,
         delta: 2,
         few: 4,
+        twins: true,
         ..Chunking::DEFAULT
     };
 
@@ -476,6 +482,7 @@ pub(super) mod tests {
                 sah_below: 0,
                 chunk_max: 7,
                 few: 0,
+                twins: false,
             },
             // The fast path's split: ranges of 3 and 4 try every partition.
             Chunking::FAST,

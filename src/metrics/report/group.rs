@@ -44,6 +44,13 @@ pub fn group_text(scene: &Scene, g: &Grouping, threads: usize, seconds: f64) -> 
     if let Some(p) = &g.pregrouping {
         let _ = writeln!(s, "{}", pregrouping_lines(p));
     }
+    if g.stats.identical > 0 {
+        let _ = writeln!(
+            s,
+            "identical   {} merges of neighbours with identical boxes before the split",
+            g.stats.identical
+        );
+    }
     let _ = writeln!(s, "rounds      {}", g.rounds);
     let _ = writeln!(
         s,

@@ -62,9 +62,11 @@ pub const LOAD_KEYS: &[&str] = &["up"];
 /// Keys the `wraptree` record adds for the partitioned schedule ([`Chunking`]): its chunk size
 /// δ (4, or 2 on the fast path), the reduction function's ε (`--chunk-epsilon`), the root's
 /// share `top` (`--chunk-top`), the SAH cuts' range size (`--chunk-sah`), the largest chunk
-/// (0 = δ) and the largest range cut by trying every partition (4 on the fast path, else 0),
-/// all read back by `replay` (a recording without `chunk_sah` was cut at Morton bits only, one
-/// without `chunk_max` into chunks of fewer than δ, one without `chunk_few` by sweeps).
+/// (0 = δ), the largest range cut by trying every partition (4 on the fast path, else 0) and
+/// whether identical neighbours were merged first (`true` on the fast path), all read back by
+/// `replay` (a recording without `chunk_sah` was cut at Morton bits only, one without
+/// `chunk_max` into chunks of fewer than δ, one without `chunk_few` by sweeps, one without
+/// `chunk_twins` merged no identical neighbours first).
 pub const PARTITIONED_KEYS: &[&str] = &[
     "chunk_delta",
     "chunk_epsilon",
@@ -72,6 +74,7 @@ pub const PARTITIONED_KEYS: &[&str] = &[
     "chunk_sah",
     "chunk_max",
     "chunk_few",
+    "chunk_twins",
 ];
 
 /// Keys the `wraptree` record adds when a cover is logged (`cover_budget` only for a cover
@@ -214,6 +217,7 @@ pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String,
         put("chunk_sah", p.mode.chunk_sah.to_string());
         put("chunk_max", p.mode.chunk_max.to_string());
         put("chunk_few", p.mode.chunk_few.to_string());
+        put("chunk_twins", p.mode.chunk_twins.to_string());
     }
     put("detail", value_name(&info.detail));
     put("scene", info.scene.name.clone());
@@ -354,6 +358,11 @@ fn mode(m: &BTreeMap<String, String>) -> Result<Mode> {
         chunk_few: match m.contains_key("chunk_few") {
             true => parse(m, "chunk_few")?,
             false => 0,
+        },
+        // A recording without `chunk_twins` merged no identical neighbours first.
+        chunk_twins: match m.contains_key("chunk_twins") {
+            true => parse(m, "chunk_twins")?,
+            false => false,
         },
     })
 }

@@ -98,6 +98,7 @@ impl From<&Part> for PartEvent {
                 [e.tx, e.ty, e.tz] = t.map(Some);
             }
             PartKind::Top => e.kind = 3,
+            PartKind::Twins => e.kind = 4,
         }
         e
     }
@@ -125,6 +126,7 @@ impl TryFrom<&PartEvent> for Part {
                 }
             }
             3 => PartKind::Top,
+            4 => PartKind::Twins,
             k => return Err(format!("unknown part kind {k}")),
         };
         Ok(Part {

@@ -198,13 +198,14 @@ flat_message! {
 }
 
 flat_message! {
-    /// A part of the run (a chunk of the partitioned schedule, a component, a copy, the top),
+    /// A part of the run (a chunk of the partitioned schedule, a component, a copy, the top,
+    /// bodies with identical boxes),
     /// on `/grouping/part`: every field of [`Part`](crate::grouping::Part), its kind flattened (the
     /// scalar fields a kind does not have are 0; the copy's transform is absent).
     PartEvent {
         /// 0-based part index.
         id: u32,
-        /// 0 chunk, 1 component, 2 copy, 3 top.
+        /// 0 chunk, 1 component, 2 copy, 3 top, 4 identical boxes (twins).
         kind: u32,
         /// Bodies the part starts from.
         bodies: u32,

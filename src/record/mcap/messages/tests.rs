@@ -57,6 +57,7 @@ fn merge_round_trips_with_distinct_values() {
             translation: [9.0, 10.0, -11.0],
         },
         PartKind::Top,
+        PartKind::Twins,
     ] {
         let p = Part {
             id: 4,
