@@ -41,7 +41,7 @@ fn build_varied(method: Method, scene: &Scene, params: &Params) -> Built {
     p.mode.chunk_sah = env("SAH").unwrap_or(p.mode.chunk_sah);
     p.mode.chunk_epsilon = env("EPS").unwrap_or(p.mode.chunk_epsilon);
     p.mode.chunk_max = env("MAX").unwrap_or(p.mode.chunk_max);
-    let mut rp = refine::FAST;
+    let mut rp = refine::fast_for(scene.len());
     rp.passes = env("PASSES").unwrap_or(rp.passes);
     rp.batch = env("BATCH").unwrap_or(rp.batch);
     let n = scene.len();

@@ -104,3 +104,22 @@ fn the_fast_flag_groups_partitioned_with_the_fast_split_and_parses_like_the_othe
     assert_eq!(Method::parse("fast"), Ok(Method::Fast));
     assert_eq!(Method::parse("grouping-fast"), Ok(Method::GroupingFast));
 }
+
+#[test]
+fn the_bench_method_refines_with_a_smaller_first_batch_from_2_14_primitives_up() {
+    // `fast` is the fast grouping, then `refine::fast_for` the scene's size: a tenth of the
+    // nodes first below `FAST_LARGE` primitives, 7 % from it up, which gives another tree there.
+    use wraptree::refine::{self, FAST, FAST_LARGE, fast_for};
+    for n in [5_000, FAST_LARGE + 1_000] {
+        let scene = generate::soup(n, 11);
+        let bench = tree_on(1, Method::Fast, &scene);
+        let grouped = tree_on(1, Method::GroupingFast, &scene);
+        let ours = refine::refine(&grouped, &fast_for(n), ()).tree;
+        assert_eq!(bench, ours, "{n} primitives");
+        let tenth = refine::refine(&grouped, &FAST, ()).tree;
+        assert_eq!(bench == tenth, n < FAST_LARGE, "{n} primitives");
+        assert!(sah(&bench) <= sah(&grouped));
+    }
+    assert_eq!(fast_for(FAST_LARGE - 1), FAST);
+    assert_eq!(fast_for(FAST_LARGE).batch, refine::FAST_LARGE_BATCH);
+}

@@ -6,7 +6,7 @@
 //! - [`Method::Grouping`], [`Method::GroupingHull`], [`Method::GroupingPartitioned`]: the
 //!   paper's grouping phase (§2.2) with AABB or hull p-sets, and in the partitioned schedule;
 //! - [`Method::Fast`]: the fast path, the partitioned schedule with small subproblems
-//!   ([`Method::GroupingFast`]) then a bounded refinement ([`crate::refine::FAST`]);
+//!   ([`Method::GroupingFast`]) then a bounded refinement ([`crate::refine::fast_for`]);
 //! - [`Method::GroupingPregroup`], [`Method::GroupingInstanced`], [`Method::GroupingObjects`]:
 //!   the same with the paper's §1.3 speed-ups ([`crate::grouping::pregroup`]);
 //! - [`parry_bvh`]: parry3d's `Bvh`, binned SAH or PLOC, as published;
@@ -67,7 +67,7 @@ pub enum Method {
     /// ([`Chunking::FAST`](crate::grouping::partitioned::Chunking::FAST)).
     GroupingFast,
     /// The fast path: [`Method::GroupingFast`] then the refinement with
-    /// [`crate::refine::FAST`].
+    /// [`crate::refine::fast_for`] the scene's size.
     Fast,
 }
 
@@ -240,7 +240,7 @@ fn build_here(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
     if method.is_refined() {
         let t = Instant::now();
         let rp = if method == Method::Fast {
-            refine::FAST
+            refine::fast_for(scene.len())
         } else {
             RefineParams::default()
         };

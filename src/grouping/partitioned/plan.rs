@@ -89,7 +89,7 @@ impl Chunking {
     /// halves, and the tree there is the split's own (SAH cuts in ranges of up to 256
     /// primitives, Morton cuts above), under a root step of about 16 bodies; only scenes of at
     /// most 24 primitives are grouped whole. Its trees are further from the exact schedule's
-    /// than the default's; the fast path's refinement (`refine::FAST`) takes their SAH back
+    /// than the default's; the fast path's refinement (`refine::fast_for`) takes their SAH back
     /// down. Root shares of 16–256 gave the same SAH and node tests after the refinement on 37
     /// scenes; 16 against 32 took 10–23 % off scenes under 1,000 primitives (the root step's
     /// Cost table is a quarter the size) and left the larger ones as they were, on 69 real
