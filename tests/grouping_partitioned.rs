@@ -620,6 +620,11 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
         Some("true")
     );
     assert!(rec_q.params.mode.chunk_twins);
+    rejects(
+        "chunk_twins",
+        "yes",
+        "metadata has a bad `chunk_twins`: \"yes\"",
+    );
     let mut fast_old = rec_q.metadata.clone();
     fast_old.remove("chunk_few");
     fast_old.remove("chunk_twins");

@@ -266,19 +266,30 @@ pub(super) fn put_merge(
 ) {
     let d = nb.diameter;
     let info = if out.listens() {
-        let (fill, balance) = fill_balance(d, x.diameter, y.diameter);
-        MergeInfo {
-            round,
-            fill,
-            balance,
-            cost: ctx.params.weights.cost(d, fill, balance),
-            queue_len: queue_len(),
-            active: d <= ctx.dl.at(round),
-        }
+        merge_info(ctx, [d, x.diameter, y.diameter], round, queue_len())
     } else {
         MergeInfo::default()
     };
     out.put(made, [x.id.min(y.id), x.id.max(y.id)], nb.aabb, d, info);
+}
+
+/// What the events of a merge in round `round` read beyond the tree, for a new body of
+/// diameter `d` from bodies of diameters `dx` and `dy`, with `queue_len` entries queued after it.
+pub(super) fn merge_info(
+    ctx: &RunInputs,
+    [d, dx, dy]: [f64; 3],
+    round: u32,
+    queue_len: u32,
+) -> MergeInfo {
+    let (fill, balance) = fill_balance(d, dx, dy);
+    MergeInfo {
+        round,
+        fill,
+        balance,
+        cost: ctx.params.weights.cost(d, fill, balance),
+        queue_len,
+        active: d <= ctx.dl.at(round),
+    }
 }
 
 /// Moves the bodies of the `live` slots (increasing) to the start of `body` and returns them,

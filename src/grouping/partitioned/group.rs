@@ -2,6 +2,7 @@
 //! executor run over it, the events announced and the Subset Tree assembled.
 
 use super::announce::{Built, announce};
+use super::brute_force::merge_info;
 use super::executor::Executor;
 use super::plan::{Chunking, Node, plan};
 use super::split::morton_order;
@@ -114,8 +115,8 @@ pub fn group_boxes<O: Observer>(
     let emitted = if listens || g.result.is_none() {
         let made = Built {
             n,
-            twins: g.twins.children.len(),
-            twin_bodies: g.twins.bodies,
+            twins: g.twins.0,
+            twin_bodies: g.twins.1,
             children: &g.children,
             aabb: &g.aabb,
             diameter: &g.diameter,
@@ -135,7 +136,7 @@ pub fn group_boxes<O: Observer>(
         rounds: g.sub.rounds,
         merges: (n - 1) as u32,
     });
-    Ok(finished(tree, params, &g.sub, g.twins.children.len()))
+    Ok(finished(tree, params, &g.sub, g.twins.0))
 }
 
 /// What the split and the subproblems leave: the tree's arrays (the merges' details when the
@@ -145,8 +146,9 @@ struct Grouped {
     diameter: Vec<f64>,
     children: Vec<[u32; 2]>,
     info: Vec<MergeInfo>,
-    /// The merges of identical neighbours, made before the split (the first steps).
-    twins: Twins,
+    /// Merges of identical neighbours, made before the split (the first steps), and the bodies
+    /// they start from.
+    twins: (usize, u32),
     nodes: Vec<Node>,
     done: Vec<AtomicBool>,
     /// `None` when the budget stopped the run.
@@ -193,19 +195,9 @@ fn split_and_group(
     diameter.par_extend(rayon::iter::repeat_n(0.0, rest).with_min_len(PAR_MIN_LEN));
     let mut info = if listens {
         let mut info = vec![MergeInfo::default(); merges];
-        let w = ctx.params.weights;
         for (i, &[a, b]) in twins.children.iter().enumerate() {
-            let d = diameter[n + i];
-            let (fill, balance) =
-                cluster::fill_balance(d, diameter[a as usize], diameter[b as usize]);
-            info[i] = MergeInfo {
-                round: 0,
-                fill,
-                balance,
-                cost: w.cost(d, fill, balance),
-                queue_len: 0,
-                active: true,
-            };
+            let d = [n + i, a as usize, b as usize].map(|x| diameter[x]);
+            info[i] = merge_info(ctx, d, 0, 0);
         }
         info
     } else {
@@ -237,7 +229,7 @@ fn split_and_group(
         diameter,
         children,
         info,
-        twins,
+        twins: (made, twins.bodies),
         nodes,
         done,
         result,
