@@ -19,7 +19,7 @@ fn work_tree(n: usize, seed: u64) -> WorkTree {
 fn the_search_in_z_order_finds_the_moves_of_the_search_in_candidate_order() {
     let w = work_tree(20_000, 3);
     let candidates = reinsert::candidates(&w, 8_000);
-    assert!(candidates.len() >= reinsert::PARALLEL_MIN);
+    assert!(candidates.len() >= reinsert::SPATIAL_MIN);
     let min_gain = 1e-12;
     let mut stack = Vec::new();
     let mut plain: Vec<Move> = candidates
@@ -38,6 +38,27 @@ fn the_search_in_z_order_finds_the_moves_of_the_search_in_candidate_order() {
     reinsert::sort_best_first(&mut plain);
     reinsert::sort_best_first(&mut ordered);
     assert_eq!(plain, ordered);
+}
+
+#[test]
+fn a_batch_searched_on_several_threads_finds_the_moves_of_one_thread() {
+    // Between the parallel and the spatial thresholds: candidate order on one thread, Z-order
+    // on rayon's threads on two.
+    let w = work_tree(3_000, 5);
+    let candidates = reinsert::candidates(&w, 600);
+    assert!((reinsert::PARALLEL_MIN..reinsert::SPATIAL_MIN).contains(&candidates.len()));
+    let search = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut moves = pool.install(|| reinsert::find_all(&w, &candidates, 1e-12));
+        reinsert::sort_best_first(&mut moves);
+        moves
+    };
+    let one = search(1);
+    assert!(one.len() > 20, "{} moves found", one.len());
+    assert_eq!(one, search(2));
 }
 
 #[test]

@@ -6,17 +6,31 @@ use super::subproblem::{Body, Counters, Leftover, MergeSlots, PairList, RunInput
 use super::{all_pairs, brute_force, voxel_step};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// Halves of at least this many primitives are grouped in parallel.
-const GRAIN: u32 = 1024;
+/// Halves of at least this many primitives are grouped in parallel (256: see the split's
+/// `PLAN_GRAIN`).
+const GRAIN: u32 = 256;
 
 /// The read-only inputs of the recursive grouping.
 pub(super) struct Executor<'a> {
     pub(super) ctx: &'a RunInputs<'a>,
     pub(super) nodes: &'a [Node],
     pub(super) done: &'a [AtomicBool],
+    /// Halves of at least this many primitives are grouped in parallel: [`GRAIN`] on a pool of
+    /// several threads ([`Executor::grain`]).
+    pub(super) grain: u32,
 }
 
 impl Executor<'_> {
+    /// The grain of a run on the current pool: [`GRAIN`], or none on one thread (where a
+    /// `rayon::join` only costs).
+    pub(super) fn grain() -> u32 {
+        if rayon::current_num_threads() > 1 {
+            GRAIN
+        } else {
+            u32::MAX
+        }
+    }
+
     /// Groups node `k`'s subtree into `out` (its merges, in post-order). `arena` holds the
     /// node's primitives as bodies (its range of the Morton order); the bodies it leaves end
     /// up at its start. Returns how many it leaves (`None` when the budget stopped it), with
@@ -53,7 +67,7 @@ impl Executor<'_> {
                 let want = node.inputs as usize <= brute_force::SMALL && node.inputs > node.keep;
                 let mid = (ln.hi - ln.lo) as usize;
                 let (la, ra) = arena.split_at_mut(mid);
-                let ((lb, ls), (rb, rs)) = if node.hi - node.lo >= GRAIN {
+                let ((lb, ls), (rb, rs)) = if node.hi - node.lo >= self.grain {
                     rayon::join(
                         || self.node(l, la, lout, want),
                         || self.node(r, ra, rout, want),
@@ -196,7 +210,7 @@ impl Executor<'_> {
                 let (lout, rest) = out.split(lm);
                 let (rout, own) = rest.split(node.below() as usize - lm);
                 let (la, ra) = arena.split_at_mut((ln.hi - ln.lo) as usize);
-                let (x, y) = if size >= GRAIN {
+                let (x, y) = if size >= self.grain {
                     let mut rs = Counters::default();
                     let (x, y) = rayon::join(
                         || self.merge_down(l, la, lout, stats),

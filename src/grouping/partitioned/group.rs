@@ -208,6 +208,7 @@ fn split_and_group(
         ctx,
         nodes: &nodes,
         done: &done,
+        grain: Executor::grain(),
     };
     let (_, new_aabb) = aabb.split_at_mut(first);
     let (_, new_d) = diameter.split_at_mut(first);
