@@ -7,10 +7,17 @@
 //! 10^3–10^5 primitives, on one thread and on two. So the builds run their parallel parts, in
 //! one piece, on one of the pool's threads ([`on_pool`]), where those steps are plain calls.
 
-/// Fewest primitives for which a build is handed to the pool: below this its grouping and
-/// refinement take no parallel step (the partitioned schedule's grains are 1,024), and the hand
-/// over alone would cost more than it saves.
+/// Fewest primitives for which a build is handed to the pool: below this the hand over alone
+/// would cost more than it saves, and the build runs on the caller's thread, which takes no
+/// parallel step when outside the pool ([`parallel_here`]).
 pub(crate) const POOL_MIN: usize = 1024;
+
+/// Whether parallel steps are worth taking here: on a thread of a pool of several threads. A
+/// thread outside the pool would hand each step over (see the module doc), and on a pool of one
+/// a `join` only costs.
+pub(crate) fn parallel_here() -> bool {
+    rayon::current_thread_index().is_some() && rayon::current_num_threads() > 1
+}
 
 /// Runs `f` on a thread of the current rayon pool (the global pool when the caller is in none)
 /// and returns what it returns; runs it on the caller's thread when that is one of the pool's
@@ -49,5 +56,19 @@ mod tests {
             (me, on_pool(true, rayon::current_thread_index))
         });
         assert_eq!(inside.0, inside.1, "already on a pool thread: run in place");
+    }
+
+    #[test]
+    fn parallel_steps_are_taken_only_on_a_thread_of_a_pool_of_several() {
+        let outside = std::thread::spawn(parallel_here).join().unwrap();
+        assert!(!outside, "outside the pool");
+        let pool = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+        };
+        assert!(!pool(1).install(parallel_here), "a pool of one");
+        assert!(pool(2).install(parallel_here), "a pool of two");
     }
 }

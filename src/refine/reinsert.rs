@@ -18,6 +18,7 @@ use crate::geom::Aabb;
 use crate::geom::area;
 use crate::geom::morton::spread_bits;
 use crate::grouping::NONE;
+use crate::par::parallel_here;
 use rayon::prelude::*;
 
 /// The best move found for one node: put `node` next to `target`, lowering the sum of interior
@@ -97,13 +98,13 @@ pub fn find_best(
 }
 
 /// The best moves of `candidates` on the frozen tree `w`. Batches of [`PARALLEL_MIN`] and more
-/// are searched on rayon's threads in [`spatial_order`] when the pool has several, and so are
-/// batches of [`SPATIAL_MIN`] and more on one thread (the order keeps the tree in cache);
-/// others on the calling thread in candidate order, where handing work to rayon or sorting
-/// costs more than it saves. The moves come back in that fixed order, the same for any number
-/// of threads, and [`sort_best_first`] ranks them independently of it.
+/// are searched on rayon's threads in [`spatial_order`] when called on a thread of a pool of
+/// several threads, and so are batches of [`SPATIAL_MIN`] and more anywhere (the order keeps
+/// the tree in cache); others on the calling thread in candidate order, where handing work to
+/// rayon or sorting costs more than it saves. The moves come back in that fixed order, the same
+/// for any number of threads, and [`sort_best_first`] ranks them independently of it.
 pub fn find_all(w: &WorkTree, candidates: &[u32], min_gain: f64) -> Vec<Move> {
-    let parallel = candidates.len() >= PARALLEL_MIN && rayon::current_num_threads() > 1;
+    let parallel = candidates.len() >= PARALLEL_MIN && parallel_here();
     if !parallel && candidates.len() < SPATIAL_MIN {
         let mut stack = Vec::new();
         return candidates
@@ -148,8 +149,9 @@ pub fn spatial_order(w: &WorkTree, candidates: &[u32]) -> Vec<u32> {
     keys.into_iter().map(|(_, x)| x).collect()
 }
 
-/// Fewest candidates searched in parallel on a pool of several threads (on 16 cores, 256
-/// against 2,048 took a 5,804-triangle mesh's first batch of 1,161 searches off one thread).
+/// Fewest candidates searched in parallel on a pool of several threads (256, with the split's
+/// finer grains: `docs/benchmarks.md`, "Thread scaling on 16 cores"; a 5,804-triangle mesh's
+/// first batch of 1,161 searches is then shared by the threads).
 pub const PARALLEL_MIN: usize = 256;
 
 /// Fewest candidates searched in [`spatial_order`] on one thread, and the size from which a

@@ -4,6 +4,7 @@
 use super::plan::Node;
 use super::subproblem::{Body, Counters, Leftover, MergeSlots, PairList, RunInputs};
 use super::{all_pairs, brute_force, voxel_step};
+use crate::par::parallel_here;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Halves of at least this many primitives are grouped in parallel (256: see the split's
@@ -15,20 +16,15 @@ pub(super) struct Executor<'a> {
     pub(super) ctx: &'a RunInputs<'a>,
     pub(super) nodes: &'a [Node],
     pub(super) done: &'a [AtomicBool],
-    /// Halves of at least this many primitives are grouped in parallel: [`GRAIN`] on a pool of
-    /// several threads ([`Executor::grain`]).
+    /// Halves of at least this many primitives are grouped in parallel ([`Executor::grain`]).
     pub(super) grain: u32,
 }
 
 impl Executor<'_> {
-    /// The grain of a run on the current pool: [`GRAIN`], or none on one thread (where a
-    /// `rayon::join` only costs).
+    /// The grain of a run on the calling thread: [`GRAIN`] where parallel steps are worth
+    /// taking ([`parallel_here`]), else none.
     pub(super) fn grain() -> u32 {
-        if rayon::current_num_threads() > 1 {
-            GRAIN
-        } else {
-            u32::MAX
-        }
+        if parallel_here() { GRAIN } else { u32::MAX }
     }
 
     /// Groups node `k`'s subtree into `out` (its merges, in post-order). `arena` holds the

@@ -6,6 +6,7 @@ use super::split::{Zone, morton_cut};
 use super::subproblem::Body;
 #[cfg(test)]
 use crate::geom::Aabb;
+use crate::par::parallel_here;
 use rayon::prelude::*;
 
 /// The split's parameters: chunk size δ, the reduction function's ε (AAC §3) and the root's share.
@@ -224,7 +225,7 @@ pub(super) fn plan(
     let keep = Keep::new(chunking, codes.len());
     let planner = Planner {
         keep: &keep,
-        grain: if rayon::current_num_threads() > 1 {
+        grain: if parallel_here() {
             PLAN_GRAIN
         } else {
             u32::MAX
@@ -272,7 +273,7 @@ struct Planned {
 struct Planner<'a> {
     keep: &'a Keep,
     /// Ranges of at least this many primitives plan their halves in parallel: [`PLAN_GRAIN`]
-    /// on a pool of several threads, none on one.
+    /// where parallel steps are worth taking ([`parallel_here`]), else none.
     grain: u32,
 }
 
