@@ -19,6 +19,12 @@ pub(crate) fn parallel_here() -> bool {
     rayon::current_thread_index().is_some() && rayon::current_num_threads() > 1
 }
 
+/// A recursion's parallel grain here: `grain` where parallel steps are worth taking
+/// ([`parallel_here`]), else none (`u32::MAX`: no range is that large).
+pub(crate) fn grain(grain: u32) -> u32 {
+    if parallel_here() { grain } else { u32::MAX }
+}
+
 /// Runs `f` on a thread of the current rayon pool (the global pool when the caller is in none)
 /// and returns what it returns; runs it on the caller's thread when that is one of the pool's
 /// already, or when `worth` is false. `f` must not wait for other threads that may need the
@@ -70,5 +76,7 @@ mod tests {
         };
         assert!(!pool(1).install(parallel_here), "a pool of one");
         assert!(pool(2).install(parallel_here), "a pool of two");
+        assert_eq!(pool(1).install(|| grain(256)), u32::MAX);
+        assert_eq!(pool(2).install(|| grain(256)), 256);
     }
 }

@@ -4,7 +4,7 @@
 use super::plan::Node;
 use super::subproblem::{Body, Counters, Leftover, MergeSlots, PairList, RunInputs};
 use super::{all_pairs, brute_force, voxel_step};
-use crate::par::parallel_here;
+use crate::par;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Halves of at least this many primitives are grouped in parallel (256: see the split's
@@ -22,9 +22,9 @@ pub(super) struct Executor<'a> {
 
 impl Executor<'_> {
     /// The grain of a run on the calling thread: [`GRAIN`] where parallel steps are worth
-    /// taking ([`parallel_here`]), else none.
+    /// taking, else none ([`par::grain`]).
     pub(super) fn grain() -> u32 {
-        if parallel_here() { GRAIN } else { u32::MAX }
+        par::grain(GRAIN)
     }
 
     /// Groups node `k`'s subtree into `out` (its merges, in post-order). `arena` holds the

@@ -6,7 +6,7 @@ use super::split::{Zone, morton_cut};
 use super::subproblem::Body;
 #[cfg(test)]
 use crate::geom::Aabb;
-use crate::par::parallel_here;
+use crate::par;
 use rayon::prelude::*;
 
 /// The split's parameters: chunk size δ, the reduction function's ε (AAC §3) and the root's share.
@@ -225,11 +225,7 @@ pub(super) fn plan(
     let keep = Keep::new(chunking, codes.len());
     let planner = Planner {
         keep: &keep,
-        grain: if parallel_here() {
-            PLAN_GRAIN
-        } else {
-            u32::MAX
-        },
+        grain: par::grain(PLAN_GRAIN),
     };
     let blocks = planner.blocks(codes, leaves, 0, 0).blocks;
     let total = blocks.iter().map(Vec::len).sum();
@@ -273,7 +269,7 @@ struct Planned {
 struct Planner<'a> {
     keep: &'a Keep,
     /// Ranges of at least this many primitives plan their halves in parallel: [`PLAN_GRAIN`]
-    /// where parallel steps are worth taking ([`parallel_here`]), else none.
+    /// where parallel steps are worth taking, else none ([`par::grain`]).
     grain: u32,
 }
 
