@@ -518,6 +518,31 @@ fn workload_counts_are_the_same_for_any_thread_count() {
     }
 }
 
+/// Overlap queries search the deeper-overlapping child pair first, so the workload's counts do
+/// not depend on which child a node stores first: the same tree with every node's children
+/// swapped gives the same counts, with box and with sphere BVs (a soup: no two boxes alike).
+#[test]
+fn workload_counts_do_not_depend_on_child_order() {
+    let counts = |c: &wraptree::query::QueryCost| {
+        let m = |m: &wraptree::query::MeanCost| (m.queries, m.bv_tests, m.prim_tests, m.capped);
+        (m(&c.point), m(&c.distance), m(&c.overlap), c.overlapping)
+    };
+    let soup = generate::soup(800, 9);
+    let tree = group(&soup, &Params::default(), ()).tree;
+    let mut mirrored = tree.clone();
+    mirrored.children.iter_mut().for_each(|k| k.swap(0, 1));
+    let w = Workload::standard(&soup, 2);
+    let boxes = counts(&measure(&tree, &soup, Bv::Aabb, &w));
+    assert_eq!(boxes.3, 8, "every touching pose overlaps");
+    assert_eq!(boxes, counts(&measure(&mirrored, &soup, Bv::Aabb, &w)));
+    // The same sphere for each node (its children's order does not change its primitives).
+    let spheres = sphere_tree(&tree, &soup, SphereMethod::Ritter);
+    assert_eq!(
+        counts(&measure(&tree, &soup, Bv::Sphere(&spheres), &w)),
+        counts(&measure(&mirrored, &soup, Bv::Sphere(&spheres), &w))
+    );
+}
+
 /// Prints the workload cost on the 12,144-polygon scene and one brute-force scene–scene
 /// query's time on the lamp (626 polygons). Not asserted: run with `--ignored --nocapture`.
 #[test]

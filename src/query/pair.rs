@@ -2,7 +2,7 @@
 //! node of `b`) reached from the root pair by splitting one side at a time.
 
 use super::prim::prim_prim;
-use super::{Counts, Entry, Hierarchy, pair_bound};
+use super::{Counts, Entry, Hierarchy, pair_bound, pair_depth};
 use std::collections::BinaryHeap;
 
 /// The child pairs of the BVTT node `(x, y)`: split the side that is not a leaf, or when
@@ -87,7 +87,10 @@ pub fn scene_distance_within(
 /// Whether some primitive of `a` touches some primitive of `b` (their distance is 0).
 ///
 /// Depth-first over the BVTT, skipping pairs whose BVs are apart (bound above 0 after slack),
-/// and returning at the first touching primitive pair. Counted as in [`scene_distance`].
+/// and returning at the first touching primitive pair. Of a pair's two child pairs, the one
+/// whose BVs overlap deeper is searched first, so the tests do not depend on which child a
+/// node stores first (only exact ties keep the stored order). Counted as in
+/// [`scene_distance`].
 pub fn overlap(a: &Hierarchy, b: &Hierarchy, counts: &mut Counts) -> bool {
     overlap_within(a, b, u64::MAX, counts)
 }
@@ -116,12 +119,21 @@ pub fn overlap_within(a: &Hierarchy, b: &Hierarchy, max_tests: u64, counts: &mut
                 }
             }
             Some(pairs) => {
-                for (c, d) in pairs.into_iter().rev() {
+                let mut open = [None; 2];
+                for (slot, (c, d)) in open.iter_mut().zip(pairs) {
                     counts.bv_tests += 1;
                     if pair_bound(a, c, b, d) - slack <= 0.0 {
-                        stack.push((c, d));
+                        *slot = Some((pair_depth(a, c, b, d), (c, d)));
                     }
                 }
+                // The deeper-overlapping pair is searched first (pushed last); ties keep the
+                // stored order.
+                if let [Some((p, _)), Some((q, _))] = open
+                    && q > p
+                {
+                    open.swap(0, 1);
+                }
+                stack.extend(open.iter().rev().flatten().map(|&(_, pair)| pair));
             }
         }
     }
