@@ -1,6 +1,7 @@
 //! The partitioned schedule's chunking against the exact schedule's tree, on the targets
-//! scenes: SAH and node tests per query (AABB BVs, standard workload) of each chunking's tree
-//! over the exact tree's, and its grouping time on one thread. How the defaults were chosen
+//! scenes: SAH and node tests per query (AABB BVs, standard workload; all queries, and the
+//! point and distance queries alone) of each chunking's tree over the exact tree's, and its
+//! grouping time on one thread. How the defaults were chosen
 //! (`docs/benchmarks.md`).
 //!
 //! `cargo run --release --example partitioned_chunking [MAX_SOUP] [DELTA:EPSILON[:TOP[:SAH]] ...]
@@ -48,7 +49,7 @@ fn main() -> anyhow::Result<()> {
     print!("{:<18} {:>8} {:>9}", "scene", "N", "exact ms");
     for ch in &chunkings {
         let name = format!("{}:{}:{}:{}", ch.delta, ch.epsilon, ch.top, ch.sah_below);
-        print!(" | {name:>17} {:>6} {:>6}", "SAH", "qry");
+        print!(" | {name:>17} {:>6} {:>6} {:>6}", "SAH", "qry", "far");
     }
     println!();
     let mut sums = vec![(0.0, 0.0, 0.0, 0.0); chunkings.len()];
@@ -60,12 +61,15 @@ fn main() -> anyhow::Result<()> {
         let workload = Workload::standard(scene, 1);
         let quality = |tree: &SubsetTree| {
             let q = query::measure(tree, scene, Bv::Aabb, &workload);
-            (sah(tree), query_values(&q)[6])
+            let v = query_values(&q);
+            let (points, near) = (workload.points.len(), workload.poses_near.len());
+            let far = (v[0] * points as f64 + v[2] * near as f64) / (points + near) as f64;
+            (sah(tree), v[6], far)
         };
         let t = Instant::now();
         let exact = pool.install(|| group(scene, &Params::default(), ()));
         let te = t.elapsed().as_secs_f64();
-        let (se, qe) = quality(&exact.tree);
+        let (se, qe, fe) = quality(&exact.tree);
         print!("{:<18} {:>8} {:>9.2}", scene.name, scene.len(), te * 1e3);
         let params = Params::default().resolve(scene);
         for (ch, sum) in chunkings.iter().zip(&mut sums) {
@@ -78,8 +82,14 @@ fn main() -> anyhow::Result<()> {
                 .install(|| group_with(scene, &params, ch, (), &budget))
                 .map_err(|s| anyhow::anyhow!("stopped: {:?}", s.reason))?;
             let tp = t.elapsed().as_secs_f64();
-            let (sp, qp) = quality(&g.tree);
-            print!(" | {:>14.2} ms {:>6.3} {:>6.3}", tp * 1e3, sp / se, qp / qe);
+            let (sp, qp, fp) = quality(&g.tree);
+            print!(
+                " | {:>14.2} ms {:>6.3} {:>6.3} {:>6.3}",
+                tp * 1e3,
+                sp / se,
+                qp / qe,
+                fp / fe
+            );
             sum.0 += tp / te;
             sum.1 += sp / se;
             sum.2 += qp / qe;
