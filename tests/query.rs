@@ -475,15 +475,21 @@ fn workload_queries_stop_at_the_cap_on_coincident_copies() {
     );
 }
 
+/// Queries, BV tests, primitive tests and capped queries per query kind, and the overlaps found.
+type KindCounts = (usize, f64, f64, u64);
+
+/// A workload cost's counts, for comparing runs ([`KindCounts`] for points, distances and
+/// overlaps, then the number of overlapping poses).
+fn counts(c: &wraptree::query::QueryCost) -> (KindCounts, KindCounts, KindCounts, usize) {
+    let m = |m: &wraptree::query::MeanCost| (m.queries, m.bv_tests, m.prim_tests, m.capped);
+    (m(&c.point), m(&c.distance), m(&c.overlap), c.overlapping)
+}
+
 /// The workload's queries run side by side on rayon's threads: every count (tests, capped
 /// queries, overlaps) is the same for any number of threads, with sphere BVs, and where the
 /// sets stop at their cap (the capped queries land in different places of each pool's run).
 #[test]
 fn workload_counts_are_the_same_for_any_thread_count() {
-    let counts = |c: &wraptree::query::QueryCost| {
-        let m = |m: &wraptree::query::MeanCost| (m.queries, m.bv_tests, m.prim_tests, m.capped);
-        (m(&c.point), m(&c.distance), m(&c.overlap), c.overlapping)
-    };
     let soup = generate::soup(600, 3);
     let soup_tree = group(&soup, &Params::default(), ()).tree;
     let spheres = sphere_tree(&soup_tree, &soup, SphereMethod::Ritter);
@@ -523,10 +529,6 @@ fn workload_counts_are_the_same_for_any_thread_count() {
 /// swapped gives the same counts, with box and with sphere BVs (a soup: no two boxes alike).
 #[test]
 fn workload_counts_do_not_depend_on_child_order() {
-    let counts = |c: &wraptree::query::QueryCost| {
-        let m = |m: &wraptree::query::MeanCost| (m.queries, m.bv_tests, m.prim_tests, m.capped);
-        (m(&c.point), m(&c.distance), m(&c.overlap), c.overlapping)
-    };
     let soup = generate::soup(800, 9);
     let tree = group(&soup, &Params::default(), ()).tree;
     let mut mirrored = tree.clone();
