@@ -14,6 +14,9 @@
 //! quality columns read NaN): the timings alone, as for thread-scaling runs, whose trees are
 //! the same for every thread count.
 //!
+//! `SEED=S` measures the trees on the standard workload of seed `S` (default 1: other points
+//! and poses of the copy).
+//!
 //! The fast path's settings can be varied through the environment: `TOP`, `SAH`, `EPS`, `MAX`
 //! (its split: root share, SAH-cut size, ε, largest chunk) and `PASSES`, `BATCH` (its reinsertion passes).
 //!
@@ -136,7 +139,7 @@ fn main() -> anyhow::Result<()> {
     let mut mirrored_rows = Vec::new();
     for f in &files {
         let scene = load(f)?;
-        let workload = quality.then(|| Workload::standard(&scene, 1));
+        let workload = quality.then(|| Workload::standard(&scene, env("SEED").unwrap_or(1)));
         // The repeats in rounds, each building every peer and method once in turn, so that a
         // slow spell of the machine falls on all of them alike; each keeps its fastest build.
         let all: Vec<Method> = peers.iter().chain(&methods).copied().collect();
