@@ -475,7 +475,7 @@ fn workload_queries_stop_at_the_cap_on_coincident_copies() {
     );
 }
 
-/// Queries, BV tests, primitive tests and capped queries per query kind, and the overlaps found.
+/// One query kind's queries, BV and primitive tests per query, and capped queries.
 type KindCounts = (usize, f64, f64, u64);
 
 /// A workload cost's counts, for comparing runs ([`KindCounts`] for points, distances and

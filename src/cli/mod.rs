@@ -281,9 +281,9 @@ pub struct ChunkArgs {
     /// exact step, down to δ/2 bodies at ε = 0.5), at least 2; 0 = by the scene's size
     /// [default: 0, 2 with --fast]. By size, scenes of up to 262,144 (2^18) primitives take
     /// 4096, which kept every real mesh tried within 2 % of the exact tree's SAH and of its
-    /// node tests on point and distance queries,
-    /// at about the exact schedule's time on one thread, spread over the threads (0.4–0.8× its
-    /// time on two above 3·10^4 primitives); larger scenes take 4, several times faster there
+    /// node tests on point and distance queries, at about the exact schedule's time on one
+    /// thread, spread over the threads (0.4–0.8× its time on two above 3·10^4 primitives);
+    /// larger scenes take 4, several times faster there
     /// (use --fast for speed on smaller ones).
     #[arg(long, value_name = "N")]
     pub chunk_delta: Option<u32>,

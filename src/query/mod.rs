@@ -175,20 +175,18 @@ fn pair_bound(a: &Hierarchy, x: u32, b: &Hierarchy, y: u32) -> f64 {
     }
 }
 
-/// How deeply the BVs of `x` in `a` and `y` in `b` overlap (larger: deeper; negative when
-/// apart): for boxes the sum over the axes of the overlap of their extents, for spheres the
-/// sum of the radii less the distance of the centres, for a box and a sphere the radius less
-/// the distance from the centre to the box.
-fn pair_depth(a: &Hierarchy, x: u32, b: &Hierarchy, y: u32) -> f64 {
-    let (x, y) = (x as usize, y as usize);
+/// How deeply the BVs of `x` in `a` and `y` in `b` overlap (larger: deeper), given their
+/// [`pair_bound`] `bound`: for two boxes the sum over the axes of the overlap of their extents
+/// (which separates boxes that touch in a face, where every bound is 0); otherwise `−bound`.
+fn pair_depth(a: &Hierarchy, x: u32, b: &Hierarchy, y: u32, bound: f64) -> f64 {
     match (a.bv, b.bv) {
         (Bv::Aabb, Bv::Aabb) => {
-            let (p, q) = (&a.tree.aabb[x], &b.tree.aabb[y]);
+            let (p, q) = (&a.tree.aabb[x as usize], &b.tree.aabb[y as usize]);
             (0..3)
                 .map(|k| p.max[k].min(q.max[k]) - p.min[k].max(q.min[k]))
                 .sum()
         }
-        _ => -pair_bound(a, x as u32, b, y as u32),
+        _ => -bound,
     }
 }
 

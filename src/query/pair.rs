@@ -122,8 +122,9 @@ pub fn overlap_within(a: &Hierarchy, b: &Hierarchy, max_tests: u64, counts: &mut
                 let mut open = [None; 2];
                 for (slot, (c, d)) in open.iter_mut().zip(pairs) {
                     counts.bv_tests += 1;
-                    if pair_bound(a, c, b, d) - slack <= 0.0 {
-                        *slot = Some((pair_depth(a, c, b, d), (c, d)));
+                    let bound = pair_bound(a, c, b, d);
+                    if bound - slack <= 0.0 {
+                        *slot = Some((pair_depth(a, c, b, d, bound), (c, d)));
                     }
                 }
                 // The deeper-overlapping pair is searched first (pushed last); ties keep the

@@ -64,8 +64,9 @@ impl Chunking {
     /// δ for scenes of up to [`Chunking::BY_SIZE_UP_TO`] primitives when none is given:
     /// chunks of 4,096 primitives make most merges the exact run's own, so the tree stays
     /// within 2 % of the exact one's SAH and point and distance queries on every real mesh
-    /// measured (25 whose split runs), where δ = 4 was 2.1–4.3 % off on five of them. It costs about the exact run's time on one
-    /// thread and spreads it over the threads (docs/benchmarks.md, "Chunks of δ primitives").
+    /// measured (25 whose split runs), where δ = 4 was 2.1–4.3 % off on five of them. It costs
+    /// about the exact run's time on one thread and spreads it over the threads
+    /// (docs/benchmarks.md, "Chunks of δ primitives").
     pub const FAITHFUL_DELTA: u32 = 4096;
 
     /// The most primitives that [`Chunking::FAITHFUL_DELTA`] applies to when δ is not given
