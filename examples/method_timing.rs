@@ -2,7 +2,8 @@
 //! every peer and method in turn, so that the machine's slow spells fall on all alike), in one
 //! rayon pool of the given size, with the refinement's share, and their SAH and node tests per
 //! query of the standard workload against the best of parry Binned, obvhs PLOC and PLOC +
-//! reinsertion (all queries, and the point and distance queries alone); with `LOOP=SECONDS` set
+//! reinsertion (all queries, the point and distance queries alone, and the contact queries of
+//! the touching poses); with `LOOP=SECONDS` set
 //! it instead builds the first method on the first file over and over for that long (a target
 //! for `perf`).
 //!
@@ -15,7 +16,8 @@
 //! the same for every thread count.
 //!
 //! `SEED=S` measures the trees on the standard workload of seed `S` (default 1: other points
-//! and poses of the copy).
+//! and poses of the copy). `TOUCH=T` gives it `T` touching poses instead of 8: those of seed
+//! `S`, then of seeds `S + 1`, `S + 2`, … in turn.
 //!
 //! The fast path's settings can be varied through the environment: `TOP`, `SAH`, `EPS`, `MAX`
 //! (its split: root share, SAH-cut size, ε, largest chunk) and `PASSES`, `BATCH` (its reinsertion passes).
@@ -122,9 +124,9 @@ fn main() -> anyhow::Result<()> {
         return Ok(());
     }
     println!(
-        "| scene | N | PLOC ms | method | ms (refine) | / PLOC | SAH / best peer | node tests / best peer | without overlap queries |"
+        "| scene | N | PLOC ms | method | ms (refine) | / PLOC | SAH / best peer | node tests / best peer | without overlap queries | contact queries |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     let quality = env::<u32>("QUALITY") != Some(0);
     let peers: &[Method] = if quality {
         &[
@@ -139,7 +141,19 @@ fn main() -> anyhow::Result<()> {
     let mut mirrored_rows = Vec::new();
     for f in &files {
         let scene = load(f)?;
-        let workload = quality.then(|| Workload::standard(&scene, env("SEED").unwrap_or(1)));
+        let seed = env("SEED").unwrap_or(1u64);
+        let workload = quality.then(|| {
+            let mut w = Workload::standard(&scene, seed);
+            let touch = env::<usize>("TOUCH").unwrap_or(w.poses_touching.len());
+            let mut next = seed;
+            while w.poses_touching.len() < touch {
+                next += 1;
+                let more = Workload::standard(&scene, next).poses_touching;
+                w.poses_touching.extend(more);
+            }
+            w.poses_touching.truncate(touch);
+            w
+        });
         // The repeats in rounds, each building every peer and method once in turn, so that a
         // slow spell of the machine falls on all of them alike; each keeps its fastest build.
         let all: Vec<Method> = peers.iter().chain(&methods).copied().collect();
@@ -157,12 +171,20 @@ fn main() -> anyhow::Result<()> {
         // Each fastest build's time, refinement share, SAH and node tests per query.
         let mirror = env::<u32>("MIRROR") == Some(1);
         let mut mirrored = Vec::new();
-        let mut measured = |b: Built| -> (f64, f64, f64, f64, f64) {
+        let mut measured = |b: Built| -> (f64, f64, f64, f64, f64, f64) {
             let Some(workload) = &workload else {
-                return (b.seconds, b.refine_seconds, f64::NAN, f64::NAN, f64::NAN);
+                return (
+                    b.seconds,
+                    b.refine_seconds,
+                    f64::NAN,
+                    f64::NAN,
+                    f64::NAN,
+                    f64::NAN,
+                );
             };
             let q = measure(&b.tree, &scene, Bv::Aabb, workload);
             let v = query_values(&q);
+            let contact = q.contact.bv_tests;
             let queries = (workload.points.len() + workload.poses_near.len()) as f64;
             let far = (v[0] * workload.points.len() as f64
                 + v[2] * workload.poses_near.len() as f64)
@@ -173,7 +195,14 @@ fn main() -> anyhow::Result<()> {
                 let w = query_values(&measure(&t, &scene, Bv::Aabb, workload));
                 mirrored.push((scene.name.clone(), b.method.name(), v[6], w[6], far));
             }
-            (b.seconds, b.refine_seconds, sah(&b.tree), v[6], far)
+            (
+                b.seconds,
+                b.refine_seconds,
+                sah(&b.tree),
+                v[6],
+                far,
+                contact,
+            )
         };
         let rows: Vec<_> = fastest
             .into_iter()
@@ -184,9 +213,10 @@ fn main() -> anyhow::Result<()> {
         let best_sah = peer.iter().map(|p| p.2).fold(f64::INFINITY, f64::min);
         let best_tests = peer.iter().map(|p| p.3).fold(f64::INFINITY, f64::min);
         let best_far = peer.iter().map(|p| p.4).fold(f64::INFINITY, f64::min);
-        for (&m, &(s, r, q, t, f)) in methods.iter().zip(ours) {
+        let best_contact = peer.iter().map(|p| p.5).fold(f64::INFINITY, f64::min);
+        for (&m, &(s, r, q, t, f, c)) in methods.iter().zip(ours) {
             println!(
-                "| {} | {} | {:.3} | {} | {:.3} ({:.3}) | {:.2} | {:.3} | {:.3} | {:.3} |",
+                "| {} | {} | {:.3} | {} | {:.3} ({:.3}) | {:.2} | {:.3} | {:.3} | {:.3} | {:.3} |",
                 scene.name,
                 scene.len(),
                 ploc * 1e3,
@@ -196,7 +226,8 @@ fn main() -> anyhow::Result<()> {
                 s / ploc,
                 q / best_sah,
                 t / best_tests,
-                f / best_far
+                f / best_far,
+                c / best_contact
             );
         }
         mirrored_rows.append(&mut mirrored);

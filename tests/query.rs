@@ -7,8 +7,8 @@ use wraptree::geom::P3;
 use wraptree::geom::distance::{segment_segment, segment_triangle, triangle_triangle};
 use wraptree::grouping::{Params, SubsetTree, group};
 use wraptree::query::{
-    Bv, Counts, Hierarchy, Workload, measure, moved, moved_spheres, overlap, point_distance,
-    reference, scene_distance, scene_distance_within,
+    Bv, Counts, Hierarchy, Workload, contacts, measure, moved, moved_spheres, overlap,
+    point_distance, reference, scene_distance, scene_distance_within,
 };
 use wraptree::scene::{Scene, generate};
 use wraptree::wrap::{SphereMethod, sphere_tree};
@@ -265,7 +265,12 @@ fn check_scene(scene: &Scene, copy: &Scene, seed: u64) -> Counts {
         .iter()
         .map(|c| reference::scene_distance(scene, c))
         .collect();
+    let touching: Vec<u64> = copies
+        .iter()
+        .map(|c| reference::contacts(scene, c))
+        .collect();
     for (k, d) in want.iter().enumerate() {
+        assert_eq!(touching[k] > 0, *d == 0.0, "pose {k}");
         if k < w.poses_near.len() {
             assert!(*d > 0.0, "near pose {k} touches the scene");
         } else if expect_touch {
@@ -306,6 +311,11 @@ fn check_scene(scene: &Scene, copy: &Scene, seed: u64) -> Counts {
                     assert_eq!(
                         overlap(&h, &h2, &mut c),
                         want[k] == 0.0,
+                        "tree {ti} bv {bi}: pose {k}"
+                    );
+                    assert_eq!(
+                        contacts(&h, &h2, &mut Counts::default()),
+                        touching[k],
                         "tree {ti} bv {bi}: pose {k}"
                     );
                 }
@@ -478,11 +488,21 @@ fn workload_queries_stop_at_the_cap_on_coincident_copies() {
 /// One query kind's queries, BV and primitive tests per query, and capped queries.
 type KindCounts = (usize, f64, f64, u64);
 
-/// A workload cost's counts, for comparing runs ([`KindCounts`] for points, distances and
-/// overlaps, then the number of overlapping poses).
-fn counts(c: &wraptree::query::QueryCost) -> (KindCounts, KindCounts, KindCounts, usize) {
+/// A workload cost's counts: [`KindCounts`] for points, distances and overlaps, the number of
+/// overlapping poses, [`KindCounts`] for contacts and the number of contacts.
+type Kinds = (KindCounts, KindCounts, KindCounts, usize, KindCounts, u64);
+
+/// A workload cost's counts, for comparing runs ([`Kinds`]).
+fn counts(c: &wraptree::query::QueryCost) -> Kinds {
     let m = |m: &wraptree::query::MeanCost| (m.queries, m.bv_tests, m.prim_tests, m.capped);
-    (m(&c.point), m(&c.distance), m(&c.overlap), c.overlapping)
+    (
+        m(&c.point),
+        m(&c.distance),
+        m(&c.overlap),
+        c.overlapping,
+        m(&c.contact),
+        c.contacts,
+    )
 }
 
 /// The workload's queries run side by side on rayon's threads: every count (tests, capped
@@ -543,6 +563,37 @@ fn workload_counts_do_not_depend_on_child_order() {
         counts(&measure(&tree, &soup, Bv::Sphere(&spheres), &w)),
         counts(&measure(&mirrored, &soup, Bv::Sphere(&spheres), &w))
     );
+}
+
+/// Contact queries visit every overlapping BV pair: their counts do not depend on the child
+/// order even between exactly tied boxes (stacked coincident copies), nor on the number of
+/// threads, and they find every touching pair.
+#[test]
+fn contact_counts_depend_on_the_trees_alone() {
+    let stack = wraptree::scene::pathological::coincident(30);
+    let tree = pairing_tree(&stack);
+    let mut mirrored = tree.clone();
+    mirrored.children.iter_mut().for_each(|k| k.swap(0, 1));
+    let w = Workload::standard(&stack, 3);
+    let on = |tree: &SubsetTree, threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let q = pool.install(|| measure(tree, &stack, Bv::Aabb, &w));
+        (
+            q.contact.queries,
+            q.contact.bv_tests,
+            q.contact.prim_tests,
+            q.contact.capped,
+            q.contacts,
+        )
+    };
+    let one = on(&tree, 1);
+    // Each of the 30 copies of a touching pose's crossing triangle meets all 30 stacked ones.
+    assert_eq!((one.0, one.3, one.4), (8, 0, 8 * 30 * 30));
+    assert_eq!(one, on(&tree, 3));
+    assert_eq!(one, on(&mirrored, 1));
 }
 
 /// Prints the workload cost on the 12,144-polygon scene and one brute-force scene–scene

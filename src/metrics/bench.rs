@@ -69,6 +69,9 @@ pub struct TargetRow {
     /// Node tests per query (AABB BVs, standard workload) of the grouping tree / parry
     /// Binned's.
     pub query_ratio: f64,
+    /// Node tests per contact query (AABB BVs, the standard workload's touching poses) of the
+    /// grouping tree / parry Binned's.
+    pub contact_ratio: f64,
     /// Largest depth of the grouping tree.
     pub depth: u32,
     /// Process peak RSS after the case, if known.
@@ -82,11 +85,12 @@ pub fn target_row(scene: &Scene, repeat: u32) -> Result<TargetRow> {
     Ok(target_rows(scene, repeat)?.0)
 }
 
-/// One measured build: best time (s), SAH, node tests per query, depth and the tree.
-type Measured = (f64, f64, f64, u32, peers::Built);
+/// One measured build: best time (s), SAH, node tests per query and per contact query,
+/// depth and the tree.
+type Measured = (f64, f64, f64, f64, u32, peers::Built);
 
 /// The best of `repeat` builds of `m` on `scene` (at most 2 from 10^6 primitives), with its
-/// SAH and node tests per query on `workload`, on the current rayon pool.
+/// SAH and node tests per query and per contact query on `workload`, on the current rayon pool.
 fn measure(m: Method, scene: &Scene, repeat: u32, workload: &Workload) -> Result<Measured> {
     let repeat = if scene.len() >= 1_000_000 {
         repeat.min(2)
@@ -104,7 +108,15 @@ fn measure(m: Method, scene: &Scene, repeat: u32, workload: &Workload) -> Result
     let b = best.expect("ran at least once");
     let q = query::measure(&b.tree, scene, Bv::Aabb, workload);
     let tests = super::compare::query_values(&q)[6];
-    Ok((b.seconds, super::sah(&b.tree), tests, b.tree.depth_max(), b))
+    let contact = q.contact.bv_tests;
+    Ok((
+        b.seconds,
+        super::sah(&b.tree),
+        tests,
+        contact,
+        b.tree.depth_max(),
+        b,
+    ))
 }
 
 /// Grouping + refinement against the best peer on one scene.
@@ -122,6 +134,8 @@ pub struct RefineRow {
     pub sah_per_best: f64,
     /// Node tests per query / the best of the same two.
     pub query_per_best: f64,
+    /// Node tests per contact query / the best of the same two.
+    pub contact_per_best: f64,
     /// The partitioned grouping + refinement: time (s).
     pub part_total_seconds: f64,
     /// Its refinement time alone / obvhs PLOC build time.
@@ -130,6 +144,8 @@ pub struct RefineRow {
     pub part_sah_per_best: f64,
     /// Its node tests per query / the best peer's (as `query_per_best`).
     pub part_query_per_best: f64,
+    /// Its node tests per contact query / the best peer's (as `contact_per_best`).
+    pub part_contact_per_best: f64,
 }
 
 /// The §1.3 speed-ups (pre-grouping, instancing) on one scene and thread count, against obvhs
@@ -166,12 +182,12 @@ pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, 
     let n = scene.len();
     let workload = Workload::standard(scene, 1);
     let run = |m: Method| measure(m, scene, repeat, &workload);
-    let (t, sah, qc, depth, plain) = run(Method::Grouping)?;
+    let (t, sah, qc, cc, depth, plain) = run(Method::Grouping)?;
     let (tp, ..) = run(Method::ObvhsPloc)?;
-    let (tb, sah_b, qc_b, _, _) = run(Method::ParryBinned)?;
-    let (_, sah_r, qc_r, _, refined) = run(Method::GroupingRefine)?;
-    let (_, sah_o, qc_o, ..) = run(Method::ObvhsPlocReinsert)?;
-    let (_, sah_pr, qc_pr, _, part_refined) = run(Method::GroupingPartitionedRefine)?;
+    let (tb, sah_b, qc_b, cc_b, _, _) = run(Method::ParryBinned)?;
+    let (_, sah_r, qc_r, cc_r, _, refined) = run(Method::GroupingRefine)?;
+    let (_, sah_o, qc_o, cc_o, ..) = run(Method::ObvhsPlocReinsert)?;
+    let (_, sah_pr, qc_pr, cc_pr, _, part_refined) = run(Method::GroupingPartitionedRefine)?;
     let refine = RefineRow {
         scene: scene.name.clone(),
         refine_seconds: refined.refine_seconds,
@@ -179,10 +195,12 @@ pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, 
         refine_per_ploc: refined.refine_seconds / tp,
         sah_per_best: sah_r / sah_b.min(sah_o),
         query_per_best: qc_r / qc_b.min(qc_o),
+        contact_per_best: cc_r / cc_b.min(cc_o),
         part_total_seconds: part_refined.seconds,
         part_refine_per_ploc: part_refined.refine_seconds / tp,
         part_sah_per_best: sah_pr / sah_b.min(sah_o),
         part_query_per_best: qc_pr / qc_b.min(qc_o),
+        part_contact_per_best: cc_pr / cc_b.min(cc_o),
     };
     let volumes = n <= 50_000;
     let vol = |b: &peers::Built| super::level_volume(&b.tree, scene, 3);
@@ -197,7 +215,7 @@ pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, 
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()?;
-            let (tm, sah_m, qc_m, depth_m, built) = pool.install(|| run(m))?;
+            let (tm, sah_m, qc_m, _, depth_m, built) = pool.install(|| run(m))?;
             let (bm, hm) = if volumes {
                 vol(&built)
             } else {
@@ -226,6 +244,7 @@ pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, 
         binned_seconds: tb,
         sah_ratio: sah / sah_b,
         query_ratio: qc / qc_b,
+        contact_ratio: cc / cc_b,
         depth,
         peak_rss_bytes: super::peak_rss_bytes(),
     };

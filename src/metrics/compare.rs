@@ -430,9 +430,10 @@ impl Measuring<'_> {
 }
 
 /// A query cost as the CSV's query columns: BV and primitive tests per query for point,
-/// distance and overlap queries; node (BV) tests per query over the whole workload; eq. (1)
-/// cost per query over the whole workload; seconds for the workload.
-pub fn query_values(q: &QueryCost) -> [f64; 9] {
+/// distance and overlap queries; node (BV) tests per query over those three kinds; eq. (1)
+/// cost per query over them; seconds for the workload (contact queries included); BV and
+/// primitive tests per contact query (kept apart: [`QueryCost::contact`]).
+pub fn query_values(q: &QueryCost) -> [f64; 11] {
     let kinds = [&q.point, &q.distance, &q.overlap];
     let queries: f64 = kinds.iter().map(|k| k.queries as f64).sum::<f64>().max(1.0);
     let bv: f64 = kinds.iter().map(|k| k.bv_tests * k.queries as f64).sum();
@@ -447,6 +448,8 @@ pub fn query_values(q: &QueryCost) -> [f64; 9] {
         bv / queries,
         cost / queries,
         q.seconds,
+        q.contact.bv_tests,
+        q.contact.prim_tests,
     ]
 }
 

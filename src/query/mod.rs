@@ -26,7 +26,9 @@ pub mod reference;
 pub mod workload;
 
 pub use moved::{moved, moved_spheres};
-pub use pair::{overlap, overlap_within, scene_distance, scene_distance_within};
+pub use pair::{
+    contacts, contacts_within, overlap, overlap_within, scene_distance, scene_distance_within,
+};
 pub use point::{point_distance, point_distance_within};
 pub use workload::{
     C_P, C_V, MAX_TESTS_PER_PAIR, MAX_TESTS_PER_PRIM, MIN_MAX_TESTS, MeanCost, QueryCost, Workload,

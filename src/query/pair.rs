@@ -1,7 +1,7 @@
 //! Scene–scene queries over the bounding-volume test tree (BVTT): the pairs (node of `a`,
 //! node of `b`) reached from the root pair by splitting one side at a time.
 
-use super::prim::prim_prim;
+use super::prim::{prim_prim, prims_touch};
 use super::{Counts, Entry, Hierarchy, pair_bound, pair_depth};
 use std::collections::BinaryHeap;
 
@@ -139,4 +139,50 @@ pub fn overlap_within(a: &Hierarchy, b: &Hierarchy, max_tests: u64, counts: &mut
         }
     }
     false
+}
+
+/// How many primitive pairs of `a` and `b` touch (their distance is 0): every contact, as
+/// collision response needs them.
+///
+/// Depth-first over the BVTT, skipping pairs whose BVs are apart (bound above 0 after slack),
+/// until every overlapping pair is split down to its primitives. Every pair of overlapping
+/// BVs is visited whatever the order, so the tests depend only on the two trees, not on which
+/// child a node stores first. Counted as in [`scene_distance`].
+pub fn contacts(a: &Hierarchy, b: &Hierarchy, counts: &mut Counts) -> u64 {
+    contacts_within(a, b, u64::MAX, counts)
+}
+
+/// [`contacts`] that gives up once it has made `max_tests` tests: the contacts found by then
+/// (a lower bound), the stop counted in [`Counts::capped`].
+pub fn contacts_within(a: &Hierarchy, b: &Hierarchy, max_tests: u64, counts: &mut Counts) -> u64 {
+    let start = counts.tests();
+    let slack = a.slack() + b.slack();
+    let (ra, rb) = (a.tree.root(), b.tree.root());
+    counts.bv_tests += 1;
+    if pair_bound(a, ra, b, rb) - slack > 0.0 {
+        return 0;
+    }
+    let mut found = 0u64;
+    let mut stack = vec![(ra, rb)];
+    while let Some((x, y)) = stack.pop() {
+        if counts.tests() - start >= max_tests {
+            counts.capped += 1;
+            return found;
+        }
+        match split(a, x, b, y) {
+            None => {
+                counts.prim_tests += 1;
+                found += u64::from(prims_touch(a.scene, x as usize, b.scene, y as usize));
+            }
+            Some(pairs) => {
+                for (c, d) in pairs {
+                    counts.bv_tests += 1;
+                    if pair_bound(a, c, b, d) - slack <= 0.0 {
+                        stack.push((c, d));
+                    }
+                }
+            }
+        }
+    }
+    found
 }

@@ -96,3 +96,44 @@ fn tris_edges(a: &Scene, t: &[[u32; 3]], b: &Scene, v: &[u32]) -> f64 {
     }
     best
 }
+
+/// Whether primitive `i` of `a` touches primitive `j` of `b`: [`prim_prim`] is 0, with the
+/// triangle pairs that either triangle's plane clearly separates skipped first (the other's
+/// corners all on one side of it by more than 1e-9 of the pair's extent, far beyond the
+/// distance's rounding), so most pairs that do not touch cost three dot products, not the
+/// distance.
+pub fn prims_touch(a: &Scene, i: usize, b: &Scene, j: usize) -> bool {
+    let (Surface::Tris(t), Surface::Tris(u)) = (Surface::of(a, i), Surface::of(b, j)) else {
+        return prim_prim(a, i, b, j) == 0.0;
+    };
+    t.iter().any(|x| {
+        let tx = tri(a, x);
+        u.iter().any(|y| {
+            let uy = tri(b, y);
+            !separated(tx, uy) && !separated(uy, tx) && triangle_triangle(tx, uy) == 0.0
+        })
+    })
+}
+
+/// Whether the plane of triangle `t` has every corner of `u` strictly on one side, each at
+/// least 1e-9 of the pair's largest coordinate extent from it (false for a degenerate `t`).
+fn separated(t: [&P3; 3], u: [&P3; 3]) -> bool {
+    let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
+    let s = u.map(|p| n.dot(&(p - t[0])));
+    // The corner nearest the plane, if all are on one side (×|n|).
+    let near = if s.iter().all(|&v| v > 0.0) {
+        s[0].min(s[1]).min(s[2])
+    } else if s.iter().all(|&v| v < 0.0) {
+        -s[0].max(s[1]).max(s[2])
+    } else {
+        return false;
+    };
+    let (mut lo, mut hi) = (*t[0], *t[0]);
+    for p in t.iter().chain(&u) {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    let ext = (hi - lo).amax();
+    // near / |n| > 1e-9 · ext, squared (false for a degenerate `t`: |n| = 0, or NaN).
+    near * near > 1e-18 * ext * ext * n.norm_squared() && n.norm_squared() > 0.0
+}

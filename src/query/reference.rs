@@ -31,3 +31,13 @@ pub fn scene_distance(a: &Scene, b: &Scene) -> f64 {
 pub fn overlap(a: &Scene, b: &Scene) -> bool {
     scene_distance(a, b) == 0.0
 }
+
+/// How many primitive pairs of `a` and `b` touch (are at distance 0).
+pub fn contacts(a: &Scene, b: &Scene) -> u64 {
+    let touch = |i: usize| {
+        (0..b.len())
+            .filter(|&j| prim_prim(a, i, b, j) == 0.0)
+            .count()
+    };
+    (0..a.len()).map(touch).sum::<usize>() as u64
+}

@@ -4,8 +4,8 @@
 //! describes it as the benchmarks use it.
 
 use super::{
-    Bv, Counts, Hierarchy, moved, moved_spheres, overlap_within, point_distance_within,
-    scene_distance_within,
+    Bv, Counts, Hierarchy, contacts_within, moved, moved_spheres, overlap_within,
+    point_distance_within, scene_distance_within,
 };
 use crate::geom::{P3, V3};
 use crate::grouping::SubsetTree;
@@ -191,6 +191,16 @@ pub struct QueryCost {
     pub overlap: MeanCost,
     /// How many overlap queries answered true.
     pub overlapping: usize,
+    /// Scene–copy contact queries (one per touching pose: every touching primitive pair).
+    ///
+    /// Kept apart from the other kinds: an overlap query stops at the first touching pair, so
+    /// its tests on a touching pose depend on how soon the traversal happens upon one (on one
+    /// tree they range over three orders of magnitude between poses, and a few poses decide
+    /// the mean), while a contact query visits every overlapping pair of BVs, so its tests
+    /// depend on the two trees alone.
+    pub contact: MeanCost,
+    /// Touching primitive pairs the contact queries found, summed over the poses.
+    pub contacts: u64,
     /// Seconds of all queries, summed as [`MeanCost::seconds`] (moving the copies excluded).
     pub seconds: f64,
 }
@@ -198,17 +208,18 @@ pub struct QueryCost {
 impl QueryCost {
     /// Queries of every kind stopped at [`Workload::max_tests`].
     pub fn capped(&self) -> u64 {
-        self.point.capped + self.distance.capped + self.overlap.capped
+        self.point.capped + self.distance.capped + self.overlap.capped + self.contact.capped
     }
 }
 
 /// Runs the whole workload on `tree` over `scene` with `bv` (sphere BVs are moved with each
 /// copy by [`moved_spheres`]): all 256 point queries, a scene–copy distance query per near pose,
-/// and an overlap query per near and per touching pose (8 answers false, 8 true), each stopping
-/// after [`Workload::max_tests`] tests; moving the copies is not timed.
+/// an overlap query per near and per touching pose (8 answers false, 8 true) and a contact
+/// query per touching pose ([`contacts_within`]), each stopping after [`Workload::max_tests`]
+/// tests; moving the copies is not timed.
 ///
 /// Once a query stops at the cap, the rest of its set (the points, the distances, the overlaps
-/// of near poses, those of touching poses) is not run and is counted as capped with no tests
+/// of near poses, those of touching poses, the contacts) is not run and is counted as capped with no tests
 /// (its mean is then a lower bound, and an overlap not run is not counted as overlapping): only
 /// exact ties reach the cap, and on them every query of the set would run to it.
 ///
@@ -252,6 +263,7 @@ impl FirstCapped {
 struct PoseResult {
     distance: Option<(Counts, f64, ())>,
     overlap: Option<(Counts, f64, bool)>,
+    contact: Option<(Counts, f64, u64)>,
 }
 
 /// A set's queries summed in workload order, as the one-by-one run counts them: after its first
@@ -309,8 +321,10 @@ pub fn measure_until(
     let poses: Vec<_> = near
         .chain(workload.poses_touching.iter().map(|p| (p, false)))
         .collect();
-    // The distances, and the overlaps of near and of touching poses, stop at the cap apart.
+    // The distances, the overlaps of near and of touching poses, and the contacts stop at the
+    // cap apart.
     let (first_dist, first_over) = (FirstCapped::new(), [FirstCapped::new(), FirstCapped::new()]);
+    let first_contact = FirstCapped::new();
     let each: Vec<PoseResult> = poses
         .par_iter()
         .enumerate()
@@ -318,10 +332,12 @@ pub fn measure_until(
             let over_set = &first_over[usize::from(is_near)];
             let run_dist = is_near && first_dist.open(i);
             let run_over = over_set.open(i);
-            if (!run_dist && !run_over) || stop.is_requested() {
+            let run_contact = !is_near && first_contact.open(i);
+            if (!run_dist && !run_over && !run_contact) || stop.is_requested() {
                 return PoseResult {
                     distance: None,
                     overlap: None,
+                    contact: None,
                 };
             }
             let (t, s) = moved(tree, scene, pose);
@@ -345,16 +361,27 @@ pub fn measure_until(
             });
             let overlap = run_over
                 .then(|| over_set.run(i, |c| overlap_within(&h, &copy, workload.max_tests, c)));
-            PoseResult { distance, overlap }
+            let contact = run_contact.then(|| {
+                first_contact.run(i, |c| contacts_within(&h, &copy, workload.max_tests, c))
+            });
+            PoseResult {
+                distance,
+                overlap,
+                contact,
+            }
         })
         .collect();
     stop.check()?;
-    // The distances, then the overlaps of near and of touching poses, each set in its order.
+    // The distances, the overlaps of near and of touching poses, and the contacts, each set in
+    // its order.
     let (mut dist, mut over) = (InOrder::default(), [InOrder::default(), InOrder::default()]);
+    let (mut contact, mut contacts) = (InOrder::default(), 0u64);
     let mut overlapping = 0;
     for (&(_, is_near), r) in poses.iter().zip(each) {
         if is_near {
             dist.push(r.distance);
+        } else {
+            contacts += contact.push(r.contact).unwrap_or(0);
         }
         let hit = over[usize::from(is_near)].push(r.overlap);
         overlapping += usize::from(hit == Some(true));
@@ -368,6 +395,12 @@ pub fn measure_until(
         distance: MeanCost::new(&dist.counts, workload.poses_near.len(), dist.seconds),
         overlap: MeanCost::new(&over_counts, n_pose, over_s),
         overlapping,
-        seconds: point.seconds + dist.seconds + over_s,
+        contact: MeanCost::new(
+            &contact.counts,
+            workload.poses_touching.len(),
+            contact.seconds,
+        ),
+        contacts,
+        seconds: point.seconds + dist.seconds + over_s + contact.seconds,
     })
 }

@@ -153,12 +153,13 @@ fn sanitize(s: &str) -> String {
 /// test cap are counted beside their row's tests per query and explained below the table.
 pub fn bench_table(rows: &[&Row]) -> String {
     let mut md = String::from(
-        "| method | wrapper | build ms | wrapper ms | SAH | depth | tightness | tests/query |\n|---|---|---|---|---|---|---|---|\n",
+        "| method | wrapper | build ms | wrapper ms | SAH | depth | tightness | tests/query | tests/contact query |\n|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
+        let contact = |q: &crate::query::QueryCost| format!("{:.0}", q.contact.bv_tests);
         let _ = writeln!(
             md,
-            "| {} | {} | {:.3} | {:.3} | {:.2} | {} | {} | {} |",
+            "| {} | {} | {:.3} | {:.3} | {:.2} | {} | {} | {} | {} |",
             r.method,
             r.wrapper,
             r.build_s * 1e3,
@@ -166,7 +167,8 @@ pub fn bench_table(rows: &[&Row]) -> String {
             r.quality.sah,
             r.quality.depth_max,
             r.tightness.map(|t| format!("{t:.4}")).unwrap_or_default(),
-            r.query.as_ref().map(tests_cell).unwrap_or_default()
+            r.query.as_ref().map(tests_cell).unwrap_or_default(),
+            r.query.as_ref().map(contact).unwrap_or_default()
         );
     }
     let capped: u64 = rows
@@ -365,7 +367,7 @@ mod tests {
         let bytes = bench_csv(&names.map(row)).unwrap();
         let mut reader = csv::Reader::from_reader(&bytes[..]);
         let width = reader.headers().unwrap().len();
-        assert_eq!(width, 25);
+        assert_eq!(width, 27);
         let records: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
         assert_eq!(records.len(), names.len());
         for (r, name) in records.iter().zip(names) {
@@ -383,7 +385,7 @@ mod tests {
         };
         let text = String::from_utf8(bench_csv(&[row("lamp"), partitioned]).unwrap()).unwrap();
         let head = "lamp,3,grouping,box,1.500000e-3,0.000000e0,2.000000e-5,1.250000e1,4,3.2500,\
-0.5000,0.7500,2.500000e-1,0.5000;0.2500,,,,,,,,,,,";
+0.5000,0.7500,2.500000e-1,0.5000;0.2500,,,,,,,,,,,,,";
         assert_eq!(text.lines().nth(1).unwrap(), head);
         assert_eq!(
             text.lines().nth(2).unwrap(),

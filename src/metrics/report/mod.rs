@@ -42,10 +42,11 @@ pub(super) fn opt(v: Option<f64>) -> String {
 }
 
 /// Columns of a query cost: node (BV) and primitive tests per query of each kind, the eq. (1)
-/// total per query, seconds for the whole workload, and how many queries stopped at the test
-/// cap ([`crate::query::Workload::max_tests`]).
+/// total per query (point, distance and overlap queries), seconds for the whole workload, node
+/// and primitive tests per contact query, and how many queries stopped at the test cap
+/// ([`crate::query::Workload::max_tests`]).
 pub(super) const QUERY_COLUMNS: &str = "point_bv,point_prim,distance_bv,distance_prim,overlap_bv,overlap_prim,\
-node_tests_per_query,query_cost,query_s,query_capped";
+node_tests_per_query,query_cost,query_s,contact_bv,contact_prim,query_capped";
 
 /// The [`QUERY_COLUMNS`] fields of a query cost, all empty without one.
 pub(super) fn query_fields(q: Option<&QueryCost>) -> Vec<String> {

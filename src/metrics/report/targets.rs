@@ -9,7 +9,7 @@ use std::fmt::Write as _;
 /// The targets table's header line.
 pub fn targets_header() -> String {
     format!(
-        "{:<18} {:>8} {:>9} {:>9} {:>7} {:>9} {:>7} {:>8} {:>8} {:>6} {:>8}\n",
+        "{:<18} {:>8} {:>9} {:>9} {:>7} {:>9} {:>7} {:>8} {:>8} {:>8} {:>6} {:>8}\n",
         "scene",
         "N",
         "group ms",
@@ -19,6 +19,7 @@ pub fn targets_header() -> String {
         "t/bin",
         "SAH/bin",
         "qry/bin",
+        "con/bin",
         "depth",
         "peak MB"
     )
@@ -28,7 +29,7 @@ pub fn targets_header() -> String {
 pub fn target_line(r: &TargetRow) -> String {
     let (t, tp, tb) = (r.group_seconds, r.ploc_seconds, r.binned_seconds);
     format!(
-        "{:<18} {:>8} {:>9.2} {:>9.2} {:>7.2} {:>9.2} {:>7.2} {:>8.3} {:>8.3} {:>6} {:>8.0}\n",
+        "{:<18} {:>8} {:>9.2} {:>9.2} {:>7.2} {:>9.2} {:>7.2} {:>8.3} {:>8.3} {:>8.3} {:>6} {:>8.0}\n",
         r.scene,
         r.n,
         t * 1e3,
@@ -38,6 +39,7 @@ pub fn target_line(r: &TargetRow) -> String {
         t / tb,
         r.sah_ratio,
         r.query_ratio,
+        r.contact_ratio,
         r.depth,
         r.peak_rss_bytes.unwrap_or(0) as f64 / 1e6
     )
@@ -48,6 +50,8 @@ pub fn targets_notes() -> String {
     "t/PLOC = grouping time / obvhs PLOC build time; t/bin = / parry3d Bvh Binned.\n\
      SAH/bin, qry/bin = SAH cost and node tests per query (AABB BVs, standard\n\
      workload) of the grouping tree / parry Binned's. Goal: t/PLOC <= 1 and qry/bin <= 1.\n\
+     con/bin = the same for node tests per contact query (every touching pair of the\n\
+     touching poses: these depend on the trees alone, not on how soon a traversal finds one).\n\
      peak MB = process peak RSS after the case (cases run in increasing size).\n\n"
         .to_string()
 }
@@ -55,39 +59,43 @@ pub fn targets_notes() -> String {
 /// Grouping + refinement against the best peer, with its notes and a blank line.
 pub fn refine_table(rows: &[RefineRow]) -> String {
     let mut s = format!(
-        "{:<18} {:>9} {:>9} {:>10} {:>9} {:>9} | {:>9} {:>10} {:>9} {:>9}\n",
+        "{:<18} {:>9} {:>9} {:>10} {:>9} {:>9} {:>9} | {:>9} {:>10} {:>9} {:>9} {:>9}\n",
         "scene",
         "ref ms",
         "total ms",
         "ref/PLOC",
         "SAH/best",
         "qry/best",
+        "con/best",
         "p tot ms",
         "p ref/PLOC",
         "p SAH/bst",
-        "p qry/bst"
+        "p qry/bst",
+        "p con/bst"
     );
     for r in rows {
         let _ = writeln!(
             s,
-            "{:<18} {:>9.2} {:>9.2} {:>10.2} {:>9.3} {:>9.3} | {:>9.2} {:>10.2} {:>9.3} {:>9.3}",
+            "{:<18} {:>9.2} {:>9.2} {:>10.2} {:>9.3} {:>9.3} {:>9.3} | {:>9.2} {:>10.2} {:>9.3} {:>9.3} {:>9.3}",
             r.scene,
             r.refine_seconds * 1e3,
             r.total_seconds * 1e3,
             r.refine_per_ploc,
             r.sah_per_best,
             r.query_per_best,
+            r.contact_per_best,
             r.part_total_seconds * 1e3,
             r.part_refine_per_ploc,
             r.part_sah_per_best,
-            r.part_query_per_best
+            r.part_query_per_best,
+            r.part_contact_per_best
         );
     }
     s.push_str(
         "grouping+refine: ref ms = refinement alone, total ms = grouping + refinement;\n\
          ref/PLOC = refinement time alone / obvhs PLOC build time;\n\
-         SAH/best, qry/best = its SAH and node tests per query / the best of parry Binned\n\
-         and obvhs PLOC + reinsertion. Goal: all three <= 1.\n\
+         SAH/best, qry/best, con/best = its SAH, node tests per query and per contact query /\n\
+         the best of parry Binned and obvhs PLOC + reinsertion. Goal: all <= 1.\n\
          p ... = the same for the partitioned grouping + refinement (grouping-partitioned+refine).\n\n",
     );
     s
