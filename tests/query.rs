@@ -557,11 +557,18 @@ fn workload_counts_do_not_depend_on_child_order() {
     let boxes = counts(&measure(&tree, &soup, Bv::Aabb, &w));
     assert_eq!(boxes.3, 8, "every touching pose overlaps");
     assert_eq!(boxes, counts(&measure(&mirrored, &soup, Bv::Aabb, &w)));
+    assert_eq!(boxes.4.0, 8, "a contact query per touching pose");
     // The same sphere for each node (its children's order does not change its primitives).
     let spheres = sphere_tree(&tree, &soup, SphereMethod::Ritter);
+    let balls = counts(&measure(&tree, &soup, Bv::Sphere(&spheres), &w));
     assert_eq!(
-        counts(&measure(&tree, &soup, Bv::Sphere(&spheres), &w)),
+        balls,
         counts(&measure(&mirrored, &soup, Bv::Sphere(&spheres), &w))
+    );
+    assert_eq!(
+        (balls.4.0, balls.5),
+        (0, 0),
+        "no contact queries with spheres"
     );
 }
 

@@ -156,7 +156,10 @@ pub fn bench_table(rows: &[&Row]) -> String {
         "| method | wrapper | build ms | wrapper ms | SAH | depth | tightness | tests/query | tests/contact query |\n|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
-        let contact = |q: &crate::query::QueryCost| format!("{:.0}", q.contact.bv_tests);
+        let contact = |q: &crate::query::QueryCost| {
+            let c = &q.contact;
+            (c.queries > 0).then(|| format!("{:.0}", c.bv_tests))
+        };
         let _ = writeln!(
             md,
             "| {} | {} | {:.3} | {:.3} | {:.2} | {} | {} | {} | {} |",
@@ -168,7 +171,7 @@ pub fn bench_table(rows: &[&Row]) -> String {
             r.quality.depth_max,
             r.tightness.map(|t| format!("{t:.4}")).unwrap_or_default(),
             r.query.as_ref().map(tests_cell).unwrap_or_default(),
-            r.query.as_ref().map(contact).unwrap_or_default()
+            r.query.as_ref().and_then(contact).unwrap_or_default()
         );
     }
     let capped: u64 = rows

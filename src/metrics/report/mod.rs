@@ -43,7 +43,8 @@ pub(super) fn opt(v: Option<f64>) -> String {
 
 /// Columns of a query cost: node (BV) and primitive tests per query of each kind, the eq. (1)
 /// total per query (point, distance and overlap queries), seconds for the whole workload, node
-/// and primitive tests per contact query, and how many queries stopped at the test cap
+/// and primitive tests per contact query (empty without contact queries: sphere BVs), and how
+/// many queries stopped at the test cap
 /// ([`crate::query::Workload::max_tests`]).
 pub(super) const QUERY_COLUMNS: &str = "point_bv,point_prim,distance_bv,distance_prim,overlap_bv,overlap_prim,\
 node_tests_per_query,query_cost,query_s,contact_bv,contact_prim,query_capped";
@@ -55,6 +56,11 @@ pub(super) fn query_fields(q: Option<&QueryCost>) -> Vec<String> {
         Some(q) => {
             let values = crate::metrics::compare::query_values(q);
             let mut f: Vec<String> = values.iter().map(|x| format!("{x:.6e}")).collect();
+            if q.contact.queries == 0 {
+                // No contact queries (sphere BVs): their columns stay empty.
+                f[9].clear();
+                f[10].clear();
+            }
             f.push(q.capped().to_string());
             f
         }
