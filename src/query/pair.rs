@@ -98,6 +98,25 @@ pub fn overlap(a: &Hierarchy, b: &Hierarchy, counts: &mut Counts) -> bool {
 /// [`overlap`] that gives up once it has made `max_tests` tests without finding a touching
 /// pair: `false` (unproven), the stop counted in [`Counts::capped`].
 pub fn overlap_within(a: &Hierarchy, b: &Hierarchy, max_tests: u64, counts: &mut Counts) -> bool {
+    descend(a, b, max_tests, counts, true, |x, y| {
+        prim_prim(a.scene, x as usize, b.scene, y as usize) == 0.0
+    })
+}
+
+/// Depth-first over the BVTT pairs of `a` and `b` whose BVs overlap (bound at most 0 after
+/// slack), from the root pair: `leaf` is called on each primitive pair reached (one primitive
+/// test), and the descent ends when it returns `true` (then `true` is returned), when every
+/// overlapping pair is visited, or once `max_tests` tests are made (the stop counted in
+/// [`Counts::capped`]). With `deeper_first`, of a pair's two child pairs the one whose BVs
+/// overlap deeper is searched first (ties keep the stored order); otherwise the stored order.
+fn descend(
+    a: &Hierarchy,
+    b: &Hierarchy,
+    max_tests: u64,
+    counts: &mut Counts,
+    deeper_first: bool,
+    mut leaf: impl FnMut(u32, u32) -> bool,
+) -> bool {
     let start = counts.tests();
     let slack = a.slack() + b.slack();
     let (ra, rb) = (a.tree.root(), b.tree.root());
@@ -114,7 +133,7 @@ pub fn overlap_within(a: &Hierarchy, b: &Hierarchy, max_tests: u64, counts: &mut
         match split(a, x, b, y) {
             None => {
                 counts.prim_tests += 1;
-                if prim_prim(a.scene, x as usize, b.scene, y as usize) == 0.0 {
+                if leaf(x, y) {
                     return true;
                 }
             }
@@ -124,11 +143,15 @@ pub fn overlap_within(a: &Hierarchy, b: &Hierarchy, max_tests: u64, counts: &mut
                     counts.bv_tests += 1;
                     let bound = pair_bound(a, c, b, d);
                     if bound - slack <= 0.0 {
-                        *slot = Some((pair_depth(a, c, b, d, bound), (c, d)));
+                        let depth = if deeper_first {
+                            pair_depth(a, c, b, d, bound)
+                        } else {
+                            0.0
+                        };
+                        *slot = Some((depth, (c, d)));
                     }
                 }
-                // The deeper-overlapping pair is searched first (pushed last); ties keep the
-                // stored order.
+                // The deeper-overlapping pair is searched first (pushed last).
                 if let [Some((p, _)), Some((q, _))] = open
                     && q > p
                 {
@@ -155,34 +178,10 @@ pub fn contacts(a: &Hierarchy, b: &Hierarchy, counts: &mut Counts) -> u64 {
 /// [`contacts`] that gives up once it has made `max_tests` tests: the contacts found by then
 /// (a lower bound), the stop counted in [`Counts::capped`].
 pub fn contacts_within(a: &Hierarchy, b: &Hierarchy, max_tests: u64, counts: &mut Counts) -> u64 {
-    let start = counts.tests();
-    let slack = a.slack() + b.slack();
-    let (ra, rb) = (a.tree.root(), b.tree.root());
-    counts.bv_tests += 1;
-    if pair_bound(a, ra, b, rb) - slack > 0.0 {
-        return 0;
-    }
     let mut found = 0u64;
-    let mut stack = vec![(ra, rb)];
-    while let Some((x, y)) = stack.pop() {
-        if counts.tests() - start >= max_tests {
-            counts.capped += 1;
-            return found;
-        }
-        match split(a, x, b, y) {
-            None => {
-                counts.prim_tests += 1;
-                found += u64::from(prims_touch(a.scene, x as usize, b.scene, y as usize));
-            }
-            Some(pairs) => {
-                for (c, d) in pairs {
-                    counts.bv_tests += 1;
-                    if pair_bound(a, c, b, d) - slack <= 0.0 {
-                        stack.push((c, d));
-                    }
-                }
-            }
-        }
-    }
+    descend(a, b, max_tests, counts, false, |x, y| {
+        found += u64::from(prims_touch(a.scene, x as usize, b.scene, y as usize));
+        false
+    });
     found
 }
