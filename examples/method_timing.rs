@@ -20,7 +20,8 @@
 //! `S`, then of seeds `S + 1`, `S + 2`, … in turn.
 //!
 //! The fast path's settings can be varied through the environment: `TOP`, `SAH`, `EPS`, `MAX`
-//! (its split: root share, SAH-cut size, ε, largest chunk) and `PASSES`, `BATCH` (its reinsertion passes).
+//! (its split: root share, SAH-cut size, ε, largest chunk), `PASSES`, `BATCH` (its reinsertion
+//! passes) and `TREELETS` (treelet passes before them, as the default refinement runs 1).
 //!
 //! `cargo run --release --example method_timing -- [--threads 1] [--repeat 5]
 //! [--methods fast,grouping] FILE...` (a FILE may be a generated scene's spec: `soup:1000000`)
@@ -64,6 +65,7 @@ fn build_varied(method: Method, scene: &Scene, params: &Params) -> Built {
     let mut rp = refine::fast_for(scene.len());
     rp.passes = env("PASSES").unwrap_or(rp.passes);
     rp.batch = env("BATCH").unwrap_or(rp.batch);
+    rp.treelet_passes = env("TREELETS").unwrap_or(rp.treelet_passes);
     let n = scene.len();
     let mut boxes = Vec::with_capacity(2 * n - 1);
     boxes.extend((0..n).map(|i| scene.prim_aabb(i)));
