@@ -1,11 +1,12 @@
 //! Hierarchy queries against brute force: point–scene distance, scene–scene distance and
-//! overlap on generated scenes, two tree shapes and AABB and sphere BVs; triangle–triangle and
+//! overlap and contacts on generated scenes, two tree shapes and AABB and sphere BVs; triangle–triangle and
 //! segment–segment distances on hand-computed cases and against dense sampling.
 
 use proptest::prelude::*;
 use wraptree::geom::P3;
 use wraptree::geom::distance::{segment_segment, segment_triangle, triangle_triangle};
 use wraptree::grouping::{Params, SubsetTree, group};
+use wraptree::query::prim::prims_touch;
 use wraptree::query::{
     Bv, Counts, Hierarchy, Workload, contacts, measure, moved, moved_spheres, overlap,
     point_distance, reference, scene_distance, scene_distance_within,
@@ -204,6 +205,26 @@ proptest! {
         // x is the centroid of u's corners x + d1, x + d2, x − d1 − d2.
         let u_tri = [x + d1, x + d2, x - d1 - d2];
         prop_assert_eq!(tt(t, u_tri), 0.0);
+    }
+
+    /// The contact test (planes that clearly separate skipped first) answers as the distance
+    /// does: on random pairs, shifted apart or not, with corners on a half-unit grid where
+    /// pairs touch at a corner, an edge or in a plane.
+    #[test]
+    fn prims_touch_agrees_with_the_distance(
+        t in triangle(),
+        u in triangle(),
+        shift in prop::array::uniform3((-2i32..=2).prop_map(|i| i as f64 * 0.5)),
+    ) {
+        let u = u.map(|q| q + wraptree::geom::V3::from(shift));
+        let one = |c: [P3; 3]| {
+            let mut s = Scene::new("one");
+            s.points.extend(c);
+            s.push(wraptree::scene::PrimitiveKind::Polygon, &[0, 1, 2], &[[0, 1, 2]]);
+            s
+        };
+        let (a, b) = (one(t), one(u));
+        prop_assert_eq!(prims_touch(&a, 0, &b, 0), tt(t, u) == 0.0);
     }
 }
 
