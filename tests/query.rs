@@ -1,6 +1,7 @@
-//! Hierarchy queries against brute force: point–scene distance, scene–scene distance and
-//! overlap and contacts on generated scenes, two tree shapes and AABB and sphere BVs; triangle–triangle and
-//! segment–segment distances on hand-computed cases and against dense sampling.
+//! Hierarchy queries against brute force: point–scene distance, scene–scene distance, overlap
+//! and contacts on generated scenes, two tree shapes and AABB and sphere BVs; triangle–triangle
+//! and segment–segment distances on hand-computed cases and against dense sampling; the
+//! contact test against the distance.
 
 use proptest::prelude::*;
 use wraptree::geom::P3;
