@@ -2,7 +2,7 @@
 //! contact query (every touching pair), per builder: the fast path, parry Binned, obvhs PLOC
 //! and PLOC + reinsertion, AABB BVs, on the touching poses of the standard workloads of seeds
 //! 1 to SEEDS (8 each). Then per builder the sums, and each sum over the least of the peers'
-//! (`docs/benchmarks.md`, "Overlap and contact queries on touching poses").
+//! (`docs/benchmarks.md`, "Contact queries: the touching poses measured by the trees alone").
 //!
 //! `cargo run --release --example touching_poses -- SEEDS FILE`
 

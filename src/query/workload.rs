@@ -226,9 +226,10 @@ impl QueryCost {
 /// [`Workload::max_tests`] tests; moving the copies is not timed.
 ///
 /// Once a query stops at the cap, the rest of its set (the points, the distances, the overlaps
-/// of near poses, those of touching poses, the contacts) is not run and is counted as capped with no tests
-/// (its mean is then a lower bound, and an overlap not run is not counted as overlapping): only
-/// exact ties reach the cap, and on them every query of the set would run to it.
+/// of near poses, those of touching poses, the contacts) is not run and is counted as capped
+/// with no tests (its mean is then a lower bound, and an overlap not run is not counted as
+/// overlapping): only exact ties reach the cap, and on them every query of the set would run
+/// to it.
 ///
 /// The queries run side by side on rayon's threads, and their counts are summed in workload
 /// order with the rule above, so the result is that of running them one by one, for any number
