@@ -38,6 +38,12 @@ fn check_valid(scene: &Scene, t: &SubsetTree) {
             "node {x} is a child {c} times"
         );
     }
+    let rebuilt = SubsetTree::new(t.aabb.clone(), t.diameter.clone(), t.children.clone());
+    assert_eq!(
+        rebuilt.as_ref(),
+        Ok(t),
+        "parents and depths follow the children"
+    );
     let mut leaves = t.leaves_under(t.root());
     leaves.sort();
     assert_eq!(leaves, (0..n as u32).collect::<Vec<_>>());
