@@ -97,17 +97,20 @@ pub fn find_best(
     })
 }
 
-/// The best moves of `candidates` on the frozen tree `w`. Batches of [`PARALLEL_MIN`] and more
-/// are searched on rayon's threads in [`spatial_order`] when called on a thread of a pool of
-/// several threads, and so are batches of [`SPATIAL_MIN`] and more anywhere (the order keeps
-/// the tree in cache); others on the calling thread in candidate order, where handing work to
-/// rayon or sorting costs more than it saves. The moves come back in that fixed order, the same
-/// for any number of threads, and [`sort_best_first`] ranks them independently of it.
+/// The best moves of `candidates` (a set: their order is not used) on the frozen tree `w`.
+/// Batches of [`PARALLEL_MIN`] and more are searched on rayon's threads in [`spatial_order`]
+/// when called on a thread of a pool of several threads, and so are batches of [`SPATIAL_MIN`]
+/// and more anywhere (the order keeps the tree in cache); others on the calling thread in id
+/// order, where handing work to rayon or ordering by space costs more than it saves. The moves
+/// come back in that fixed order, the same for any number of threads, and [`sort_best_first`]
+/// ranks them independently of it.
 pub fn find_all(w: &WorkTree, candidates: &[u32], min_gain: f64) -> Vec<Move> {
     let parallel = candidates.len() >= PARALLEL_MIN && parallel_here();
     if !parallel && candidates.len() < SPATIAL_MIN {
+        let mut ids = candidates.to_vec();
+        ids.sort_unstable();
         let mut stack = Vec::new();
-        return candidates
+        return ids
             .iter()
             .filter_map(|&c| find_best(w, c, min_gain, &mut stack))
             .collect();
@@ -155,7 +158,7 @@ pub fn spatial_order(w: &WorkTree, candidates: &[u32]) -> Vec<u32> {
 pub const PARALLEL_MIN: usize = 256;
 
 /// Fewest candidates searched in [`spatial_order`] on one thread, and the size from which a
-/// pass ranks its candidates on rayon's threads (eight times as many nodes) and sorts them there.
+/// pass ranks its candidates on rayon's threads (eight times as many nodes).
 pub const SPATIAL_MIN: usize = 2048;
 
 /// Orders moves best first: larger gain, then smaller node id.
@@ -178,8 +181,10 @@ pub fn still_valid(w: &WorkTree, m: &Move) -> bool {
 /// lowest SAH and node tests for the same time (`docs/benchmarks.md`, "Refinement variants").
 ///
 /// The set is what matters ([`find_all`]'s moves are sorted by gain afterwards), so it is
-/// selected, not sorted: returned in id order. Keys are computed on rayon's threads for large
-/// trees; the set is the same for any number of threads.
+/// selected, not sorted, and returned in the order it is found (the chosen slots' children in
+/// slot order, then the tied ones by id; [`find_all`] orders its searches itself). Keys are
+/// computed on rayon's threads for large trees; the set and its order are the same for any
+/// number of threads.
 pub fn candidates(w: &WorkTree, count: usize) -> Vec<u32> {
     let nodes = w.parent.len();
     let count = count.min(nodes - 1);
@@ -225,10 +230,5 @@ pub fn candidates(w: &WorkTree, count: usize) -> Vec<u32> {
     tied.sort_unstable();
     tied.truncate(count - ids.len());
     ids.extend(tied);
-    if ids.len() < SPATIAL_MIN {
-        ids.sort_unstable();
-    } else {
-        ids.par_sort_unstable();
-    }
     ids
 }
