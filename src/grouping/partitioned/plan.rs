@@ -96,7 +96,8 @@ impl Chunking {
     /// scenes; 16 against 32 took 10–23 % off scenes under 1,000 primitives (the root step's
     /// Cost table is a quarter the size) and left the larger ones as they were, on 69 real
     /// meshes. δ = 2 against 4 (with the executor's lean recursion for such subtrees) took about
-    /// a fifth off the time and left as good trees (`docs/benchmarks.md`, "Users' sizes").
+    /// a fifth off the time and left as good trees (`docs/benchmarks.md`, "The fast path:
+    /// variants measured and not kept").
     pub const FAST: Chunking = Chunking {
         top: 16,
         delta: 2,
