@@ -204,44 +204,53 @@ fn new_nodes(
 ) -> Vec<(u32, [u32; 2], Aabb, bool)> {
     let Scratch { boxes, split, .. } = buf;
     let (n, full) = (leaves.len(), (1usize << leaves.len()) - 1);
-    // The old interior slots by leaf set, to keep a slot where its set survives.
-    let mask_of = |x: u32| -> usize {
-        let mut m = 0;
-        let mut stack = vec![x];
-        while let Some(y) = stack.pop() {
-            match leaves.iter().position(|&l| l == y) {
-                Some(i) => m |= 1 << i,
-                None => stack.extend(w.kids(y)),
+    // The old interior slots' leaf sets. Each interior node was opened after its parent, so in
+    // reverse formation order a node's interior children already have theirs.
+    let mut old = [0usize; MAX_LEAVES - 1];
+    for i in (0..inner.len()).rev() {
+        old[i] = w.kids(inner[i]).iter().fold(0, |m, &c| {
+            m | match leaves.iter().position(|&l| l == c) {
+                Some(j) => 1 << j,
+                None => old[inner.iter().position(|&y| y == c).expect("a treelet node")],
             }
-        }
-        m
-    };
-    let old: Vec<(u32, usize)> = inner.iter().map(|&x| (x, mask_of(x))).collect();
-    // New interior sets, root first (depth-first, P side before the rest).
-    let mut sets = Vec::with_capacity(n - 1);
-    let mut stack = vec![full];
-    while let Some(s) = stack.pop() {
+        });
+    }
+    let old = &old[..inner.len()];
+    // New interior sets, root first (depth-first, P side before the rest); the pending sets
+    // are disjoint, so at most n.
+    let mut sets = [0usize; MAX_LEAVES - 1];
+    let mut count = 0;
+    let mut stack = [0usize; MAX_LEAVES];
+    let mut top = 1;
+    stack[0] = full;
+    while top > 0 {
+        top -= 1;
+        let s = stack[top];
         if s.count_ones() >= 2 {
-            sets.push(s);
+            sets[count] = s;
+            count += 1;
             let p = split[s] as usize;
-            stack.push(s ^ p);
-            stack.push(p);
+            stack[top] = s ^ p;
+            stack[top + 1] = p;
+            top += 2;
         }
     }
-    let mut slot = vec![NONE; sets.len()];
-    let mut used = vec![false; old.len()];
+    debug_assert_eq!(count, n - 1);
+    let sets = &sets[..count];
+    let mut slot = [NONE; MAX_LEAVES - 1];
+    let mut used = [false; MAX_LEAVES - 1];
     for (i, &s) in sets.iter().enumerate() {
-        if let Some(j) = old.iter().position(|&(_, m)| m == s) {
-            slot[i] = old[j].0;
+        if let Some(j) = old.iter().position(|&m| m == s) {
+            slot[i] = inner[j];
             used[j] = true;
         }
     }
-    let mut free = old
+    let mut free = inner
         .iter()
         .zip(&used)
         .filter(|(_, u)| !**u)
-        .map(|(o, _)| o.0);
-    for s in slot.iter_mut().filter(|s| **s == NONE) {
+        .map(|(&x, _)| x);
+    for s in slot[..count].iter_mut().filter(|s| **s == NONE) {
         *s = free
             .next()
             .expect("a treelet of n leaves has n − 1 interior slots");
@@ -264,7 +273,7 @@ fn new_nodes(
             if w.kids(x) == [kids[1], kids[0]] {
                 kids.swap(0, 1);
             }
-            let changed = old.iter().all(|&(y, m)| y != x || m != s);
+            let changed = !inner.iter().zip(old).any(|(&y, &m)| y == x && m == s);
             (x, kids, boxes[s], changed)
         })
         .collect()
