@@ -21,7 +21,8 @@
 //!
 //! The fast path's settings can be varied through the environment: `TOP`, `SAH`, `EPS`, `MAX`
 //! (its split: root share, SAH-cut size, ε, largest chunk), `PASSES`, `BATCH` (its reinsertion
-//! passes) and `TREELETS` (treelet passes before them, as the default refinement runs 1).
+//! passes), `TREELETS` (treelet passes before them), `TK` (a treelet's leaves) and `GAMMA` (the
+//! fewest leaves under a treelet root).
 //!
 //! `cargo run --release --example method_timing -- [--threads 1] [--repeat 5]
 //! [--methods fast,grouping] FILE...` (a FILE may be a generated scene's spec: `soup:1000000`)
@@ -66,6 +67,8 @@ fn build_varied(method: Method, scene: &Scene, params: &Params) -> Built {
     rp.passes = env("PASSES").unwrap_or(rp.passes);
     rp.batch = env("BATCH").unwrap_or(rp.batch);
     rp.treelet_passes = env("TREELETS").unwrap_or(rp.treelet_passes);
+    rp.treelet = env("TK").unwrap_or(rp.treelet);
+    rp.treelet_min = env("GAMMA").unwrap_or(rp.treelet_min);
     let n = scene.len();
     let mut boxes = Vec::with_capacity(2 * n - 1);
     boxes.extend((0..n).map(|i| scene.prim_aabb(i)));

@@ -123,3 +123,74 @@ fn the_bench_method_refines_with_a_smaller_first_batch_from_2_14_primitives_up()
     assert_eq!(fast_for(FAST_LARGE - 1), FAST);
     assert_eq!(fast_for(FAST_LARGE).batch, refine::FAST_LARGE_BATCH);
 }
+
+#[test]
+fn below_2_10_primitives_the_bench_method_refines_without_its_treelet_pass() {
+    // Three reinsertion passes below `FAST_SMALL`, where the treelet pass would cost a large
+    // share of PLOC's build; from it up the treelets of `FAST` change the tree.
+    use wraptree::refine::{self, FAST, FAST_SMALL, FAST_SMALL_PARAMS, fast_for};
+    let n = 700;
+    let scene = generate::soup(n, 5);
+    let bench = tree_on(1, Method::Fast, &scene);
+    let grouped = tree_on(1, Method::GroupingFast, &scene);
+    assert_eq!(bench, refine::refine(&grouped, &FAST_SMALL_PARAMS, ()).tree);
+    assert_ne!(bench, refine::refine(&grouped, &FAST, ()).tree);
+    assert_eq!(fast_for(FAST_SMALL - 1), FAST_SMALL_PARAMS);
+    assert_eq!(fast_for(FAST_SMALL), FAST);
+    assert_eq!(FAST_SMALL_PARAMS.treelet_passes, 0);
+    assert_eq!((FAST.treelet_passes, FAST.treelet_min), (1, 8));
+}
+
+#[test]
+fn record_with_the_fast_paths_refinement_flags_gives_the_bench_tree_and_replays() {
+    use wraptree::refine::{fast_for, refine};
+    let dir = tempfile::tempdir().unwrap();
+    let bunny = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/stanford-bunny.obj");
+    let prefix = dir.path().join("bunny");
+    let p = prefix.to_str().unwrap();
+    let args = [
+        "record",
+        bunny.to_str().unwrap(),
+        "--fast",
+        "--refine",
+        "--refine-passes",
+        "2",
+        "--refine-treelet",
+        "5",
+        "--refine-treelet-min",
+        "8",
+        "--detail",
+        "levels",
+        "--reproducible",
+        "-o",
+        p,
+    ];
+    let out = wraptree(&args, dir.path());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mcap = format!("{p}.mcap");
+    let rec = wraptree::record::mcap::read_recording(std::path::Path::new(&mcap)).unwrap();
+    let r = rec.refine.expect("the metadata names the refinement");
+    let scene = load_path(&bunny, &LoadOptions::default()).unwrap().scene;
+    assert_eq!(r.params, fast_for(scene.len()), "the recorded parameters");
+    let bench = tree_on(1, Method::Fast, &scene);
+    assert_eq!(
+        refine(&rec.tree(&scene).unwrap(), &r.params, ()).tree,
+        bench
+    );
+    let out = wraptree(&["replay", &mcap, "--verify"], dir.path());
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && stdout.contains("the refinement's moves are identical"),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // A treelet root below 3 leaves is refused in one line, before any work.
+    let mut bad = args;
+    bad[9] = "2";
+    let out = wraptree(&bad, dir.path());
+    common::assert_one_line_error(&out, "--refine-treelet-min");
+}

@@ -91,13 +91,20 @@ fn treelet_gamma_follows_the_size_rule() {
         (1_000_000, 1_024),
         (1 << 24, 16_384),
     ] {
-        assert_eq!(auto.gamma(n), gamma, "n = {n}");
+        assert_eq!(auto.gamma(&RefineParams::default(), n), gamma, "n = {n}");
     }
+    // The parameters' γ over the size rule, the tuning's over both.
+    let eight = RefineParams {
+        treelet_min: 8,
+        ..RefineParams::default()
+    };
+    assert_eq!(auto.gamma(&eight, 1_000_000), 8);
     let fixed = Tuning {
         treelet_min: 3,
         ..Tuning::default()
     };
-    assert_eq!(fixed.gamma(1_000_000), 3);
+    assert_eq!(fixed.gamma(&RefineParams::default(), 1_000_000), 3);
+    assert_eq!(fixed.gamma(&eight, 1_000_000), 3);
     // The rule is the default: γ = 64 set explicitly gives the same run below 65,536.
     let scene = generate::soup(3_000, 5);
     let tree = group(&scene, &Params::default(), ()).tree;

@@ -80,6 +80,10 @@ pub struct RecordCmd {
     /// Treelet restructuring passes before the reinsertion passes (with --refine; 0 = none).
     #[arg(long, default_value_t = RefineParams::default().treelet_passes, requires = "refine")]
     refine_treelet_passes: u32,
+    /// Treelets are rooted only at nodes of at least this many leaves (with --refine; 0 = by
+    /// the tree's size: 64 up to 65,536 leaves, more above; the fast path's refinement uses 8).
+    #[arg(long, default_value_t = RefineParams::default().treelet_min, requires = "refine")]
+    refine_treelet_min: u32,
     #[command(flatten)]
     live: LiveArgs,
 }
@@ -217,6 +221,7 @@ impl RecordCmd {
                 batch: self.refine_batch,
                 treelet: self.refine_treelet,
                 treelet_passes: self.refine_treelet_passes,
+                treelet_min: self.refine_treelet_min,
             }),
             live: Live::default(),
         };

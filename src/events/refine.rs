@@ -18,6 +18,10 @@ pub struct RefineParams {
     pub treelet: u32,
     /// Treelet restructuring passes run before the reinsertion passes (0: none).
     pub treelet_passes: u32,
+    /// Treelets are rooted only at nodes of at least this many leaves (Karras and Aila's γ;
+    /// at least 3); 0 = by the tree's size (64 up to 65,536 leaves, more above).
+    #[serde(default)]
+    pub treelet_min: u32,
 }
 
 impl Default for RefineParams {
@@ -30,6 +34,7 @@ impl Default for RefineParams {
             batch: 0.1,
             treelet: 7,
             treelet_passes: 1,
+            treelet_min: 0,
         }
     }
 }
@@ -47,6 +52,12 @@ impl RefineParams {
             return Err(format!(
                 "refine treelet must be 3 to {} leaves, got {}",
                 MAX_TREELET_LEAVES, self.treelet
+            ));
+        }
+        if self.treelet_min != 0 && self.treelet_min < 3 {
+            return Err(format!(
+                "refine treelet-min must be 0 (by the tree's size) or at least 3 leaves, got {}",
+                self.treelet_min
             ));
         }
         Ok(())

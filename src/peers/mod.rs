@@ -6,7 +6,7 @@
 //! - [`Method::Grouping`], [`Method::GroupingHull`], [`Method::GroupingPartitioned`]: the
 //!   paper's grouping phase (§2.2) with AABB or hull p-sets, and in the partitioned schedule;
 //! - [`Method::Fast`]: the fast path, the partitioned schedule with small subproblems
-//!   ([`Method::GroupingFast`]) then a bounded refinement ([`crate::refine::fast_for`]);
+//!   ([`Method::GroupingFast`]) then a bounded refinement ([`crate::refine::refine_fast`]);
 //! - [`Method::GroupingPregroup`], [`Method::GroupingInstanced`], [`Method::GroupingObjects`]:
 //!   the same with the paper's §1.3 speed-ups ([`crate::grouping::pregroup`]);
 //! - [`parry_bvh`]: parry3d's `Bvh`, binned SAH or PLOC, as published;
@@ -66,8 +66,7 @@ pub enum Method {
     /// The partitioned schedule with the fast path's split
     /// ([`Chunking::FAST`](crate::grouping::partitioned::Chunking::FAST)).
     GroupingFast,
-    /// The fast path: [`Method::GroupingFast`] then the refinement with
-    /// [`crate::refine::fast_for`] the scene's size.
+    /// The fast path: [`Method::GroupingFast`] then [`crate::refine::refine_fast`].
     Fast,
 }
 
@@ -239,18 +238,17 @@ fn build_here(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
     let mut built = build_base(base, scene, params)?;
     if method.is_refined() {
         let t = Instant::now();
-        let rp = if method == Method::Fast {
-            refine::fast_for(scene.len())
-        } else {
-            RefineParams::default()
-        };
         let Built {
             tree,
             seconds,
             stats,
             ..
         } = built;
-        let tree = refine::refine_owned(tree, &rp, ()).tree;
+        let tree = if method == Method::Fast {
+            refine::refine_fast(tree).tree
+        } else {
+            refine::refine_owned(tree, &RefineParams::default(), ()).tree
+        };
         let refine_seconds = t.elapsed().as_secs_f64();
         built = Built {
             method,

@@ -27,6 +27,14 @@ impl RecordOptions {
         {
             bail!("--refine-treelet must be 3 to 7 leaves, got {}", r.treelet);
         }
+        if let Some(r) = &self.refine
+            && (1..3).contains(&r.treelet_min)
+        {
+            bail!(
+                "--refine-treelet-min must be 0 (by the tree's size) or at least 3 leaves, got {}",
+                r.treelet_min
+            );
+        }
         Ok(())
     }
 }

@@ -26,18 +26,30 @@ use crate::grouping::{sah, sah_of_sums};
 use crate::par::{POOL_MIN, on_pool};
 use work::WorkTree;
 
-/// The fast path's refinement (`--fast`, bench method `fast`), after the partitioned grouping
-/// with [`Chunking::FAST`](crate::grouping::partitioned::Chunking::FAST): the default's
-/// reinsertion passes without its treelet pass. Pass k searches a fixed share of the nodes, so
-/// the work stays proportional to the tree's size; the treelet pass cost about as much again
-/// and, on the fast path's trees, raised the node tests per query of some scenes (a CAD chair,
-/// lamps) while lowering their SAH; two passes saved about 3 % of the fast path's time and left
-/// one more of 37 scenes above the best peer's SAH.
+/// The fast path's refinement (`--fast`, bench method `fast`) from [`FAST_SMALL`] leaves up,
+/// after the partitioned grouping with
+/// [`Chunking::FAST`](crate::grouping::partitioned::Chunking::FAST): one pass of small
+/// treelets low in the tree, then two reinsertion passes. The split leaves
+/// its lowest levels as binned cuts made without regard to their neighbours; treelets of 5
+/// leaves at every node of at least 8 rebuild them optimally, which the reinsertion's
+/// candidates (children of large, inefficient parents) seldom reach. Against three reinsertion
+/// passes alone, on 69 real meshes (with [`FAST_SMALL_PARAMS`] below 1,024 primitives): the
+/// point and distance queries at or below the best peer's on 53 instead of 44, the contact
+/// queries on 53 instead of 44, SAH on 67 for both, in 1.14–1.17× the time from 1,024 primitives up
+/// (median; `docs/benchmarks.md`, "The fast path on 69 meshes" and "The fast path: variants
+/// measured and not kept"). Pass k of the reinsertion searches a fixed share of the nodes, so
+/// the work stays proportional to the tree's size.
+///
+/// Treelets of 7 leaves rooted at every node of at least 8 gave the best trees measured (the
+/// point and distance queries at or below the best peer's on 57 of 69) in about twice the
+/// refinement's time; those of 4 leaves, or rooted only from 16 or 32 leaves, gave less than
+/// 5 leaves from 8.
 pub const FAST: RefineParams = RefineParams {
-    passes: 3,
+    passes: 2,
     batch: 0.1,
-    treelet: 7,
-    treelet_passes: 0,
+    treelet: 5,
+    treelet_passes: 1,
+    treelet_min: 8,
 };
 
 /// Trees of at least this many leaves take [`FAST_LARGE_BATCH`] in [`fast_for`] (2^14).
@@ -49,10 +61,25 @@ pub const FAST_LARGE: usize = 1 << 14;
 /// refinement's time; below 10^4 it left six of 40 above the best peer's SAH (up to 1.3 %).
 pub const FAST_LARGE_BATCH: f64 = 0.07;
 
+/// Trees of fewer leaves than this take [`FAST_SMALL_PARAMS`] in [`fast_for`] (2^10).
+pub const FAST_SMALL: usize = 1 << 10;
+
+/// The fast path's refinement below [`FAST_SMALL`] leaves: three reinsertion passes and no
+/// treelet pass. There PLOC builds a tree in tens of microseconds and the treelet pass cost
+/// 0.2–0.6× of it (the 200-triangle `franka-link0` went from 1.73× to 2.26–2.33× PLOC's time).
+pub const FAST_SMALL_PARAMS: RefineParams = RefineParams {
+    passes: 3,
+    treelet_passes: 0,
+    ..FAST
+};
+
 /// The fast path's refinement for a tree of `n` leaves: [`FAST`], with a first batch of
-/// [`FAST_LARGE_BATCH`] from [`FAST_LARGE`] leaves up.
+/// [`FAST_LARGE_BATCH`] from [`FAST_LARGE`] leaves up, or [`FAST_SMALL_PARAMS`] below
+/// [`FAST_SMALL`] ([`refine_fast`]).
 pub fn fast_for(n: usize) -> RefineParams {
-    if n >= FAST_LARGE {
+    if n < FAST_SMALL {
+        FAST_SMALL_PARAMS
+    } else if n >= FAST_LARGE {
         RefineParams {
             batch: FAST_LARGE_BATCH,
             ..FAST
@@ -68,8 +95,8 @@ pub fn fast_for(n: usize) -> RefineParams {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Tuning {
     /// Treelets are rooted only at nodes whose subtree has at least this many leaves (Karras
-    /// and Aila's γ); 3 = every node that has more than one shape; 0 (the default) = by the
-    /// tree's size, [`Tuning::gamma`].
+    /// and Aila's γ), over [`RefineParams::treelet_min`]; 3 = every node that has more than one
+    /// shape; 0 (the default) = the parameters' γ ([`Tuning::gamma`]).
     pub treelet_min: u32,
     /// Treelets are rooted only at every `treelet_every`-th height from the bottom (heights 2,
     /// 2 + e, 2 + 2e, …; 1 = every height).
@@ -91,13 +118,17 @@ impl Default for Tuning {
 }
 
 impl Tuning {
-    /// γ for a tree of `n` leaves: `treelet_min` if set, else the size rule: 64 up to 65,536
+    /// γ for a tree of `n` leaves under `params`: `treelet_min` here if set, else the
+    /// parameters' ([`RefineParams::treelet_min`]) if set, else the size rule: 64 up to 65,536
     /// leaves (about 1/32 of the interior nodes, since treelets at every node cost several PLOC
     /// builds), above that `n` rounded up to a power of two, over 1,024 (128 at 10^5, 1,024 at
     /// 10^6), where the larger γ gives the same SAH in less time (`docs/benchmarks.md`).
-    pub fn gamma(&self, n: usize) -> u32 {
+    pub fn gamma(&self, params: &RefineParams, n: usize) -> u32 {
         if self.treelet_min > 0 {
             return self.treelet_min;
+        }
+        if params.treelet_min > 0 {
+            return params.treelet_min;
         }
         (n.checked_next_power_of_two().unwrap_or(1 << 40) / 1024).clamp(64, 1 << 30) as u32
     }
@@ -146,6 +177,13 @@ pub fn refine<O: Observer>(tree: &SubsetTree, params: &RefineParams, observer: O
 /// fast path's refinement time). The same steps, events and result.
 pub fn refine_owned<O: Observer>(tree: SubsetTree, params: &RefineParams, observer: O) -> Refined {
     refine_tuned_owned(tree, params, &Tuning::default(), observer)
+}
+
+/// The fast path's refinement of `tree` ([`fast_for`] its size), taking it by value as
+/// [`refine_owned`] does; nothing is reported.
+pub fn refine_fast(tree: SubsetTree) -> Refined {
+    let params = fast_for(tree.leaves());
+    refine_owned(tree, &params, ())
 }
 
 /// [`refine`] with other [`Tuning`] than the default.
@@ -224,7 +262,7 @@ fn refine_here<O: Observer>(
     let treelets = |run: &mut Run<'_, O>, passes: &mut u32| {
         for _ in 0..params.treelet_passes {
             *passes += 1;
-            if run.treelet_pass(*passes - 1, params.treelet as usize, tuning) == 0 {
+            if run.treelet_pass(*passes - 1, params, tuning) == 0 {
                 break;
             }
         }
@@ -293,10 +331,11 @@ impl<O: Observer> Run<'_, O> {
 
     /// One treelet pass ([`treelet`]): every height's treelets solved on the frozen tree, then
     /// applied in root order. Returns the treelets rebuilt.
-    fn treelet_pass(&mut self, pass: u32, k: usize, tuning: &Tuning) -> u32 {
+    fn treelet_pass(&mut self, pass: u32, params: &RefineParams, tuning: &Tuning) -> u32 {
         let mut kept = 0;
+        let k = params.treelet as usize;
         let every = tuning.treelet_every.max(1) as usize;
-        let levels = treelet::by_height(&self.w, tuning.gamma(self.w.n as usize));
+        let levels = treelet::by_height(&self.w, tuning.gamma(params, self.w.n as usize));
         for roots in levels.into_iter().step_by(every) {
             for plan in treelet::solve_all(&self.w, &roots, k, self.min_gain) {
                 let sah_before = self.sah();

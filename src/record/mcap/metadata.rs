@@ -88,8 +88,10 @@ pub const COVER_KEYS: &[&str] = &[
 
 /// Keys the `wraptree` record adds when the tree was refined (`record --refine`): `refine` =
 /// `treelet+reinsert` (the method; `reinsert` in recordings without treelet passes), its
-/// `refine_passes`, `refine_batch`, `refine_treelet` and `refine_treelet_passes` (what
-/// `replay --verify` re-runs), the moves kept (`refine_steps`) and the SAH before and after. `depth_max` and
+/// `refine_passes`, `refine_batch`, `refine_treelet`, `refine_treelet_passes` and
+/// `refine_treelet_min` (what `replay --verify` re-runs; a recording without the last roots its
+/// treelets by the tree's size, 0), the moves kept (`refine_steps`) and the SAH before and
+/// after. `depth_max` and
 /// `depth_mean` and the levels are then the refined tree's.
 pub const REFINE_KEYS: &[&str] = &[
     "refine",
@@ -97,6 +99,7 @@ pub const REFINE_KEYS: &[&str] = &[
     "refine_batch",
     "refine_treelet",
     "refine_treelet_passes",
+    "refine_treelet_min",
     "refine_steps",
     "refine_sah_before",
     "refine_sah_after",
@@ -123,6 +126,7 @@ pub fn put_refine(m: &mut BTreeMap<String, String>, r: &RefineSummary) {
         ("refine_batch", r.params.batch.to_string()),
         ("refine_treelet", r.params.treelet.to_string()),
         ("refine_treelet_passes", r.params.treelet_passes.to_string()),
+        ("refine_treelet_min", r.params.treelet_min.to_string()),
         ("refine_steps", r.steps.to_string()),
         ("refine_sah_before", r.sah_before.to_string()),
         ("refine_sah_after", r.sah_after.to_string()),
@@ -148,6 +152,11 @@ pub fn refine(m: &BTreeMap<String, String>) -> Result<Option<RefineSummary>> {
                 },
                 treelet_passes: if treelets {
                     parse(m, "refine_treelet_passes")?
+                } else {
+                    0
+                },
+                treelet_min: if m.contains_key("refine_treelet_min") {
+                    parse(m, "refine_treelet_min")?
                 } else {
                     0
                 },
