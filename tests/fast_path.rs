@@ -165,12 +165,7 @@ fn record_with_the_fast_paths_refinement_flags_gives_the_bench_tree_and_replays(
         "-o",
         p,
     ];
-    let out = wraptree(&args, dir.path());
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::printed(&args, dir.path());
     let mcap = format!("{p}.mcap");
     let rec = wraptree::record::mcap::read_recording(std::path::Path::new(&mcap)).unwrap();
     let r = rec.refine.expect("the metadata names the refinement");
