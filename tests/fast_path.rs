@@ -142,7 +142,7 @@ fn below_2_10_primitives_the_bench_method_refines_without_its_treelet_pass() {
 }
 
 #[test]
-fn record_with_the_fast_paths_refinement_flags_gives_the_bench_tree_and_replays() {
+fn record_fast_refine_gives_the_bench_tree_and_replays() {
     use wraptree::refine::{fast_for, refine};
     let dir = tempfile::tempdir().unwrap();
     let bunny = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/stanford-bunny.obj");
@@ -153,12 +153,6 @@ fn record_with_the_fast_paths_refinement_flags_gives_the_bench_tree_and_replays(
         bunny.to_str().unwrap(),
         "--fast",
         "--refine",
-        "--refine-passes",
-        "2",
-        "--refine-treelet",
-        "5",
-        "--refine-treelet-min",
-        "8",
         "--detail",
         "levels",
         "--reproducible",
@@ -183,9 +177,19 @@ fn record_with_the_fast_paths_refinement_flags_gives_the_bench_tree_and_replays(
         "{stdout}{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    // A treelet root below 3 leaves is refused in one line, before any work.
-    let mut bad = args;
-    bad[9] = "2";
+    // A flag given wins over the fast path's value...
+    let other = dir.path().join("three");
+    let mut three = args.to_vec();
+    three.truncate(args.len() - 1);
+    three.extend([other.to_str().unwrap(), "--refine-passes", "3"]);
+    common::printed(&three, dir.path());
+    let path = format!("{}.mcap", other.display());
+    let rec = wraptree::record::mcap::read_recording(std::path::Path::new(&path)).unwrap();
+    let r = rec.refine.expect("refined");
+    assert_eq!((r.params.passes, r.params.treelet_min), (3, 8));
+    // ...and a treelet root below 3 leaves is refused in one line, before any work.
+    let mut bad = args.to_vec();
+    bad.extend(["--refine-treelet-min", "2"]);
     let out = wraptree(&bad, dir.path());
     common::assert_one_line_error(&out, "--refine-treelet-min");
 }

@@ -186,9 +186,8 @@ pub struct GroupArgs {
     pub schedule: Schedule,
     /// The fast path: the partitioned schedule whose split is the tree below a root share of
     /// 16 (chunks of δ = 2; the --chunk-* flags still apply), after merging neighbours with
-    /// identical boxes; with `record`, `--refine --refine-passes 2 --refine-treelet 5
-    /// --refine-treelet-min 8` adds its refinement from 1,024 primitives up (and
-    /// `--refine-batch 0.07` from 16,384), `--refine --refine-treelet-passes 0` below.
+    /// identical boxes; with `record`, `--refine` adds its refinement (the bench method
+    /// `fast`'s, for the scene's size).
     #[arg(long, conflicts_with = "schedule")]
     pub fast: bool,
     /// Components grouped on their own first: none, objects (the file's o/g), connected

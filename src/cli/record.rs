@@ -14,7 +14,7 @@ use wraptree::output::output_prefix;
 use wraptree::record::live::{self, Live, LiveOptions, RerunLive};
 use wraptree::record::mcap::Compression;
 use wraptree::record::{Detail, RecordOptions, Written, record};
-use wraptree::refine::RefineParams;
+use wraptree::refine::{self, RefineParams};
 use wraptree::scene::Scene;
 use wraptree::stop::Stop;
 use wraptree::wrap::WrapperKind;
@@ -63,29 +63,54 @@ pub struct RecordCmd {
     /// is less than half leaves; the .rrd always has every level).
     #[arg(long)]
     all_levels: bool,
+    #[command(flatten)]
+    refine: RefineArgs,
+    #[command(flatten)]
+    live: LiveArgs,
+}
+
+/// The refinement of a recorded run (`record --refine`).
+#[derive(Args, Debug, Clone, Copy)]
+pub struct RefineArgs {
     /// Refine the finished tree (treelet restructuring, then reinsertion, see docs/method.md)
     /// and record each step on the `refine` timeline / `/refine/step` topic; the levels are then
     /// the refined tree's.
     #[arg(long)]
-    refine: bool,
-    /// Most refinement passes (with --refine).
-    #[arg(long, default_value_t = RefineParams::default().passes, requires = "refine")]
-    refine_passes: u32,
-    /// Fraction of the nodes searched in the first refinement pass, in (0, 1] (with --refine).
-    #[arg(long, default_value_t = RefineParams::default().batch, requires = "refine")]
-    refine_batch: f64,
-    /// Most leaves of a restructured treelet, 3 to 7 (with --refine).
-    #[arg(long, default_value_t = RefineParams::default().treelet, requires = "refine")]
-    refine_treelet: u32,
-    /// Treelet restructuring passes before the reinsertion passes (with --refine; 0 = none).
-    #[arg(long, default_value_t = RefineParams::default().treelet_passes, requires = "refine")]
-    refine_treelet_passes: u32,
+    pub refine: bool,
+    /// Most refinement passes (with --refine) [default: 3; with --fast, the fast path's
+    /// refinement for the scene's size: 2 from 1,024 primitives, 3 below].
+    #[arg(long, requires = "refine")]
+    refine_passes: Option<u32>,
+    /// Fraction of the nodes searched in the first refinement pass, in (0, 1] (with --refine)
+    /// [default: 0.1; with --fast, 0.07 from 16,384 primitives].
+    #[arg(long, requires = "refine")]
+    refine_batch: Option<f64>,
+    /// Most leaves of a restructured treelet, 3 to 7 (with --refine) [default: 7; with --fast,
+    /// 5].
+    #[arg(long, requires = "refine")]
+    refine_treelet: Option<u32>,
+    /// Treelet restructuring passes before the reinsertion passes (with --refine; 0 = none)
+    /// [default: 1; with --fast, 1 from 1,024 primitives, 0 below].
+    #[arg(long, requires = "refine")]
+    refine_treelet_passes: Option<u32>,
     /// Treelets are rooted only at nodes of at least this many leaves (with --refine; 0 = by
-    /// the tree's size: 64 up to 65,536 leaves, more above; the fast path's refinement uses 8).
-    #[arg(long, default_value_t = RefineParams::default().treelet_min, requires = "refine")]
-    refine_treelet_min: u32,
-    #[command(flatten)]
-    live: LiveArgs,
+    /// the tree's size: 64 up to 65,536 leaves, more above) [default: 0; with --fast, 8].
+    #[arg(long, requires = "refine")]
+    refine_treelet_min: Option<u32>,
+}
+
+impl RefineArgs {
+    /// The refinement's parameters with `--refine`: `base` with every refine flag given in its
+    /// place.
+    fn params(&self, base: RefineParams) -> Option<RefineParams> {
+        self.refine.then(|| RefineParams {
+            passes: self.refine_passes.unwrap_or(base.passes),
+            batch: self.refine_batch.unwrap_or(base.batch),
+            treelet: self.refine_treelet.unwrap_or(base.treelet),
+            treelet_passes: self.refine_treelet_passes.unwrap_or(base.treelet_passes),
+            treelet_min: self.refine_treelet_min.unwrap_or(base.treelet_min),
+        })
+    }
 }
 
 /// Watching the run live while the files are written (`record`, `replay --a/--b/--c`); see
@@ -206,6 +231,8 @@ impl RecordCmd {
         let stop = stop_flag();
         let limits = self.limits.limits()?;
         let limit = CoverLimit::from_flags(self.cover_tolerance, self.cover_budget);
+        let refine = self.refine;
+        let first_refine = refine.params(RefineParams::default());
         let mut opts = RecordOptions {
             detail: self.detail,
             force: self.force,
@@ -216,13 +243,8 @@ impl RecordCmd {
             cover: limit.map(|l| (l, self.cover_kinds)),
             all_levels: self.all_levels,
             mcap_compression: self.mcap_compression,
-            refine: self.refine.then_some(RefineParams {
-                passes: self.refine_passes,
-                batch: self.refine_batch,
-                treelet: self.refine_treelet,
-                treelet_passes: self.refine_treelet_passes,
-                treelet_min: self.refine_treelet_min,
-            }),
+            // Checked on the defaults first; the fast path's are set once the size is known.
+            refine: first_refine,
             live: Live::default(),
         };
         opts.check()?;
@@ -230,6 +252,10 @@ impl RecordCmd {
         let live = self.live.start(&stop)?;
         opts.live = live.clone();
         let loaded = self.scene.load()?;
+        if self.group.fast && refine.refine {
+            opts.refine = refine.params(refine::fast_for(loaded.scene.len()));
+            opts.check()?;
+        }
         let params = self.group.params()?.resolve(&loaded.scene);
         let prefix = output_prefix(self.output.as_deref(), &loaded.source.file_name, "")?;
         let progress = Progress::for_merges(loaded.scene.len() as u64);
