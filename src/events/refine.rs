@@ -40,23 +40,25 @@ impl Default for RefineParams {
 }
 
 impl RefineParams {
-    /// Checks that `batch` is in (0, 1]; the error names the parameter.
+    /// Checks `batch` (in (0, 1]), `treelet` (3 to [`MAX_TREELET_LEAVES`]) and `treelet_min`
+    /// (0, or at least 3); the error names the parameter as `record`'s flag does, without its
+    /// dashes (`refine-batch`, …).
     pub fn check(&self) -> Result<(), String> {
         if !(self.batch > 0.0 && self.batch <= 1.0) {
             return Err(format!(
-                "refine batch must be in (0, 1], got {}",
+                "refine-batch must be in (0, 1], got {}",
                 self.batch
             ));
         }
         if !(3..=MAX_TREELET_LEAVES as u32).contains(&self.treelet) {
             return Err(format!(
-                "refine treelet must be 3 to {} leaves, got {}",
+                "refine-treelet must be 3 to {} leaves, got {}",
                 MAX_TREELET_LEAVES, self.treelet
             ));
         }
-        if self.treelet_min != 0 && self.treelet_min < 3 {
+        if (1..3).contains(&self.treelet_min) {
             return Err(format!(
-                "refine treelet-min must be 0 (by the tree's size) or at least 3 leaves, got {}",
+                "refine-treelet-min must be 0 (by the tree's size) or at least 3 leaves, got {}",
                 self.treelet_min
             ));
         }

@@ -85,9 +85,18 @@ pub fn target_row(scene: &Scene, repeat: u32) -> Result<TargetRow> {
     Ok(target_rows(scene, repeat)?.0)
 }
 
-/// One measured build: best time (s), SAH, node tests per query and per contact query,
-/// depth and the tree.
-type Measured = (f64, f64, f64, f64, u32, peers::Built);
+/// One measured build: the fastest of the repeats, its SAH and its node tests per query and per
+/// contact query.
+struct Measured {
+    /// The build (its time is `built.seconds`).
+    built: peers::Built,
+    /// SAH of its tree.
+    sah: f64,
+    /// Node tests per query (AABB BVs, the standard workload).
+    tests: f64,
+    /// Node tests per contact query.
+    contact: f64,
+}
 
 /// The best of `repeat` builds of `m` on `scene` (at most 2 from 10^6 primitives), with its
 /// SAH and node tests per query and per contact query on `workload`, on the current rayon pool.
@@ -105,18 +114,14 @@ fn measure(m: Method, scene: &Scene, repeat: u32, workload: &Workload) -> Result
             best = Some(b);
         }
     }
-    let b = best.expect("ran at least once");
-    let q = query::measure(&b.tree, scene, Bv::Aabb, workload);
-    let tests = super::compare::query_values(&q)[6];
-    let contact = q.contact.bv_tests;
-    Ok((
-        b.seconds,
-        super::sah(&b.tree),
-        tests,
-        contact,
-        b.tree.depth_max(),
-        b,
-    ))
+    let built = best.expect("ran at least once");
+    let q = query::measure(&built.tree, scene, Bv::Aabb, workload);
+    Ok(Measured {
+        sah: super::sah(&built.tree),
+        tests: super::compare::query_values(&q)[6],
+        contact: q.contact.bv_tests,
+        built,
+    })
 }
 
 /// Grouping + refinement against the best peer on one scene.
@@ -182,29 +187,38 @@ pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, 
     let n = scene.len();
     let workload = Workload::standard(scene, 1);
     let run = |m: Method| measure(m, scene, repeat, &workload);
-    let (t, sah, qc, cc, depth, plain) = run(Method::Grouping)?;
-    let (tp, ..) = run(Method::ObvhsPloc)?;
-    let (tb, sah_b, qc_b, cc_b, _, _) = run(Method::ParryBinned)?;
-    let (_, sah_r, qc_r, cc_r, _, refined) = run(Method::GroupingRefine)?;
-    let (_, sah_o, qc_o, cc_o, ..) = run(Method::ObvhsPlocReinsert)?;
-    let (_, sah_pr, qc_pr, cc_pr, _, part_refined) = run(Method::GroupingPartitionedRefine)?;
+    let plain = run(Method::Grouping)?;
+    let tp = run(Method::ObvhsPloc)?.built.seconds;
+    let binned = run(Method::ParryBinned)?;
+    let refined = run(Method::GroupingRefine)?;
+    let reinserted = run(Method::ObvhsPlocReinsert)?;
+    let part_refined = run(Method::GroupingPartitionedRefine)?;
+    // The best of parry Binned and PLOC + reinsertion, per measure.
+    let best_sah = binned.sah.min(reinserted.sah);
+    let best_tests = binned.tests.min(reinserted.tests);
+    let best_contact = binned.contact.min(reinserted.contact);
     let refine = RefineRow {
         scene: scene.name.clone(),
-        refine_seconds: refined.refine_seconds,
-        total_seconds: refined.seconds,
-        refine_per_ploc: refined.refine_seconds / tp,
-        sah_per_best: sah_r / sah_b.min(sah_o),
-        query_per_best: qc_r / qc_b.min(qc_o),
-        contact_per_best: cc_r / cc_b.min(cc_o),
-        part_total_seconds: part_refined.seconds,
-        part_refine_per_ploc: part_refined.refine_seconds / tp,
-        part_sah_per_best: sah_pr / sah_b.min(sah_o),
-        part_query_per_best: qc_pr / qc_b.min(qc_o),
-        part_contact_per_best: cc_pr / cc_b.min(cc_o),
+        refine_seconds: refined.built.refine_seconds,
+        total_seconds: refined.built.seconds,
+        refine_per_ploc: refined.built.refine_seconds / tp,
+        sah_per_best: refined.sah / best_sah,
+        query_per_best: refined.tests / best_tests,
+        contact_per_best: refined.contact / best_contact,
+        part_total_seconds: part_refined.built.seconds,
+        part_refine_per_ploc: part_refined.built.refine_seconds / tp,
+        part_sah_per_best: part_refined.sah / best_sah,
+        part_query_per_best: part_refined.tests / best_tests,
+        part_contact_per_best: part_refined.contact / best_contact,
     };
+    let (t, sah, qc) = (plain.built.seconds, plain.sah, plain.tests);
     let volumes = n <= 50_000;
     let vol = |b: &peers::Built| super::level_volume(&b.tree, scene, 3);
-    let (box8, hull8) = if volumes { vol(&plain) } else { (1.0, 1.0) };
+    let (box8, hull8) = if volumes {
+        vol(&plain.built)
+    } else {
+        (1.0, 1.0)
+    };
     let mut sped_up = Vec::new();
     for m in [
         Method::GroupingPregroup,
@@ -215,9 +229,10 @@ pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, 
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()?;
-            let (tm, sah_m, qc_m, _, depth_m, built) = pool.install(|| run(m))?;
+            let sped = pool.install(|| run(m))?;
+            let tm = sped.built.seconds;
             let (bm, hm) = if volumes {
-                vol(&built)
+                vol(&sped.built)
             } else {
                 (f64::NAN, f64::NAN)
             };
@@ -228,9 +243,9 @@ pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, 
                 seconds: tm,
                 per_ploc: tm / tp,
                 per_grouping: tm / t,
-                sah_ratio: sah_m / sah,
-                query_ratio: qc_m / qc,
-                depth: depth_m,
+                sah_ratio: sped.sah / sah,
+                query_ratio: sped.tests / qc,
+                depth: sped.built.tree.depth_max(),
                 box8_ratio: bm / box8,
                 hull8_ratio: hm / hull8,
             });
@@ -241,11 +256,11 @@ pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, 
         n,
         group_seconds: t,
         ploc_seconds: tp,
-        binned_seconds: tb,
-        sah_ratio: sah / sah_b,
-        query_ratio: qc / qc_b,
-        contact_ratio: cc / cc_b,
-        depth,
+        binned_seconds: binned.built.seconds,
+        sah_ratio: sah / binned.sah,
+        query_ratio: qc / binned.tests,
+        contact_ratio: plain.contact / binned.contact,
+        depth: plain.built.tree.depth_max(),
         peak_rss_bytes: super::peak_rss_bytes(),
     };
     Ok((row, refine, sped_up))
