@@ -82,9 +82,18 @@ impl RefineColumns {
         self.tick.push(0);
         self.sah.push(sah);
         self.text_ticks.push(0);
+        let roots = match params.treelet_min {
+            0 => "roots by the tree's size".to_string(),
+            g => format!("roots of at least {g} leaves"),
+        };
+        let treelets = match params.treelet_passes {
+            0 => "no treelet pass".to_string(),
+            1 => format!("1 treelet pass ({} leaves, {roots})", params.treelet),
+            p => format!("{p} treelet passes ({} leaves, {roots})", params.treelet),
+        };
         self.text.push(format!(
-            "refinement: {} treelet passes ({} leaves), then up to {} reinsertion passes, first batch {} of the nodes; SAH {sah:.6}",
-            params.treelet_passes, params.treelet, params.passes, params.batch
+            "refinement: {treelets}, then up to {} reinsertion passes, first batch {} of the nodes; SAH {sah:.6}",
+            params.passes, params.batch
         ));
         Ok(())
     }
