@@ -147,8 +147,13 @@ fn tick(v: f64, log: bool) -> String {
         format!("{x:.0}")
     } else if a >= 1.0 {
         format!("{x:.2}")
+    } else if a == 0.0 {
+        "0".to_string()
     } else {
-        format!("{x:.3}")
+        // Three significant digits here too (0.00112, not 0.001), trailing zeros dropped.
+        let digits = (2.0 - a.log10().floor()) as usize;
+        let f = format!("{x:.digits$}");
+        f.trim_end_matches('0').trim_end_matches('.').to_string()
     }
 }
 
@@ -404,6 +409,11 @@ mod tests {
         assert_eq!(tick(2e6, false), "2e6");
         assert_eq!(tick(2.0, true), "100");
         assert_eq!(tick(0.0005, false), "5e-4");
+        // Log ticks a few per cent apart below 1 (build times of about a millisecond).
+        assert_eq!(tick(0.00112f64.log10(), true), "0.00112");
+        assert_eq!(tick(0.00125f64.log10(), true), "0.00125");
+        assert_eq!(tick(0.5, false), "0.5");
+        assert_eq!(tick(0.0, false), "0");
     }
 
     #[test]
