@@ -3,7 +3,8 @@
 //! rayon pool of the given size, with the refinement's share, and their SAH and node tests per
 //! query of the standard workload against the best of parry Binned, obvhs PLOC and PLOC +
 //! reinsertion (all queries, the point and distance queries alone, and the contact queries of
-//! the touching poses); with `LOOP=SECONDS` set
+//! the touching poses; then the point queries and the scene–copy distance queries apart, each
+//! against the best peer on that measure); with `LOOP=SECONDS` set
 //! it instead builds the first method on the first file over and over for that long (a target
 //! for `perf`).
 //!
@@ -86,6 +87,35 @@ fn build_varied(method: Method, scene: &Scene, params: &Params) -> Built {
     }
 }
 
+/// One build's time and its tree's measures (NaN where the trees are not measured): node tests
+/// per query of all queries, of the point and distance queries together (`far`), of the
+/// contact queries, of the point queries and of the scene–copy distance queries.
+#[derive(Clone, Copy)]
+struct Row {
+    seconds: f64,
+    refine: f64,
+    sah: f64,
+    tests: f64,
+    far: f64,
+    contact: f64,
+    point: f64,
+    distance: f64,
+}
+
+impl Row {
+    /// A row whose trees were not measured.
+    const UNMEASURED: Row = Row {
+        seconds: f64::NAN,
+        refine: f64::NAN,
+        sah: f64::NAN,
+        tests: f64::NAN,
+        far: f64::NAN,
+        contact: f64::NAN,
+        point: f64::NAN,
+        distance: f64::NAN,
+    };
+}
+
 fn main() -> anyhow::Result<()> {
     let mut threads = 1usize;
     let mut repeat = 5usize;
@@ -129,9 +159,9 @@ fn main() -> anyhow::Result<()> {
         return Ok(());
     }
     println!(
-        "| scene | N | PLOC ms | method | ms (refine) | / PLOC | SAH / best peer | node tests / best peer | without overlap queries | contact queries |"
+        "| scene | N | PLOC ms | method | ms (refine) | / PLOC | SAH / best peer | node tests / best peer | without overlap queries | contact queries | point queries | distance queries |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     let quality = env::<u32>("QUALITY") != Some(0);
     let peers: &[Method] = if quality {
         &[
@@ -176,20 +206,16 @@ fn main() -> anyhow::Result<()> {
         // Each fastest build's time, refinement share, SAH and node tests per query.
         let mirror = env::<u32>("MIRROR") == Some(1);
         let mut mirrored = Vec::new();
-        let mut measured = |b: Built| -> (f64, f64, f64, f64, f64, f64) {
+        let mut measured = |b: Built| -> Row {
             let Some(workload) = &workload else {
-                return (
-                    b.seconds,
-                    b.refine_seconds,
-                    f64::NAN,
-                    f64::NAN,
-                    f64::NAN,
-                    f64::NAN,
-                );
+                return Row {
+                    seconds: b.seconds,
+                    refine: b.refine_seconds,
+                    ..Row::UNMEASURED
+                };
             };
             let q = measure(&b.tree, &scene, Bv::Aabb, workload);
             let v = query_values(&q);
-            let contact = q.contact.bv_tests;
             let queries = (workload.points.len() + workload.poses_near.len()) as f64;
             let far = (v[0] * workload.points.len() as f64
                 + v[2] * workload.poses_near.len() as f64)
@@ -200,39 +226,50 @@ fn main() -> anyhow::Result<()> {
                 let w = query_values(&measure(&t, &scene, Bv::Aabb, workload));
                 mirrored.push((scene.name.clone(), b.method.name(), v[6], w[6], far));
             }
-            (
-                b.seconds,
-                b.refine_seconds,
-                sah(&b.tree),
-                v[6],
+            Row {
+                seconds: b.seconds,
+                refine: b.refine_seconds,
+                sah: sah(&b.tree),
+                tests: v[6],
                 far,
-                contact,
-            )
+                contact: q.contact.bv_tests,
+                point: v[0],
+                distance: v[2],
+            }
         };
-        let rows: Vec<_> = fastest
+        let rows: Vec<Row> = fastest
             .into_iter()
             .map(|b| measured(b.expect("at least one repeat")))
             .collect();
         let (peer, ours) = rows.split_at(peers.len());
-        let ploc = peer[ploc_slot].0;
-        let best_sah = peer.iter().map(|p| p.2).fold(f64::INFINITY, f64::min);
-        let best_tests = peer.iter().map(|p| p.3).fold(f64::INFINITY, f64::min);
-        let best_far = peer.iter().map(|p| p.4).fold(f64::INFINITY, f64::min);
-        let best_contact = peer.iter().map(|p| p.5).fold(f64::INFINITY, f64::min);
-        for (&m, &(s, r, q, t, f, c)) in methods.iter().zip(ours) {
+        let ploc = peer[ploc_slot].seconds;
+        let best = |f: fn(&Row) -> f64| peer.iter().map(f).fold(f64::INFINITY, f64::min);
+        let best = Row {
+            seconds: ploc,
+            refine: 0.0,
+            sah: best(|r| r.sah),
+            tests: best(|r| r.tests),
+            far: best(|r| r.far),
+            contact: best(|r| r.contact),
+            point: best(|r| r.point),
+            distance: best(|r| r.distance),
+        };
+        for (&m, r) in methods.iter().zip(ours) {
             println!(
-                "| {} | {} | {:.3} | {} | {:.3} ({:.3}) | {:.2} | {:.3} | {:.3} | {:.3} | {:.3} |",
+                "| {} | {} | {:.3} | {} | {:.3} ({:.3}) | {:.2} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} |",
                 scene.name,
                 scene.len(),
                 ploc * 1e3,
                 m.name(),
-                s * 1e3,
-                r * 1e3,
-                s / ploc,
-                q / best_sah,
-                t / best_tests,
-                f / best_far,
-                c / best_contact
+                r.seconds * 1e3,
+                r.refine * 1e3,
+                r.seconds / ploc,
+                r.sah / best.sah,
+                r.tests / best.tests,
+                r.far / best.far,
+                r.contact / best.contact,
+                r.point / best.point,
+                r.distance / best.distance
             );
         }
         mirrored_rows.append(&mut mirrored);
