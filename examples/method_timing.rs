@@ -245,14 +245,13 @@ fn main() -> anyhow::Result<()> {
         let ploc = peer[ploc_slot].seconds;
         let best = |f: fn(&Row) -> f64| peer.iter().map(f).fold(f64::INFINITY, f64::min);
         let best = Row {
-            seconds: ploc,
-            refine: 0.0,
             sah: best(|r| r.sah),
             tests: best(|r| r.tests),
             far: best(|r| r.far),
             contact: best(|r| r.contact),
             point: best(|r| r.point),
             distance: best(|r| r.distance),
+            ..Row::UNMEASURED
         };
         for (&m, r) in methods.iter().zip(ours) {
             println!(
