@@ -20,9 +20,8 @@
 //! and poses of the copy). `TOUCH=T` gives it `T` touching poses instead of 8: those of seed
 //! `S`, then of seeds `S + 1`, `S + 2`, … in turn.
 //!
-//! The fast path's settings can be varied through the environment: `TOP`, `SAH`, `EPS`, `MAX`,
-//! `NEAR` (its split: root share, SAH-cut size, ε, largest chunk, largest range built
-//! bottom-up), `PASSES`, `BATCH` (its reinsertion
+//! The fast path's settings can be varied through the environment: `TOP`, `SAH`, `EPS`, `MAX`
+//! (its split: root share, SAH-cut size, ε, largest chunk), `PASSES`, `BATCH` (its reinsertion
 //! passes), `TREELETS` (treelet passes before them), `TK` (a treelet's leaves) and `GAMMA` (the
 //! fewest leaves under a treelet root).
 //!
@@ -65,7 +64,6 @@ fn build_varied(method: Method, scene: &Scene, params: &Params) -> Built {
     p.mode.chunk_sah = env("SAH").unwrap_or(p.mode.chunk_sah);
     p.mode.chunk_epsilon = env("EPS").unwrap_or(p.mode.chunk_epsilon);
     p.mode.chunk_max = env("MAX").unwrap_or(p.mode.chunk_max);
-    p.mode.chunk_nearest = env("NEAR").unwrap_or(p.mode.chunk_nearest);
     let mut rp = refine::fast_for(scene.len());
     rp.passes = env("PASSES").unwrap_or(rp.passes);
     rp.batch = env("BATCH").unwrap_or(rp.batch);

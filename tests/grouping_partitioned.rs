@@ -625,29 +625,11 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
         "yes",
         "metadata has a bad `chunk_twins`: \"yes\"",
     );
-    // The lowest levels built bottom-up: none by default, ranges of up to 64 on the fast
-    // path; a recording without the key built none so.
-    assert_eq!(
-        rec.metadata.get("chunk_nearest").map(String::as_str),
-        Some("0")
-    );
-    assert_eq!(
-        rec_q.metadata.get("chunk_nearest").map(String::as_str),
-        Some("64")
-    );
-    assert_eq!(rec_q.params.mode.chunk_nearest, Chunking::FAST.nearest);
-    rejects(
-        "chunk_nearest",
-        "-1",
-        "metadata has a bad `chunk_nearest`: \"-1\"",
-    );
     let mut fast_old = rec_q.metadata.clone();
     fast_old.remove("chunk_few");
-    fast_old.remove("chunk_nearest");
     fast_old.remove("chunk_twins");
     let params = wraptree::record::mcap::metadata::params(&fast_old).unwrap();
     assert_eq!(params.mode.chunk_few, 0);
-    assert_eq!(params.mode.chunk_nearest, 0);
     assert!(!params.mode.chunk_twins);
     let out = wraptree(&["replay", "q.mcap", "--verify"], dir.path());
     let text = String::from_utf8_lossy(&out.stdout);

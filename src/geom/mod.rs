@@ -117,19 +117,6 @@ pub fn surface_area(e: &V3) -> f64 {
     2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
 }
 
-/// The lesser of `a` and `b`, `a` when `b` is NaN: one `minsd` or `minss` for floats
-/// (`f64::min` also checks `a`).
-#[inline(always)]
-pub fn lesser<T: PartialOrd>(a: T, b: T) -> T {
-    if b < a { b } else { a }
-}
-
-/// The greater of `a` and `b`, `a` when `b` is NaN.
-#[inline(always)]
-pub fn greater<T: PartialOrd>(a: T, b: T) -> T {
-    if b > a { b } else { a }
-}
-
 /// Surface area of `b` (0 for an empty box).
 pub fn area(b: &Aabb) -> f64 {
     let e = b.extents();

@@ -181,12 +181,6 @@ pub struct Mode {
     /// ([`Chunking::few`](crate::grouping::partitioned::Chunking::few)); 0 = the SAH sweep. The
     /// fast path sets 4.
     pub chunk_few: u32,
-    /// The partitioned schedule's lowest levels built bottom-up: ranges of more than
-    /// `chunk_few` up to this many primitives within the SAH cuts' ranges are built by PLOC's
-    /// nearest neighbours
-    /// ([`Chunking::nearest`](crate::grouping::partitioned::Chunking::nearest)); 0 = none. The
-    /// fast path sets 64.
-    pub chunk_nearest: u32,
     /// The partitioned schedule's twins: bodies with identical boxes side by side in the Morton
     /// order are merged in pairs before the split
     /// ([`Chunking::twins`](crate::grouping::partitioned::Chunking::twins)). The fast path
@@ -208,7 +202,6 @@ impl Default for Mode {
             chunk_sah: crate::grouping::partitioned::Chunking::DEFAULT.sah_below,
             chunk_max: crate::grouping::partitioned::Chunking::DEFAULT.chunk_max,
             chunk_few: crate::grouping::partitioned::Chunking::DEFAULT.few,
-            chunk_nearest: crate::grouping::partitioned::Chunking::DEFAULT.nearest,
             chunk_twins: crate::grouping::partitioned::Chunking::DEFAULT.twins,
         }
     }
@@ -227,7 +220,6 @@ impl Mode {
             chunk_epsilon: ch.epsilon,
             chunk_sah: ch.sah_below,
             chunk_few: ch.few,
-            chunk_nearest: ch.nearest,
             chunk_twins: ch.twins,
             ..self
         }

@@ -179,20 +179,15 @@ impl Method {
     /// The partitioned schedule's settings this method groups a scene of `n` primitives with
     /// under `params`, for the methods that run it (`grouping-partitioned` with `params`'
     /// chunks, `fast` with its own): `delta=… epsilon=… top=… sah=…`, as the `--chunk-*` flags
-    /// name them, and ` nearest=…` where ranges are built bottom-up (the fast path's), with δ as
-    /// the run uses it ([`Chunking::delta_for`](crate::grouping::partitioned::Chunking::delta_for)).
+    /// name them, with δ as the run uses it ([`Chunking::delta_for`](crate::grouping::partitioned::Chunking::delta_for)).
     pub fn chunking(self, params: &Params, n: usize) -> Option<String> {
         let mode = match self.base() {
             Method::GroupingPartitioned => params.mode,
             Method::GroupingFast => params.mode.fast(),
             _ => return None,
         };
-        let nearest = match mode.chunk_nearest {
-            0 => String::new(),
-            k => format!(" nearest={k}"),
-        };
         Some(format!(
-            "delta={} epsilon={} top={} sah={}{nearest}",
+            "delta={} epsilon={} top={} sah={}",
             crate::grouping::partitioned::Chunking::delta_for(mode.chunk_delta, n),
             mode.chunk_epsilon,
             mode.chunk_top,
@@ -403,7 +398,7 @@ mod tests {
             Some(d)
         );
         // The fast path keeps its own chunks whatever `params` say.
-        let f = "delta=2 epsilon=0.5 top=16 sah=256 nearest=64";
+        let f = "delta=2 epsilon=0.5 top=16 sah=256";
         assert_eq!(Method::Fast.chunking(&p, 10).as_deref(), Some(f));
         assert_eq!(
             Method::GroupingFast.chunking(&p, 1 << 20).as_deref(),

@@ -34,7 +34,6 @@ pub(crate) fn chunking_of(params: &ResolvedParams, n: usize) -> Chunking {
         chunk_max: params.mode.chunk_max,
         delta: Chunking::delta_for(params.mode.chunk_delta, n),
         few: params.mode.chunk_few,
-        nearest: params.mode.chunk_nearest,
         twins: params.mode.chunk_twins,
     }
 }

@@ -4,8 +4,7 @@
 //!
 //! The primitives are sorted by Morton code (`split`), neighbours with identical boxes are
 //! merged first where the chunking asks (`twins`), the sorted range is split into chunks
-//! (`plan`, with what each node keeps for its parent from `keep`; its lowest ranges cut by
-//! SAH or, on the fast path, by a tree built bottom-up: `split`, `bottom_up`), and each chunk and each
+//! (`plan`, with what each node keeps for its parent from `keep`), and each chunk and each
 //! node of the split groups its bodies with the paper's Cost and limits (`executor`): by brute
 //! force up to 64 bodies (`brute_force`, `all_pairs`), with the exact run's voxel hash and
 //! MPairs above (`voxel_step`). Merge steps are numbered in the split's post-order before any
@@ -15,7 +14,6 @@
 
 mod all_pairs;
 mod announce;
-mod bottom_up;
 mod brute_force;
 mod executor;
 mod group;

@@ -34,11 +34,6 @@ pub struct Chunking {
     /// chunks, try every partition for the best binary tree over their leaves instead of the
     /// SAH sweep (`split`); 0 = the sweep. Only δ = 2 (or `chunk_max` below 4) leaves such ranges to be cut.
     pub few: u32,
-    /// Ranges of more than [`Chunking::few`] up to this many primitives within the SAH cuts'
-    /// ranges are built bottom-up instead of cut (`bottom_up`): PLOC's nearest neighbours in
-    /// the range's order by the area of their union, mutual pairs merged until one cluster
-    /// is left, its cuts handed to the split; 0 = none. The fast path sets 64.
-    pub nearest: u32,
     /// Whether bodies with identical boxes that the Morton order puts side by side are merged
     /// in pairs before the split, and again while such pairs remain (`twins`): a mesh of
     /// double-sided faces is then split as one of half the size. The fast path sets it.
@@ -63,7 +58,6 @@ impl Chunking {
         sah_below: 256,
         chunk_max: 0,
         few: 0,
-        nearest: 0,
         twins: false,
     };
 
@@ -108,7 +102,6 @@ impl Chunking {
         top: 16,
         delta: 2,
         few: 4,
-        nearest: 64,
         twins: true,
         ..Chunking::DEFAULT
     };
@@ -116,17 +109,12 @@ impl Chunking {
     /// Whether a range of `size` primitives is a chunk: at most [`Chunking::chunk_max`] (δ
     /// when 0), and at least one.
     pub fn is_chunk(&self, size: u32) -> bool {
-        size <= self.largest_chunk()
-    }
-
-    /// The most primitives a chunk holds: [`Chunking::chunk_max`] (δ when 0), at least one.
-    pub fn largest_chunk(&self) -> u32 {
         let max = if self.chunk_max == 0 {
             self.delta
         } else {
             self.chunk_max
         };
-        max.max(1)
+        size <= max.max(1)
     }
 
     /// Whether a scene of `n` primitives is grouped as one subproblem, the exact schedule's
@@ -343,7 +331,7 @@ impl Planner<'_> {
     ) -> (u32, u32) {
         let size = codes.len() as u32;
         if self.sah(size) {
-            let mut zone = Zone::new(codes, leaves, &self.keep.chunking);
+            let mut zone = Zone::new(codes, leaves, self.keep.chunking.few);
             let planned = self.build_with(
                 &mut |start, len| zone.cut(start, len),
                 0,
@@ -506,7 +494,6 @@ pub(super) mod tests {
                 sah_below: 0,
                 chunk_max: 7,
                 few: 0,
-                nearest: 0,
                 twins: false,
             },
             // The fast path's split: ranges of 3 and 4 try every partition.

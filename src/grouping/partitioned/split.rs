@@ -1,9 +1,7 @@
 //! The order the split cuts (the Morton codes of the primitives' centres, [`morton_order`]) and
 //! where it cuts a range: at its highest differing Morton bit ([`morton_cut`]), or, in a range
 //! of at most [`Chunking::sah_below`](super::Chunking::sah_below) primitives, where the
-//! surface area heuristic puts the cut ([`Zone`]), down to the ranges of at most
-//! [`Chunking::nearest`](super::Chunking::nearest), which take the cuts of a tree built
-//! bottom-up over them (`bottom_up`).
+//! surface area heuristic puts the cut ([`Zone`]).
 //!
 //! A Morton cut is a fixed plane of the scene's grid, whatever lies there: it runs through
 //! clusters (a patch of a soup, the parts of one copy) as readily as between them, and each side
@@ -19,11 +17,9 @@
 //! each side stays in Morton order; a range without such a boundary (centres that span no
 //! length, or NaN) gets the Morton cut.
 
-use super::Chunking;
-use super::bottom_up::BottomUp;
 use super::subproblem::Body;
 use crate::geom::morton::spread_bits;
-use crate::geom::{Aabb, V3, greater, lesser, surface_area};
+use crate::geom::{Aabb, V3, surface_area};
 use crate::grouping::PAR_MIN_LEN;
 use crate::grouping::mpairs::order_bits;
 use rayon::prelude::*;
@@ -215,21 +211,24 @@ pub(super) struct Zone<'z> {
     side: Vec<u8>,
     /// Ranges of 3 up to this many primitives try every partition ([`Zone::few`]).
     few: usize,
-    /// Ranges of more than `skip` up to this many primitives are built bottom-up.
-    nearest: usize,
-    /// The larger of `few` and the largest chunk: ranges the bottom-up plans leave to `few`
-    /// or to the chunks.
-    skip: usize,
-    /// Cuts planned bottom-up, as (start, length, left side's length), the next last.
-    planned: Vec<(u32, u32, u32)>,
-    /// Scratch of the bottom-up plans.
-    bottom_up: BottomUp,
 }
 
 /// Surface area of the box `lo..hi`.
 #[inline]
 fn area(lo: &[f64; 3], hi: &[f64; 3]) -> f64 {
     surface_area(&V3::new(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]))
+}
+
+/// The lesser of `a` and `b`, `a` when `b` is NaN: one `minsd` (`f64::min` also checks `a`).
+#[inline(always)]
+fn lesser(a: f64, b: f64) -> f64 {
+    if b < a { b } else { a }
+}
+
+/// The greater of `a` and `b`, `a` when `b` is NaN.
+#[inline(always)]
+fn greater(a: f64, b: f64) -> f64 {
+    if b > a { b } else { a }
 }
 
 /// The bin of a centre at `x` bin widths from the low end: a NaN or negative `x` goes to bin
@@ -321,15 +320,9 @@ fn stable_split(
 
 impl<'z> Zone<'z> {
     /// A zone over `codes` and `leaves` (the same order, Morton-sorted), whose ranges of 3 up to
-    /// `chunking.few` primitives (at most [`FEW`]) try every partition and whose ranges of
-    /// more, up to `chunking.nearest`, are built bottom-up.
-    pub(super) fn new(
-        codes: &'z mut [(u64, u32)],
-        leaves: &'z mut [Body],
-        chunking: &Chunking,
-    ) -> Zone<'z> {
+    /// `few` primitives (at most [`FEW`]) try every partition.
+    pub(super) fn new(codes: &'z mut [(u64, u32)], leaves: &'z mut [Body], few: u32) -> Zone<'z> {
         let m = leaves.len();
-        let few = (chunking.few as usize).min(FEW);
         let cen: Vec<[f64; 3]> = leaves
             .iter()
             .map(|l| {
@@ -347,50 +340,14 @@ impl<'z> Zone<'z> {
             ord: [vec![0; m], vec![0; m], vec![0; m]],
             sorted: vec![false; m],
             side: vec![0; m],
-            few,
-            nearest: chunking.nearest as usize,
-            skip: few.max(chunking.largest_chunk() as usize),
-            planned: Vec::new(),
-            bottom_up: Default::default(),
+            few: (few as usize).min(FEW),
         }
-    }
-
-    /// Plans `start..start + len` bottom-up ([`BottomUp`]): reorders its positions depth
-    /// first and queues the cuts of the tree's nodes of more than `skip` primitives, which
-    /// the split asks for next, in pre-order.
-    fn plan_bottom_up(&mut self, start: usize, len: usize) {
-        let part = &self.perm[start..start + len];
-        let leaves = &*self.leaves;
-        self.bottom_up
-            .plan(part.iter().map(|&p| &leaves[p as usize].aabb), self.skip);
-        self.tmp.clear();
-        self.tmp.extend_from_slice(part);
-        let plan = &self.bottom_up;
-        for (d, &o) in self.perm[start..start + len].iter_mut().zip(&plan.order) {
-            *d = self.tmp[o as usize];
-        }
-        self.sorted[start..start + len].fill(false);
-        let queued = plan.cuts.iter().rev();
-        self.planned
-            .extend(queued.map(|&(at, n, nl)| (start as u32 + at, n, nl)));
     }
 
     /// Cuts `start..start + len` of the planned order (at least 2 long) and returns the left
-    /// side's length: as its bottom-up plan has it, if it lies in one; else at the SAH
-    /// boundary (module doc), each side in its order, or, when there is none, at the highest
-    /// differing Morton bit (the middle when every code is equal).
+    /// side's length: at the SAH boundary (module doc), each side in its order, or, when there
+    /// is none, at the highest differing Morton bit (the middle when every code is equal).
     pub(super) fn cut(&mut self, start: usize, len: usize) -> usize {
-        // Within a plan the split asks for its cuts in their order; it leaves the ranges of at
-        // most `skip` to `few`.
-        if len > self.skip {
-            if self.planned.is_empty() && len <= self.nearest {
-                self.plan_bottom_up(start, len);
-            }
-            if let Some((s, n, nl)) = self.planned.pop() {
-                debug_assert_eq!((s as usize, n as usize), (start, len));
-                return nl as usize;
-            }
-        }
         if let Some(nl) = self.sah(start, len) {
             return nl;
         }
@@ -697,11 +654,7 @@ mod tests {
     fn cut_once(mut leaves: Vec<Body>) -> (usize, Vec<(u64, u32)>, Vec<Body>) {
         let mut codes: Vec<(u64, u32)> =
             leaves.iter().map(|l| (u64::from(l.id) * 3, l.id)).collect();
-        let chunking = Chunking {
-            nearest: 0,
-            ..Chunking::FAST
-        };
-        let mut zone = Zone::new(&mut codes, &mut leaves, &chunking);
+        let mut zone = Zone::new(&mut codes, &mut leaves, FEW as u32);
         let nl = zone.cut(0, zone.perm.len());
         zone.apply();
         (nl, codes, leaves)
@@ -829,14 +782,9 @@ mod tests {
                 let boxes: Vec<Aabb> = leaves.iter().map(|l| l.aabb).collect();
                 // Σ interior area of the zone's tree over these leaves with `few`.
                 let tree = |few: u32| {
-                    let chunking = Chunking {
-                        few,
-                        nearest: 0,
-                        ..Chunking::FAST
-                    };
                     let mut l = leaves.clone();
                     let mut codes: Vec<(u64, u32)> = (0..m).map(|i| (u64::from(i), i)).collect();
-                    interior(&mut Zone::new(&mut codes, &mut l, &chunking), 0, m as usize)
+                    interior(&mut Zone::new(&mut codes, &mut l, few), 0, m as usize)
                 };
                 let (got, swept) = (tree(FEW as u32), tree(0));
                 let want = best_interior(&boxes);
@@ -859,54 +807,6 @@ mod tests {
         let mut ids: Vec<u32> = leaves.iter().map(|l| l.id).collect();
         ids.sort_unstable();
         assert_eq!(ids, (0..4).collect::<Vec<_>>());
-    }
-
-    #[test]
-    fn ranges_up_to_nearest_take_the_bottom_up_trees_cuts() {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(23);
-        for m in [5u32, 40, 64, 100] {
-            let leaves: Vec<Body> = (0..m)
-                .map(|i| {
-                    let c = [0; 3].map(|_| rng.random_range(0.0..10.0));
-                    leaf(i, c, rng.random_range(0.01..1.0))
-                })
-                .collect();
-            // The zone's nodes of more than 4 leaves, as the split asks for its cuts (ranges
-            // of 2 are chunks).
-            let mut l = leaves.clone();
-            let mut codes: Vec<(u64, u32)> = (0..m).map(|i| (u64::from(i), i)).collect();
-            let mut zone = Zone::new(&mut codes, &mut l, &Chunking::FAST);
-            fn walk(zone: &mut Zone<'_>, start: usize, len: usize, got: &mut Vec<Vec<u32>>) {
-                if len <= 2 {
-                    return;
-                }
-                let nl = zone.cut(start, len);
-                assert!(0 < nl && nl < len);
-                if len > 4 {
-                    let mut v = zone.perm[start..start + len].to_vec();
-                    v.sort_unstable();
-                    got.push(v);
-                }
-                walk(zone, start, nl, got);
-                walk(zone, start + nl, len - nl, got);
-            }
-            let mut got = Vec::new();
-            walk(&mut zone, 0, m as usize, &mut got);
-            assert!(zone.planned.is_empty());
-            // Up to 64 leaves, the bottom-up tree's own nodes; above, SAH cuts first.
-            let mut plan = BottomUp::default();
-            plan.plan(leaves.iter().map(|l| &l.aabb), 4);
-            let want: Vec<Vec<u32>> = plan
-                .cuts
-                .iter()
-                .map(|&(at, n, _)| {
-                    let mut v = plan.order[at as usize..(at + n) as usize].to_vec();
-                    v.sort_unstable();
-                    v
-                })
-                .collect();
-            assert_eq!(got == want, m <= 64, "{m} leaves");
-        }
     }
 
     #[test]

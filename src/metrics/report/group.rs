@@ -23,10 +23,9 @@ pub fn group_text(scene: &Scene, g: &Grouping, threads: usize, seconds: f64) -> 
             p.mode.chunk_delta,
             p.mode.chunk_epsilon,
             p.mode.chunk_top,
-            match (p.mode.chunk_sah, p.mode.chunk_nearest) {
-                (0, _) => "Morton cuts only".to_string(),
-                (n, 0) => format!("SAH cuts up to {n} primitives"),
-                (n, k) => format!("SAH cuts up to {n} primitives, built bottom-up up to {k}"),
+            match p.mode.chunk_sah {
+                0 => "Morton cuts only".to_string(),
+                n => format!("SAH cuts up to {n} primitives"),
             },
             if whole {
                 "; grouped whole, the exact schedule's tree: at most 1.5 × the root share"

@@ -62,12 +62,11 @@ pub const LOAD_KEYS: &[&str] = &["up"];
 /// Keys the `wraptree` record adds for the partitioned schedule ([`Chunking`]): its chunk size
 /// δ (4, or 2 on the fast path), the reduction function's ε (`--chunk-epsilon`), the root's
 /// share `top` (`--chunk-top`), the SAH cuts' range size (`--chunk-sah`), the largest chunk
-/// (0 = δ), the largest range cut by trying every partition (4 on the fast path, else 0), the
-/// largest range built bottom-up (64 on the fast path, else 0) and whether identical
-/// neighbours were merged first (`true` on the fast path), all read back by `replay` (a
-/// recording without `chunk_sah` was cut at Morton bits only, one without `chunk_max` into
-/// chunks of fewer than δ, one without `chunk_few` by sweeps, one without `chunk_nearest` with
-/// no range built bottom-up, one without `chunk_twins` merged no identical neighbours first).
+/// (0 = δ), the largest range cut by trying every partition (4 on the fast path, else 0) and
+/// whether identical neighbours were merged first (`true` on the fast path), all read back by
+/// `replay` (a recording without `chunk_sah` was cut at Morton bits only, one without
+/// `chunk_max` into chunks of fewer than δ, one without `chunk_few` by sweeps, one without
+/// `chunk_twins` merged no identical neighbours first).
 pub const PARTITIONED_KEYS: &[&str] = &[
     "chunk_delta",
     "chunk_epsilon",
@@ -75,7 +74,6 @@ pub const PARTITIONED_KEYS: &[&str] = &[
     "chunk_sah",
     "chunk_max",
     "chunk_few",
-    "chunk_nearest",
     "chunk_twins",
 ];
 
@@ -228,7 +226,6 @@ pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String,
         put("chunk_sah", p.mode.chunk_sah.to_string());
         put("chunk_max", p.mode.chunk_max.to_string());
         put("chunk_few", p.mode.chunk_few.to_string());
-        put("chunk_nearest", p.mode.chunk_nearest.to_string());
         put("chunk_twins", p.mode.chunk_twins.to_string());
     }
     put("detail", value_name(&info.detail));
@@ -369,11 +366,6 @@ fn mode(m: &BTreeMap<String, String>) -> Result<Mode> {
         // A recording without `chunk_few` cut every range by the SAH sweep.
         chunk_few: match m.contains_key("chunk_few") {
             true => parse(m, "chunk_few")?,
-            false => 0,
-        },
-        // A recording without `chunk_nearest` built no range bottom-up.
-        chunk_nearest: match m.contains_key("chunk_nearest") {
-            true => parse(m, "chunk_nearest")?,
             false => 0,
         },
         // A recording without `chunk_twins` merged no identical neighbours first.
