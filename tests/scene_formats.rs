@@ -361,6 +361,56 @@ fn line_continuations_join_statements() {
 }
 
 /// Runs `wraptree ARGS` in `dir`; its exit code and stderr.
+#[test]
+fn an_off_file_loads_as_the_same_mesh_as_its_obj() {
+    // The bundled lamp (quads and polygons) written as OFF: its vertices, then each face's
+    // vertex count and indices from 0.
+    let obj = std::fs::read_to_string(repo("scenes/lamp.obj")).unwrap();
+    let (mut verts, mut faces) = (Vec::new(), Vec::new());
+    for line in obj.lines() {
+        let mut w = line.split_whitespace();
+        match w.next() {
+            Some("v") => verts.push(w.take(3).collect::<Vec<_>>().join(" ")),
+            Some("f") => {
+                let idx: Vec<String> = w
+                    .map(|t| {
+                        let i: usize = t.split('/').next().unwrap().parse().unwrap();
+                        (i - 1).to_string()
+                    })
+                    .collect();
+                faces.push(format!("{} {}", idx.len(), idx.join(" ")));
+            }
+            _ => {}
+        }
+    }
+    let off = format!(
+        "OFF\n# the lamp\n{} {} 0\n{}\n{}\n",
+        verts.len(),
+        faces.len(),
+        verts.join("\n"),
+        faces.join("\n")
+    );
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("lamp.off"), &off).unwrap();
+    let a = load_path(&repo("scenes/lamp.obj"), &Z_UP).unwrap();
+    let b = load_path(&tmp.path().join("lamp.off"), &Z_UP).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(b.scene.len(), a.scene.len());
+    assert_eq!(b.scene.tris.len(), a.scene.tris.len());
+    let (ba, bb) = (a.scene.aabb(), b.scene.aabb());
+    assert_box("lamp.off", &bb, ba.min.into(), ba.max.into(), 0.0);
+    // The command line reads it by its extension, and a truncated one is one error line.
+    let (code, err) = run(&["group", "lamp.off"], tmp.path());
+    assert_eq!(code, 0, "{err}");
+    std::fs::write(tmp.path().join("cut.off"), &off[..off.len() / 2]).unwrap();
+    let (code, err) = run(&["group", "cut.off"], tmp.path());
+    assert_eq!(code, 1, "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("error: cut.off: not a valid OFF file ("),
+        "{err}"
+    );
+}
+
 fn run(args: &[&str], dir: &Path) -> (i32, String) {
     let out = common::wraptree(args, dir);
     (

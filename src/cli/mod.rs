@@ -79,7 +79,7 @@ enum Command {
 /// How to read a scene file.
 #[derive(Args, Debug, Clone)]
 pub struct SceneArgs {
-    /// Scene file: Wavefront OBJ, STL, PLY, glTF/GLB or URDF (by its extension).
+    /// Scene file: Wavefront OBJ, STL, PLY, OFF, glTF/GLB or URDF (by its extension).
     pub scene: PathBuf,
     /// Treat each object (OBJ o/g, STL solid, glTF node, URDF link) as one convex polyhedron
     /// (default: each face is a polygon).

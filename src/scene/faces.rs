@@ -1,5 +1,6 @@
-//! Faces read from a mesh file (STL, PLY, glTF, a URDF's meshes and shapes) and how they become
-//! a [`Scene`]: the rules OBJ files follow ([`super::obj::polygon`], [`super::obj::polyhedron`]).
+//! Faces read from a mesh file (STL, PLY, OFF, glTF, a URDF's meshes and shapes) and how they
+//! become a [`Scene`]: the rules OBJ files follow ([`super::obj::polygon`],
+//! [`super::obj::polyhedron`]).
 //!
 //! [`build`] checks every coordinate (finite, within ±[`MAX_COORDINATE`]), turns the scene so
 //! that the file's up axis is +Z, merges vertices with bit-identical positions (in order of first

@@ -4,6 +4,7 @@
 //! |---|---|---|
 //! | `.stl` | STL, binary or ASCII (one object per `solid`) | [`super::stl`] (`stl_io`) |
 //! | `.ply` | PLY, ASCII or binary, faces of any size | [`super::ply`] (`ply-rs-bw`) |
+//! | `.off` | OFF, ASCII, faces of any size | [`super::off`] (read here: `f64` coordinates) |
 //! | `.gltf`, `.glb` | glTF 2.0: the default scene's triangle meshes, node transforms applied | [`super::gltf`] (`gltf`) |
 //! | `.urdf` | a robot: each link's meshes and shapes placed by its joints | [`super::urdf`] (`urdf-rs`) |
 //! | `.dae`, `.xacro` | refused with a one-line error saying what to do | |
@@ -27,7 +28,7 @@ use sha2::{Digest, Sha256};
 
 use super::faces::Faces;
 use super::urdf::UrdfOptions;
-use super::{Scene, export, gltf, obj, ply, stl, urdf};
+use super::{Scene, export, gltf, obj, off, ply, stl, urdf};
 
 /// Which axis of a file points up. The loader turns the scene so that it is +Z, the up axis
 /// of the recordings and snapshots.
@@ -156,6 +157,8 @@ pub enum Format {
     Stl,
     /// PLY, ASCII or binary.
     Ply,
+    /// OFF (Object File Format), ASCII.
+    Off,
     /// glTF 2.0 JSON (`.gltf`).
     Gltf,
     /// glTF 2.0 binary (`.glb`).
@@ -175,6 +178,7 @@ impl Format {
         Ok(match ext.as_str() {
             "stl" => Format::Stl,
             "ply" => Format::Ply,
+            "off" => Format::Off,
             "gltf" => Format::Gltf,
             "glb" => Format::Glb,
             "urdf" => Format::Urdf,
@@ -195,7 +199,7 @@ impl Format {
     }
 
     /// The up axis the format defines: Y for glTF (its specification), Z for URDF (ROS) and for
-    /// OBJ, STL and PLY, which define none (files made for robotics and CAD are Z-up).
+    /// OBJ, STL, PLY and OFF, which define none (files made for robotics and CAD are Z-up).
     pub fn default_up(self) -> Up {
         match self {
             Format::Gltf | Format::Glb => Up::Y,
@@ -211,7 +215,7 @@ impl Format {
             .map(|e| e.to_string_lossy().to_ascii_lowercase());
         matches!(
             ext.as_deref(),
-            Some("obj" | "stl" | "ply" | "gltf" | "glb" | "urdf" | "dae" | "xacro")
+            Some("obj" | "stl" | "ply" | "off" | "gltf" | "glb" | "urdf" | "dae" | "xacro")
         )
     }
 }
@@ -323,6 +327,7 @@ fn load_other(
         Format::Obj => return obj::load(file_name, bytes, opts),
         Format::Stl => (stl::read(file_name, &bytes)?, false, Vec::new()),
         Format::Ply => (ply::read(file_name, &bytes)?, false, Vec::new()),
+        Format::Off => (off::read(file_name, &bytes)?, false, Vec::new()),
         Format::Gltf | Format::Glb => {
             let read = gltf::read(file_name, &bytes, dir)?;
             (read.faces, read.external, read.warnings)
@@ -376,6 +381,7 @@ pub(super) fn mesh_faces(
         Format::Obj => (obj::read_faces(file_name, bytes)?, Vec::new()),
         Format::Stl => (stl::read(file_name, &bytes)?, Vec::new()),
         Format::Ply => (ply::read(file_name, &bytes)?, Vec::new()),
+        Format::Off => (off::read(file_name, &bytes)?, Vec::new()),
         Format::Gltf | Format::Glb => {
             let read = gltf::read(file_name, &bytes, dir)?;
             (read.faces, read.warnings)

@@ -6,7 +6,7 @@
 //! the hull's faces for a polyhedron).
 //!
 //! - [`load`] loads a scene file by its extension: [`obj`] Wavefront OBJ (via `tobj`), [`stl`],
-//!   [`ply`], [`gltf`] (glTF/GLB) and [`urdf`] (a robot's links placed by its joints), as
+//!   [`ply`], [`off`], [`gltf`] (glTF/GLB) and [`urdf`] (a robot's links placed by its joints), as
 //!   polygons or as polyhedra, with validation; `faces` holds the rules the non-OBJ formats
 //!   share and [`export`] the OBJ a multi-file input is embedded as in recordings;
 //! - [`generate`] makes the seeded synthetic scenes (robot base, lamp, replicas, soups);
@@ -23,6 +23,7 @@ pub mod generate;
 pub mod gltf;
 pub mod load;
 pub mod obj;
+pub mod off;
 pub mod pathological;
 pub mod ply;
 pub mod soup;

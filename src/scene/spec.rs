@@ -1,4 +1,4 @@
-//! Scenes named on a command line: a scene file (OBJ, STL, PLY, glTF, URDF), or a generated
+//! Scenes named on a command line: a scene file (OBJ, STL, PLY, OFF, glTF, URDF), or a generated
 //! scene as `KIND[:COUNT]`
 //! (`wraptree bench`, `sweep`).
 

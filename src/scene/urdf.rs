@@ -9,7 +9,7 @@
 //! joint follows its joint (multiplier × value + offset) unless given a value itself.
 //!
 //! **Geometry.** Each `<visual>` (or `<collision>`) is placed by the link's pose and its own
-//! `<origin>`. A `<mesh>` (STL, OBJ, PLY, glTF/GLB; COLLADA `.dae` is refused with one error
+//! `<origin>`. A `<mesh>` (STL, OBJ, PLY, OFF, glTF/GLB; COLLADA `.dae` is refused with one error
 //! line) is scaled by its `scale` first; its path is resolved as [`resolve`] says. Shapes are
 //! meshed ([`shapes`]): a box as 6 rectangles, a cylinder as [`shapes::SIDES`] rectangles and
 //! two [`shapes::SIDES`]-gons, a sphere as [`shapes::SLICES`] × [`shapes::STACKS`] polygons
