@@ -58,6 +58,11 @@ const URDF: &str = r#"<?xml version="1.0"?>
 </robot>
 "#;
 
+/// An OFF cube: comments, counts on the keyword's line, quads with colours after them.
+const OFF: &str = "# a cube\nCOFF 8 6 12\n0 0 0 1 0 0 1\n1 0 0 1 0 0 1\n1 1 0 1 0 0 1\n\
+0 1 0 1 0 0 1\n0 0 1 1 0 0 1\n1 0 1 1 0 0 1\n1 1 1 1 0 0 1\n0 1 1 1 0 0 1\n\
+4 0 3 2 1 255 0 0\n4 4 5 6 7\n4 0 1 5 4\n4 2 3 7 6 # side\n4 1 2 6 5\n4 3 0 4 7\n";
+
 /// Valid files to mutate, each with its name (which picks the reader).
 fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     vec![
@@ -65,6 +70,7 @@ fn seeds() -> Vec<(&'static str, Vec<u8>)> {
         ("seed.stl", data("multibody.stl")),
         ("seed.ply", data("mirror.ply")),
         ("seed.ply", data("cube_blender_uv.ply")),
+        ("seed.off", OFF.as_bytes().to_vec()),
         ("seed.glb", data("nested.glb")),
         ("seed.gltf", data("rgb_cube_with_primitives.gltf")),
         ("seed.urdf", URDF.as_bytes().to_vec()),
@@ -194,7 +200,7 @@ fn check_scene(s: &Scene) -> Result<(), TestCaseError> {
 }
 
 #[test]
-fn mutated_stl_ply_gltf_and_urdf_files_load_or_fail_with_one_line() {
+fn mutated_stl_ply_off_gltf_and_urdf_files_load_or_fail_with_one_line() {
     let seeds = seeds();
     for (name, bytes) in &seeds {
         load_bytes(name, bytes.clone(), &LoadOptions::default())
