@@ -169,6 +169,15 @@ pub(crate) struct Built {
     pub warnings: Vec<String>,
 }
 
+/// The stem of `file_name` (its name without directory or extension): what a scene or its
+/// one object is named after.
+pub(crate) fn stem(file_name: &str) -> String {
+    std::path::Path::new(file_name)
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
 /// Turns `faces` of the file `file_name` into a scene by the rules of the module docs.
 pub(crate) fn build(
     file_name: &str,
@@ -204,10 +213,7 @@ pub(crate) fn build(
         };
         return Err(err(LoadErrorKind::NoFaces, format!("no faces{why}")));
     }
-    let stem = std::path::Path::new(file_name)
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    let stem = stem(file_name);
     let mut scene = Scene::new(stem);
     let of_coord = weld(&faces.coords, &mut scene.points);
     let face_verts = |f: &[u32]| {

@@ -12,8 +12,6 @@
 //! coordinates are turned so that +Y becomes +Z (OBJ itself says nothing about up: Z is kept by
 //! default).
 
-use std::path::Path;
-
 use self::groups::{Group, INDEX_SPLIT, collect_groups};
 use self::pipe::Cleaned;
 use self::polygon::PolygonStats;
@@ -125,10 +123,7 @@ fn load_piped_from(
         problem,
     };
     let up = opts.up.unwrap_or(Format::Obj.default_up());
-    let stem = Path::new(file_name)
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    let stem = super::faces::stem(file_name);
     let mut scene = Scene::new(stem);
     let (groups, scanned) = parse(
         file_name,

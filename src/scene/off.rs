@@ -69,10 +69,7 @@ pub(crate) fn read(file_name: &str, bytes: &[u8]) -> Result<Faces, LoadError> {
             .map_err(|_| malformed(format!("line {at}: the {what} count {w:?} is not a count")))
     };
     let (nv, nf) = (count(0, "vertex")?, count(1, "face")?);
-    let stem = std::path::Path::new(file_name)
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    let stem = super::faces::stem(file_name);
     let mut faces = Faces::new();
     let object = faces.object(&stem);
     let truncated = |what: &str, got: usize| {
@@ -99,6 +96,7 @@ pub(crate) fn read(file_name: &str, bytes: &[u8]) -> Result<Faces, LoadError> {
             number(at, words[2])?,
         ]);
     }
+    let mut verts = Vec::new();
     for f in 0..nf {
         let (at, words) = lines.next().ok_or_else(|| truncated("faces", f))?;
         let k: usize = words[0].parse().map_err(|_| {
@@ -113,7 +111,7 @@ pub(crate) fn read(file_name: &str, bytes: &[u8]) -> Result<Faces, LoadError> {
                 words.len() - 1
             )));
         }
-        let mut verts = Vec::with_capacity(k);
+        verts.clear();
         for w in &words[1..=k] {
             let i: usize = w.parse().map_err(|_| {
                 malformed(format!("line {at}: the vertex index {w:?} is not an index"))
@@ -126,7 +124,7 @@ pub(crate) fn read(file_name: &str, bytes: &[u8]) -> Result<Faces, LoadError> {
             }
             verts.push(i as u32);
         }
-        faces.face(verts, object);
+        faces.face(verts.iter().copied(), object);
     }
     Ok(faces)
 }

@@ -217,10 +217,7 @@ pub(crate) fn read(file_name: &str, bytes: &[u8]) -> Result<Faces, LoadError> {
     if !has_faces {
         return Ok(faces);
     }
-    let stem = std::path::Path::new(file_name)
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    let stem = super::faces::stem(file_name);
     let object = faces.object(&stem);
     faces.coords = coords;
     let n = faces.coords.len();

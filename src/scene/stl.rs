@@ -24,10 +24,7 @@ pub(crate) fn read(file_name: &str, bytes: &[u8]) -> Result<Faces, LoadError> {
         kind,
         problem: format!("not a valid STL file ({what})"),
     };
-    let stem = std::path::Path::new(file_name)
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    let stem = super::faces::stem(file_name);
     let count = (bytes.len() >= HEADER)
         .then(|| u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize);
     let exact_binary = count.is_some_and(|n| {
