@@ -152,14 +152,48 @@ pub fn with_ext(prefix: &Path, ext: &str) -> PathBuf {
     PathBuf::from(s)
 }
 
-/// The output directory: `given` or `default`, created with its parents if missing.
-pub fn output_dir(given: Option<&Path>, default: &str) -> Result<PathBuf> {
-    let d = given.map_or_else(|| PathBuf::from(default), Path::to_path_buf);
-    if !d.is_dir() {
-        std::fs::create_dir_all(&d)
-            .with_context(|| format!("{}: cannot create the output directory", d.display()))?;
+/// An output directory, and the directories [`output_dir`] made for it: those are removed
+/// again when it is dropped while still empty (a command that failed or was stopped before
+/// writing leaves nothing behind).
+#[derive(Debug)]
+pub struct OutDir {
+    path: PathBuf,
+    /// The directories made, deepest first.
+    made: Vec<PathBuf>,
+}
+
+impl std::ops::Deref for OutDir {
+    type Target = Path;
+
+    fn deref(&self) -> &Path {
+        &self.path
     }
-    Ok(d)
+}
+
+impl Drop for OutDir {
+    fn drop(&mut self) {
+        for d in &self.made {
+            // Fails, and so keeps the directory, once anything was written into it.
+            if std::fs::remove_dir(d).is_err() {
+                break;
+            }
+        }
+    }
+}
+
+/// The output directory: `given` or `default`, created with its parents if missing.
+pub fn output_dir(given: Option<&Path>, default: &str) -> Result<OutDir> {
+    let path = given.map_or_else(|| PathBuf::from(default), Path::to_path_buf);
+    let made: Vec<PathBuf> = path
+        .ancestors()
+        .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
+        .map(Path::to_path_buf)
+        .collect();
+    if !path.is_dir() {
+        std::fs::create_dir_all(&path)
+            .with_context(|| format!("{}: cannot create the output directory", path.display()))?;
+    }
+    Ok(OutDir { path, made })
 }
 
 /// Checks, before the work that produces them, that the files `paths` may be written: none is

@@ -336,6 +336,45 @@ fn sweep_writes_every_setting_to_csv_heat_maps_and_one_rrd() {
     common::assert_one_line_error(&bad, "--a must be a finite number");
 }
 
+/// A command that fails after making its output directory takes away the directories it made
+/// (still empty) and leaves one that was there before, with its files.
+#[test]
+fn a_failed_sweep_leaves_no_output_directories_behind() {
+    let dir = tempfile::tempdir().unwrap();
+    let made = dir.path().join("new").join("out");
+    let o = made.to_str().unwrap();
+    // Every setting is left out at a 1 µs budget, which fails after the directory is made.
+    let args = [
+        "sweep",
+        "lamp",
+        "--a",
+        "1",
+        "--b",
+        "1",
+        "--c",
+        "0",
+        "--max-seconds",
+        "1e-6",
+    ];
+    let out = wraptree(&[&args[..], &["-o", o]].concat());
+    common::assert_one_line_error(&out, "every setting was left out");
+    assert!(!dir.path().join("new").exists(), "made directories removed");
+    let kept = dir.path().join("kept");
+    std::fs::create_dir(&kept).unwrap();
+    std::fs::write(kept.join("notes.txt"), "mine").unwrap();
+    let out = wraptree(&[&args[..], &["-o", kept.to_str().unwrap()]].concat());
+    common::assert_one_line_error(&out, "every setting was left out");
+    assert_eq!(
+        std::fs::read_to_string(kept.join("notes.txt")).unwrap(),
+        "mine"
+    );
+    let empty = dir.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    let out = wraptree(&[&args[..], &["-o", empty.to_str().unwrap()]].concat());
+    common::assert_one_line_error(&out, "every setting was left out");
+    assert!(empty.is_dir(), "a directory the user made stays");
+}
+
 #[test]
 fn peers_build_valid_trees_on_bundled_meshes_and_differ_in_quality() {
     let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
