@@ -240,8 +240,8 @@ pub fn draw(
     }
     names.push("figure".into());
     let cam = super::fit_camera(&frames, opts.azimuth, opts.elevation, opts.size);
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("{}: cannot create the directory", dir.display()))?;
+    // Taken away again, if still empty, when the snapshot fails or is stopped.
+    let _dir = crate::output::output_dir(Some(dir), "")?;
     let outs = pendings(dir, &names, opts.force)?;
     let kind = kinds
         .iter()
