@@ -181,7 +181,8 @@ impl Drop for OutDir {
     }
 }
 
-/// The output directory: `given` or `default`, created with its parents if missing.
+/// The output directory: `given` or `default`, created with its parents if missing; the
+/// [`OutDir`] takes away the directories made here if they are still empty when it is dropped.
 pub fn output_dir(given: Option<&Path>, default: &str) -> Result<OutDir> {
     let path = given.map_or_else(|| PathBuf::from(default), Path::to_path_buf);
     let made: Vec<PathBuf> = path
