@@ -105,7 +105,9 @@ pub(crate) fn read(file_name: &str, bytes: &[u8]) -> Result<Faces, LoadError> {
                 words[0]
             ))
         })?;
-        if words.len() < 1 + k {
+        // `words` holds the count itself, so `len() - 1` cannot underflow, where `1 + k` could
+        // overflow.
+        if words.len() - 1 < k {
             return Err(malformed(format!(
                 "line {at}: a face of {k} vertices lists {}",
                 words.len() - 1
@@ -245,6 +247,11 @@ mod tests {
                 "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4 0 1 2\n",
                 LoadErrorKind::Malformed,
                 "a face of 4 vertices lists 3",
+            ),
+            (
+                "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n18446744073709551615 0 1 2\n",
+                LoadErrorKind::Malformed,
+                "a face of 18446744073709551615 vertices lists 3",
             ),
             (
                 "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n",
