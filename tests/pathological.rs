@@ -409,8 +409,7 @@ fn stress_quick_writes_the_csv_and_the_chart() {
 }
 
 /// Sizes spanning 12 decades: node 862 here mixes points 1e-2 apart with a 6e5 extent, which
-/// collapse in parry's `f32`; its folded hull once left a vertex 1.2e4 outside while claiming
-/// `exact` (fixed by the `f64` convexity check and fallbacks of `geom::hull`).
+/// collapse in `f32`, where a hull once folded and left a vertex 1.2e4 outside.
 #[test]
 fn hull_wrappers_hold_their_vertices_across_12_decades() {
     let s = path::scales(500, 1);

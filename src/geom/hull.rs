@@ -1,21 +1,21 @@
 //! Convex hulls of point sets ([`hull_of`]), shared by the hull p-set of the grouping phase and
-//! the hull Wrapper Trees. Vertices are stored in `f64` and are always input points; parry
-//! (`f32`) only decides which points are on the hull.
+//! the hull Wrapper Trees. Vertices are always input points, in `f64`.
 //!
 //! Degenerate input is normal here (one polygon is flat; duplicates; collinear points), so the
-//! dimension is decided first in `f64`, and every solid from parry is checked in `f64`
-//! ([`is_convex_cover`]), with fallbacks when the check fails ([`hull_of`]). Nothing here
-//! panics.
+//! dimension is decided first, from the extents along the principal axes. Solids are built by
+//! Quickhull with exact orientation tests (`quickhull`), which gives a closed convex surface
+//! on any input, at any mix of scales, in time that grows with the points, not points × faces.
+//! Nothing here panics.
 
 use super::{P3, V3};
 use crate::geom::pca::Frame;
 use std::cmp::Ordering::Greater;
 use std::collections::HashMap;
 
-mod incremental;
+mod quickhull;
 
-/// Containment tolerance of hulls, relative to the node's AABB diameter: parry decides in
-/// `f32`, so a point it drops may lie outside the `f64` hull by about 1e-7 of the node's extent.
+/// Containment tolerance of hulls, relative to the node's AABB diameter. Hull faces are exact;
+/// this covers the rounding of the face planes that tests and the excess measure compute.
 pub const HULL_TOL_REL: f64 = 1e-5;
 /// Extents below this fraction of the largest extent count as zero (flat or collinear).
 pub const FLAT_REL: f64 = 1e-9;
@@ -30,8 +30,6 @@ pub struct Hull {
     pub triangles: Vec<[u32; 3]>,
     /// 0 point, 1 segment, 2 flat polygon, 3 solid.
     pub dim: u8,
-    /// False when parry failed and this is the principal-axes box of the points instead.
-    pub exact: bool,
 }
 
 impl Hull {
@@ -122,25 +120,21 @@ impl ExcessTest<'_> {
     }
 }
 
-/// The hull of `points`, and the points themselves when the hull is only a fallback box.
+/// The hull of `points`.
 ///
 /// The dimension is decided from the extents along the principal axes ([`Frame::principal`]):
 /// a point, a segment, a flat polygon (Andrew's monotone chain in the plane of best fit,
-/// fan-triangulated, one side), or a solid. A solid is parry's hull in a scaled principal frame,
-/// accepted only if [`is_convex_cover`] holds; else parry is retried with uniform scaling, then
-/// an incremental hull in `f64` (`incremental`) is built; if that fails too (ill-conditioned
-/// input), the result is the principal-axes box ([`Hull::exact`] is false): a correct but
-/// looser convex wrapper, and the caller builds the parent from the returned points.
-pub fn hull_of(mut points: Vec<P3>) -> (Hull, Option<Vec<P3>>) {
+/// fan-triangulated, one side), or a solid by exact Quickhull (`quickhull`). A set that is
+/// not flat by its extents yet lies exactly in one plane gets the flat hull.
+pub fn hull_of(mut points: Vec<P3>) -> Hull {
     dedup(&mut points);
     let one = |vertices: Vec<P3>, dim| Hull {
         vertices,
         triangles: Vec::new(),
         dim,
-        exact: true,
     };
     if points.len() <= 1 {
-        return (one(points, 0), None);
+        return one(points, 0);
     }
     let frame = Frame::principal(&points);
     let (lo, hi) = frame.bounds(&points);
@@ -153,24 +147,20 @@ pub fn hull_of(mut points: Vec<P3>) -> (Hull, Option<Vec<P3>>) {
         let lo = points.iter().min_by(|a, b| along(a).total_cmp(&along(b)));
         let hi = points.iter().max_by(|a, b| along(a).total_cmp(&along(b)));
         return match (lo, hi) {
-            (Some(a), Some(b)) => (one(vec![*a, *b], 1), None),
-            _ => (one(points, 0), None),
+            (Some(a), Some(b)) => one(vec![*a, *b], 1),
+            _ => one(points, 0),
         };
     }
     if ext[small].partial_cmp(&(FLAT_REL * ext[big])) != Some(Greater) {
-        return (flat_hull(&points, &frame, big, mid), None);
+        return flat_hull(&points, &frame, big, mid);
     }
-    // Parry's f32 quickhull can return a folded mesh on near-degenerate input (12-decade
-    // scenes, the 12,144-polygon scene): check it, and fall back as the doc comment says.
-    let tol = HULL_TOL_REL * ext.norm();
-    let valid = |h: Hull| is_convex_cover(&h, &points, tol).then_some(h);
-    let solid = solid_hull(&points, &frame, lo, hi, false)
-        .and_then(valid)
-        .or_else(|| solid_hull(&points, &frame, lo, hi, true).and_then(valid))
-        .or_else(|| exact_hull(&points, &frame, tol).and_then(valid));
-    match solid {
-        Some(h) => (h, None),
-        None => (box_hull(&frame, lo, hi), Some(points)),
+    match quickhull::hull(&points) {
+        Some((used, triangles)) => Hull {
+            vertices: used.iter().map(|&i| points[i]).collect(),
+            triangles,
+            dim: 3,
+        },
+        None => flat_hull(&points, &frame, big, mid),
     }
 }
 
@@ -201,20 +191,6 @@ pub fn is_convex_cover(h: &Hull, points: &[P3], tol: f64) -> bool {
             None => true,
         }
     })
-}
-
-/// The hull by [`incremental::hull`] in `f64`, on local coordinates (small numbers far from
-/// the scene origin); points within `tol / 4` of a face count as inside.
-fn exact_hull(points: &[P3], frame: &Frame, tol: f64) -> Option<Hull> {
-    let local: Vec<P3> = points.iter().map(|p| P3::from(frame.local(p))).collect();
-    let (used, triangles) = incremental::hull(&local, tol / 4.0)?;
-    let hull = Hull {
-        vertices: used.iter().map(|&i| points[i]).collect(),
-        triangles,
-        dim: 3,
-        exact: true,
-    };
-    (hull.volume() > 0.0).then_some(hull)
 }
 
 /// Removes exact duplicates (by bits), keeping the first of each.
@@ -258,7 +234,6 @@ fn flat_hull(points: &[P3], frame: &Frame, u: usize, v: usize) -> Hull {
             vertices: ends.to_vec(),
             triangles: Vec::new(),
             dim: 1,
-            exact: true,
         };
     }
     let triangles = (1..vertices.len() as u32 - 1)
@@ -268,89 +243,6 @@ fn flat_hull(points: &[P3], frame: &Frame, u: usize, v: usize) -> Hull {
         vertices,
         triangles,
         dim: 2,
-        exact: true,
-    }
-}
-
-/// The solid hull by parry in the principal frame, each axis scaled to [-1, 1] (or all by the
-/// largest extent when `uniform`); `None` if parry fails or panics.
-///
-/// The hull is affine-invariant, so the scaling makes thin sets well-conditioned. parry's
-/// `try_convex_hull` is guarded by `catch_unwind` (parry issue #49). Points that round to the
-/// same `f32` are given to parry once: `f32` keeps 24 bits, so a node whose sizes span many
-/// decades has distinct points closer than 6e-8 of its extent, and parry then returns a
-/// non-manifold, non-convex mesh.
-fn solid_hull(points: &[P3], frame: &Frame, lo: V3, hi: V3, uniform: bool) -> Option<Hull> {
-    let mid = (lo + hi) / 2.0;
-    let half = if uniform {
-        V3::repeat((hi - lo).max() / 2.0)
-    } else {
-        (hi - lo) / 2.0
-    };
-    // One parry point per distinct f32 value, remembering the first input point that gave it.
-    let mut index: HashMap<[u32; 3], usize> = HashMap::with_capacity(points.len());
-    let mut local: Vec<parry3d::math::Vector> = Vec::with_capacity(points.len());
-    for (i, p) in points.iter().enumerate() {
-        let q = (frame.local(p) - mid).component_div(&half);
-        let l = parry3d::math::Vector::new(q.x as f32, q.y as f32, q.z as f32);
-        if let std::collections::hash_map::Entry::Vacant(e) =
-            index.entry(l.to_array().map(f32::to_bits))
-        {
-            e.insert(i);
-            local.push(l);
-        }
-    }
-    let (hv, ht) = std::panic::catch_unwind(|| parry3d::transformation::try_convex_hull(&local))
-        .ok()?
-        .ok()?;
-    let vertices: Vec<P3> = hv
-        .iter()
-        .map(|l| {
-            index
-                .get(&l.to_array().map(f32::to_bits))
-                .map(|&i| points[i])
-        })
-        .collect::<Option<_>>()?;
-    if vertices.len() < 4 || ht.len() < 4 {
-        return None;
-    }
-    if ht.iter().flatten().any(|&i| i as usize >= vertices.len()) {
-        return None;
-    }
-    let c = P3::from(vertices.iter().map(|p| p.coords).sum::<V3>() / vertices.len() as f64);
-    let triangles = ht
-        .iter()
-        .map(|&[a, b, t]| {
-            let [pa, pb, pc] = [a, b, t].map(|i| vertices[i as usize]);
-            if (pb - pa).cross(&(pc - pa)).dot(&(pa - c)) < 0.0 {
-                [a, t, b]
-            } else {
-                [a, b, t]
-            }
-        })
-        .collect();
-    let hull = Hull {
-        vertices,
-        triangles,
-        dim: 3,
-        exact: true,
-    };
-    (hull.volume() > 0.0).then_some(hull)
-}
-
-/// The box of local bounds `lo..hi` in `frame`, as a hull (the fallback when parry fails).
-fn box_hull(frame: &Frame, lo: V3, hi: V3) -> Hull {
-    let vertices = (0..8)
-        .map(|k| {
-            let pick = |a: usize| if k >> a & 1 == 1 { hi[a] } else { lo[a] };
-            frame.world(&V3::new(pick(0), pick(1), pick(2)))
-        })
-        .collect();
-    Hull {
-        vertices,
-        triangles: BOX_TRIANGLES.to_vec(),
-        dim: 3,
-        exact: false,
     }
 }
 
@@ -396,8 +288,8 @@ mod tests {
     #[test]
     fn twelve_decade_node_gets_its_true_hull() {
         let pts: Vec<P3> = NODE_862.iter().map(|&c| P3::from(c)).collect();
-        let (h, support) = hull_of(pts.clone());
-        assert!(h.exact && support.is_none());
+        let h = hull_of(pts.clone());
+        assert_eq!(h.dim, 3);
         let tol = HULL_TOL_REL * 6.3e5;
         assert!(is_convex_cover(&h, &pts, tol));
         // A vertex of the scene 1.56e4 inside the true hull; the folded hull had it 1.2e4 out.
@@ -417,7 +309,6 @@ mod tests {
             vertices: pts.clone(),
             triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
             dim: 3,
-            exact: true,
         };
         assert!(is_convex_cover(&tet, &pts, 0.0));
         let outside = [P3::new(1.0, 1.0, 1.0)];
@@ -431,15 +322,58 @@ mod tests {
     }
 
     #[test]
-    fn incremental_hull_of_a_cube_with_inner_points() {
+    fn cube_with_inner_and_face_points_has_its_corners() {
         let mut pts: Vec<P3> = (0..8)
             .map(|k| P3::new((k & 1) as f64, (k >> 1 & 1) as f64, (k >> 2 & 1) as f64))
             .collect();
-        pts.extend([P3::new(0.5, 0.5, 0.5), P3::new(0.2, 0.7, 0.1)]);
-        let frame = Frame::principal(&pts);
-        let h = exact_hull(&pts, &frame, 1e-9).unwrap();
+        // Inner points, and points exactly on faces and edges: none may become a vertex.
+        pts.extend(
+            [
+                [0.5, 0.5, 0.5],
+                [0.2, 0.7, 0.1],
+                [0.5, 0.5, 1.0],
+                [0.0, 0.3, 0.0],
+            ]
+            .map(P3::from),
+        );
+        let h = hull_of(pts.clone());
         assert_eq!(h.vertices.len(), 8);
-        assert!(is_convex_cover(&h, &pts, 1e-9));
+        assert!(is_convex_cover(&h, &pts, 0.0));
         assert!((h.volume() - 1.0).abs() < 1e-12);
+    }
+
+    /// Points of a sphere of radius `r` about `c`, from a fixed sequence.
+    fn sphere(c: [f64; 3], r: f64, n: usize) -> Vec<P3> {
+        (0..n)
+            .map(|i| {
+                let t = (i as f64 + 0.5) / n as f64;
+                let (z, phi) = (1.0 - 2.0 * t, i as f64 * 2.399_963_229_728_653);
+                let s = (1.0 - z * z).sqrt();
+                P3::new(
+                    c[0] + r * s * phi.cos(),
+                    c[1] + r * s * phi.sin(),
+                    c[2] + r * z,
+                )
+            })
+            .collect()
+    }
+
+    /// A part a thousandth of its neighbour's size beside it, far from the origin: the
+    /// mixed-scale unions that made the `f32` hull fold. The hull is closed and convex, holds
+    /// every point, and keeps the small part's outer points as vertices.
+    #[test]
+    fn mixed_scales_give_a_closed_convex_hull() {
+        for (small, far) in [(1e-3, 60.0), (1e-6, 60.0), (2e-3, 1e4)] {
+            let mut pts = sphere([far, far, 0.0], 15.0, 2000);
+            pts.extend(sphere([far + 15.5, far, 0.0], small, 500));
+            // Duplicated surface points and near-coplanar noise on one great circle.
+            pts.extend(pts[..100].to_vec());
+            let h = hull_of(pts.clone());
+            assert_eq!(h.dim, 3);
+            assert!(is_convex_cover(&h, &pts, 1e-9 * far), "{small} {far}");
+            // The small part's cap outside the tangent cone: about 1.6 % of its 500 points.
+            let small_part = h.vertices.iter().filter(|v| v.x > far + 15.2).count();
+            assert!(small_part >= 5, "{small} {far}: {small_part}");
+        }
     }
 }

@@ -4,8 +4,7 @@
 //!
 //! Vertices stay `f64`; parry (`f32`) sees them relative to the pair's AABB centre. A merged
 //! body keeps the vertices of the hull of both vertex sets, from [`crate::geom::hull::hull_of`]
-//! (the same checked hull the Wrapper Trees use); where that is only a fallback box, it keeps the
-//! whole union, which has the same hull. Sets flat or collinear to within
+//! (the same exact hull the Wrapper Trees use). Sets flat or collinear to within
 //! [`crate::geom::hull::FLAT_REL`] of their extent are hulled as polygons or segments, so a
 //! body may drop points that far from its hull; a merge's own diameter is always computed from
 //! both children's full vertex sets.
@@ -138,9 +137,7 @@ impl PSetBodies for HullBodies {
         let d = self.union_diameter(x, y);
         let mut union = std::mem::take(&mut self.points[x as usize]);
         union.append(&mut std::mem::take(&mut self.points[y as usize]));
-        // The hull's vertices, or the points themselves where the hull is only a fallback box.
-        let (hull, support) = hull_of(union);
-        self.points.push(support.unwrap_or(hull.vertices));
+        self.points.push(hull_of(union).vertices);
         self.diameter.push(d);
         d
     }

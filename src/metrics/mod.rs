@@ -62,7 +62,7 @@ pub fn level_volume(tree: &SubsetTree, scene: &crate::scene::Scene, d: u32) -> (
             .iter()
             .flat_map(|&l| scene.prim_vertices(l as usize).copied())
             .collect();
-        hulls += crate::geom::hull::hull_of(points).0.volume();
+        hulls += crate::geom::hull::hull_of(points).volume();
     }
     (boxes, hulls)
 }

@@ -219,7 +219,7 @@ const WRAPPERS: [&str; 6] = [
 /// Builds wrapper `kind` over `tree` and returns how far the worst vertex lies outside its
 /// node's wrapper beyond the tolerance (≤ 0: every vertex inside). Tolerances: 1e-9 × scene
 /// diagonal plus 16 ulps of the largest coordinate for spheres and OBBs (`f64` throughout),
-/// plus [`HULL_TOL_REL`] × the node's box diameter for hulls (parry decides in `f32`).
+/// plus [`HULL_TOL_REL`] × the node's box diameter for hulls (the rounding of their face planes).
 fn wrapper_excess(kind: &str, tree: &SubsetTree, scene: &Scene) -> f64 {
     let far = scene
         .points

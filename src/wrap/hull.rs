@@ -13,26 +13,14 @@ use crate::scene::Scene;
 /// One hull per Subset Tree node (index = node id).
 pub fn hull_tree(tree: &SubsetTree, scene: &Scene) -> Vec<Hull> {
     let n = tree.leaves();
-    let mut hulls = Vec::with_capacity(tree.len());
-    // Points whose hull is the node's exact hull, kept only where the hull is a fallback box.
-    let mut support: Vec<Option<Vec<P3>>> = Vec::with_capacity(tree.len());
+    let mut hulls: Vec<Hull> = Vec::with_capacity(tree.len());
     for leaf in 0..n {
-        let pts: Vec<P3> = scene.prim_vertices(leaf).copied().collect();
-        let (h, s) = hull_of(pts);
-        hulls.push(h);
-        support.push(s);
+        hulls.push(hull_of(scene.prim_vertices(leaf).copied().collect()));
     }
     for [a, b] in &tree.children {
-        let mut pts = Vec::new();
-        for c in [*a as usize, *b as usize] {
-            match support[c].take() {
-                Some(s) => pts.extend(s),
-                None => pts.extend_from_slice(&hulls[c].vertices),
-            }
-        }
-        let (h, s) = hull_of(pts);
-        hulls.push(h);
-        support.push(s);
+        let [ha, hb] = [*a, *b].map(|c| &hulls[c as usize].vertices);
+        let pts: Vec<P3> = ha.iter().chain(hb).copied().collect();
+        hulls.push(hull_of(pts));
     }
     hulls
 }

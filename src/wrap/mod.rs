@@ -10,7 +10,7 @@
 //! - [`tightness`], [`report`] — volume, error and containment per level; [`distance`] — exact
 //!   point–primitive distances; [`cover`] — the fewest wrappers within an error.
 //!
-//! Everything is `f64` except parry's hull decision (`f32`): every wrapper contains the vertices
+//! Everything is `f64`, and hull faces are decided exactly: every wrapper contains the vertices
 //! below its node up to rounding, hulls up to [`HULL_TOL_REL`] × the node's AABB diameter.
 
 pub mod cover;

@@ -83,7 +83,7 @@ pub fn obb_tree(tree: &SubsetTree, scene: &Scene, hulls: Option<&[Hull]>) -> Vec
         .map(|x| {
             let pts = order.node_points(x);
             let basis = match hulls {
-                Some(h) if h[x as usize].exact => h[x as usize].vertices.as_slice(),
+                Some(h) => h[x as usize].vertices.as_slice(),
                 _ => pts,
             };
             let obb = Obb::fit(&Frame::principal(basis), pts);
