@@ -1,7 +1,10 @@
 //! `bench` times builds by the protocol of the published tables: rounds that build every
-//! method once in turn, each method keeping its fastest build, on a thread of the rayon pool.
+//! method once in turn, each method keeping its fastest build, on a thread of the rayon pool;
+//! its table's `/ PLOC` column is the ratio of the same rows' build times.
 
 use wraptree::grouping::Params;
+use wraptree::metrics::compare::{Options, Step, Wrapper, evaluate};
+use wraptree::metrics::report::bench_table;
 use wraptree::metrics::timing::fastest_builds;
 use wraptree::peers::{self, Method};
 use wraptree::scene::generate;
@@ -65,4 +68,58 @@ fn a_stop_ends_the_rounds_before_the_next_build() {
     });
     assert!(is_interrupted(&r.expect_err("stopped")));
     assert_eq!(calls, 3);
+}
+
+#[test]
+fn bench_builds_in_rounds_before_its_wrappers_and_its_table_divides_by_ploc_s_time() {
+    let scene = generate::replicate(&generate::robot_base(), 3, 1);
+    let opts = Options {
+        methods: vec![Method::Fast, Method::ObvhsPloc],
+        wrappers: vec![Wrapper::Box],
+        repeat: 3,
+        tightness_max_n: 0,
+        ..Options::default()
+    };
+    let mut steps = Vec::new();
+    let rows = evaluate(&scene, &opts, &Stop::new(), &mut |s| steps.push(s)).unwrap();
+    let builds: Vec<Step> = steps.iter().copied().take(6).collect();
+    let rounds: Vec<Step> = [Method::Fast, Method::ObvhsPloc]
+        .repeat(3)
+        .into_iter()
+        .map(Step::Build)
+        .collect();
+    assert_eq!(
+        builds, rounds,
+        "rounds of every method in turn, then the rest"
+    );
+    assert!(!steps[6..].iter().any(|s| matches!(s, Step::Build(_))));
+    // The table's `/ PLOC` column: each row's build time over PLOC's row's.
+    let build_s = |m: Method| rows.iter().find(|r| r.method == m.name()).unwrap().build_s;
+    let (fast, ploc) = (build_s(Method::Fast), build_s(Method::ObvhsPloc));
+    let table = bench_table(&rows.iter().collect::<Vec<_>>());
+    let header: Vec<&str> = table
+        .lines()
+        .next()
+        .unwrap()
+        .split('|')
+        .map(str::trim)
+        .collect();
+    let col = header
+        .iter()
+        .position(|&c| c == "/ PLOC")
+        .expect("a / PLOC column");
+    let cell = |method: &str| -> String {
+        let line = table
+            .lines()
+            .find(|l| l.starts_with(&format!("| {method} |")))
+            .unwrap();
+        line.split('|').nth(col).unwrap().trim().to_string()
+    };
+    assert_eq!(cell("fast"), format!("{:.2}", fast / ploc));
+    assert_eq!(cell("obvhs-ploc"), "1.00");
+    // Without PLOC among the methods the column is left empty.
+    let fast_rows: Vec<_> = rows.iter().filter(|r| r.method == "fast").collect();
+    let alone = bench_table(&fast_rows);
+    let line = alone.lines().nth(2).unwrap();
+    assert_eq!(line.split('|').nth(col).unwrap().trim(), "");
 }
