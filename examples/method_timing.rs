@@ -1,5 +1,6 @@
 //! Time bench methods on scene files against obvhs PLOC, best of the repeats (run in rounds of
-//! every peer and method in turn, so that the machine's slow spells fall on all alike), in one
+//! every peer and method in turn, so that the machine's slow spells fall on all alike: the
+//! protocol of `wraptree bench`, [`wraptree::metrics::timing`]), in one
 //! rayon pool of the given size, with the refinement's share, and their SAH and node tests per
 //! query of the standard workload against the best of parry Binned, obvhs PLOC and PLOC +
 //! reinsertion (all queries, the point and distance queries alone, and the contact queries of
@@ -32,11 +33,13 @@ use std::path::Path;
 use std::time::Instant;
 use wraptree::grouping::{Params, group_boxes, sah};
 use wraptree::metrics::compare::query_values;
+use wraptree::metrics::timing::fastest_builds;
 use wraptree::peers::{Built, Method, build};
 use wraptree::query::{Bv, Workload, measure};
 use wraptree::refine;
 use wraptree::scene::spec::scene_spec;
 use wraptree::scene::{LoadOptions, Scene, load_path};
+use wraptree::stop::Stop;
 
 /// The environment variable `name` parsed, if set.
 fn env<T: std::str::FromStr>(name: &str) -> Option<T> {
@@ -53,10 +56,16 @@ fn load(f: &str) -> anyhow::Result<Scene> {
     Ok(load_path(Path::new(f), &LoadOptions::default())?.scene)
 }
 
-/// `method` built, the fast path with the settings the environment varies.
-fn build_varied(method: Method, scene: &Scene, params: &Params) -> Built {
-    if method != Method::Fast {
-        return build(method, scene, params).expect("built");
+/// The environment variables that vary the fast path's settings.
+const VARIED: [&str; 9] = [
+    "TOP", "SAH", "EPS", "MAX", "PASSES", "BATCH", "TREELETS", "TK", "GAMMA",
+];
+
+/// `method` built, the fast path with the settings the environment varies (without them, as
+/// `wraptree bench` builds it).
+fn build_varied(method: Method, scene: &Scene, params: &Params) -> Result<Built, String> {
+    if method != Method::Fast || !VARIED.iter().any(|v| std::env::var_os(v).is_some()) {
+        return build(method, scene, params);
     }
     let mut p = params.clone();
     p.mode = p.mode.fast();
@@ -78,13 +87,13 @@ fn build_varied(method: Method, scene: &Scene, params: &Params) -> Built {
     let g = group_boxes(boxes, &resolved, ());
     let t1 = Instant::now();
     let r = refine::refine_owned(g.tree, &rp, ());
-    Built {
+    Ok(Built {
         method,
         tree: r.tree,
         seconds: t.elapsed().as_secs_f64(),
         stats: Some(g.stats),
         refine_seconds: t1.elapsed().as_secs_f64(),
-    }
+    })
 }
 
 /// One build's time and its tree's measures (NaN where the trees are not measured): node tests
@@ -118,7 +127,7 @@ impl Row {
 
 fn main() -> anyhow::Result<()> {
     let mut threads = 1usize;
-    let mut repeat = 5usize;
+    let mut repeat = 5u32;
     let mut methods = vec![Method::Fast];
     let mut files = Vec::new();
     let mut args = std::env::args().skip(1);
@@ -149,12 +158,13 @@ fn main() -> anyhow::Result<()> {
         let scene = load(&files[0])?;
         let t = Instant::now();
         let mut runs = 0u64;
-        pool.install(|| {
+        pool.install(|| -> anyhow::Result<()> {
             while t.elapsed().as_secs_f64() < secs {
-                build_varied(methods[0], &scene, &params);
+                build_varied(methods[0], &scene, &params).map_err(anyhow::Error::msg)?;
                 runs += 1;
             }
-        });
+            Ok(())
+        })?;
         println!("{runs} runs, {:.3} ms each", secs * 1e3 / runs as f64);
         return Ok(());
     }
@@ -189,20 +199,14 @@ fn main() -> anyhow::Result<()> {
             w.poses_touching.truncate(touch);
             w
         });
-        // The repeats in rounds, each building every peer and method once in turn, so that a
-        // slow spell of the machine falls on all of them alike; each keeps its fastest build.
+        // The repeats in rounds, each building every peer and method once in turn (the
+        // protocol of `wraptree bench`); each keeps its fastest build.
         let all: Vec<Method> = peers.iter().chain(&methods).copied().collect();
-        let mut fastest: Vec<Option<Built>> = vec![None; all.len()];
-        pool.install(|| {
-            for _ in 0..repeat {
-                for (slot, &m) in fastest.iter_mut().zip(&all) {
-                    let b = build_varied(m, &scene, &params);
-                    if slot.as_ref().is_none_or(|x| b.seconds < x.seconds) {
-                        *slot = Some(b);
-                    }
-                }
-            }
-        });
+        let fastest = pool.install(|| {
+            fastest_builds(&all, repeat, &Stop::new(), |m| {
+                build_varied(m, &scene, &params)
+            })
+        })?;
         // Each fastest build's time, refinement share, SAH and node tests per query.
         let mirror = env::<u32>("MIRROR") == Some(1);
         let mut mirrored = Vec::new();
@@ -237,10 +241,7 @@ fn main() -> anyhow::Result<()> {
                 distance: v[2],
             }
         };
-        let rows: Vec<Row> = fastest
-            .into_iter()
-            .map(|b| measured(b.expect("at least one repeat")))
-            .collect();
+        let rows: Vec<Row> = fastest.into_iter().map(&mut measured).collect();
         let (peer, ours) = rows.split_at(peers.len());
         let ploc = peer[ploc_slot].seconds;
         let best = |f: fn(&Row) -> f64| peer.iter().map(f).fold(f64::INFINITY, f64::min);

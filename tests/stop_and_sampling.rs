@@ -53,12 +53,18 @@ fn bench_stops_at_the_next_step_and_writes_nothing() {
     });
     let e = r.expect_err("a requested stop ends the run");
     assert!(is_interrupted(&e), "{e}");
-    // Stopped right after the first tightness: no query, no second method.
+    // Stopped right after the first tightness: no query, nothing measured on the second
+    // method's tree (both were built first, in rounds).
     assert!(matches!(
         steps.last(),
         Some(Step::Tightness(Method::Grouping, _))
     ));
-    assert!(!steps.contains(&Step::Build(Method::MedianSplit)));
+    assert!(steps.contains(&Step::Build(Method::MedianSplit)));
+    assert!(
+        !steps
+            .iter()
+            .any(|s| matches!(s, Step::Wrapper(Method::MedianSplit, _)))
+    );
     // The command writes only finished rows: the previous file stays as it was.
     assert_eq!(std::fs::read_to_string(&csv).unwrap(), "previous results\n");
     // A finished run replaces it.

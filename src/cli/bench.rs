@@ -13,6 +13,7 @@ use wraptree::metrics::report::{
     bench_outputs, bench_table, record_cost_header, record_cost_line, record_cost_notes,
     refine_table, speedup_table, target_line, targets_header, targets_notes, write_bench,
 };
+use wraptree::metrics::timing::ROUNDS;
 use wraptree::output::{check_absent, output_dir};
 use wraptree::peers::Method;
 use wraptree::scene::generate;
@@ -58,11 +59,16 @@ pub struct BenchCmd {
     /// scans, obvhs PLOC) [default: all cores]; the partitioned table sets 1 and 2 itself.
     #[arg(long, value_name = "N")]
     pub(super) threads: Option<usize>,
-    /// Timed repetitions per case (the best is reported). With SCENEs a case is repeated only
-    /// while its runs took under 0.1 s in all; with 2 or more, a case whose runs took under
-    /// 20 ms in all is repeated until they do (at most 200 runs).
-    #[arg(long, default_value_t = 3)]
-    repeat: u32,
+    /// Timed runs. With SCENEs the builds run in this many rounds, each building every method
+    /// once, in --methods' order, and each method's fastest build is reported (with
+    /// obvhs-ploc among them, in the table's `/ PLOC` column too): the protocol of the build
+    /// times in docs/benchmarks.md (add `--threads 1` for its one-thread tables). Each wrapper
+    /// is built up to this many times, the best kept, and repeated only while its runs took
+    /// under 0.1 s in all (with 2 or more, at least until they took 20 ms, at most 200 runs).
+    /// Without SCENEs: the same rounds per scene of the targets table (at most 2 from 10^6
+    /// primitives). [default: 9 with SCENEs, else 3]
+    #[arg(long, value_name = "N")]
+    repeat: Option<u32>,
     /// Instead: measure recording (time and file sizes per --detail) on the 3,130- and
     /// 12,144-polygon scenes and a 10^5-triangle soup.
     #[arg(long)]
@@ -131,6 +137,11 @@ pub(super) fn load_spec(spec: &str) -> Result<wraptree::scene::Scene> {
 }
 
 impl BenchCmd {
+    /// `--repeat` of the tables without SCENEs.
+    fn repeat_else(&self) -> u32 {
+        self.repeat.unwrap_or(3)
+    }
+
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         let threads = super::build_pool(self.threads)?;
@@ -157,7 +168,7 @@ impl BenchCmd {
             .map(|s| load_spec(s))
             .collect::<Result<Vec<_>>>()?;
         let mut opts = Options {
-            repeat: self.repeat,
+            repeat: self.repeat.unwrap_or(ROUNDS),
             tightness_max_n: self.tightness_max_n,
             tightness_nodes: self.tightness_nodes,
             ..Options::default()
@@ -197,13 +208,20 @@ impl BenchCmd {
         let stop = Stop::on_signals();
         let mut rows = Vec::new();
         for scene in &scenes {
-            let bar = progress::bar(opts.methods.len() as u64, &scene.name);
-            let mut started = 0;
+            // A step per build of each round, then one per method measured.
+            let methods = opts.methods.len() as u64;
+            let bar = progress::bar((u64::from(opts.repeat.max(1)) + 1) * methods, &scene.name);
+            let (mut done, mut measuring) = (0, None);
             let r = evaluate(scene, &opts, &stop, &mut |step| {
-                if let Step::Build(_) = step {
-                    // Methods finished so far.
-                    bar.set_position(started);
-                    started += 1;
+                let next = match step {
+                    Step::Build(_) => true,
+                    Step::Wrapper(m, _) | Step::Tightness(m, _) | Step::Query(m, _) => {
+                        measuring.replace(m) != Some(m)
+                    }
+                };
+                if next {
+                    bar.set_position(done);
+                    done += 1;
                 }
                 bar.set_message(step.to_string());
             });
@@ -229,7 +247,7 @@ impl BenchCmd {
         for scene in &cases {
             stop.check()?;
             let bar = progress::spinner(&format!("targets: {}", scene.name));
-            let rows = target_rows(scene, self.repeat);
+            let rows = target_rows(scene, self.repeat_else());
             bar.finish_and_clear();
             let (r, refine, speedups) = rows?;
             refined.push(refine);
@@ -242,7 +260,7 @@ impl BenchCmd {
         if self.max_soup >= 10_000_000 {
             cases.push(generate::soup(10_000_000, 1));
         }
-        super::bench_partitioned::print_table(&cases, self.repeat)?;
+        super::bench_partitioned::print_table(&cases, self.repeat_else())?;
         Ok(ExitCode::SUCCESS)
     }
 
@@ -260,14 +278,14 @@ impl BenchCmd {
                 .map(|s| load_spec(s))
                 .collect::<Result<Vec<_>>>()?
         };
-        super::bench_partitioned::print_table(&cases, self.repeat)?;
+        super::bench_partitioned::print_table(&cases, self.repeat_else())?;
         Ok(ExitCode::SUCCESS)
     }
 
     /// `--record`: what recording costs, a line per scene and detail as it is measured.
     fn run_record(&self) -> Result<ExitCode> {
         print!("{}", record_cost_header());
-        let fixed = record_costs(self.repeat, |r| print!("{}", record_cost_line(r)))?;
+        let fixed = record_costs(self.repeat_else(), |r| print!("{}", record_cost_line(r)))?;
         print!("{}", record_cost_notes(&fixed));
         Ok(ExitCode::SUCCESS)
     }

@@ -50,11 +50,10 @@ enum Command {
     /// 1,024 vertices each: about 0.6 s per 1,000).
     Scene(scene_cmd::SceneCmd),
     /// Compare hierarchy builders × wrappers on scenes (CSV, charts, .rrd), or print the targets
-    /// table against obvhs PLOC and parry Binned. With the defaults (7 builders × 4 wrappers) a
-    /// real scene takes about 1 s below 10^3 primitives and 0.1–0.7 ms per primitive above, on
-    /// 2 cores (a 35,902-polygon assembly of rigid copies: 22–29 s; 124,705 polygons: 47 s).
-    /// Stacked coincident copies cost more: their queries test every tied pair, up to a cap (ten
-    /// coincident copies of a 3,476-triangle part: about 8.5 s per builder).
+    /// table against obvhs PLOC and parry Binned. Build times are taken as in the tables of
+    /// docs/benchmarks.md: rounds that build every method in turn, the fastest build of each
+    /// kept (--repeat). Stacked coincident copies take long: their queries test every tied
+    /// pair, up to a cap. How long a bench takes: docs/benchmarks.md.
     Bench(bench::BenchCmd),
     /// Run the A/B/C grid of the grouping Cost on a scene: table, heat maps, the series of every
     /// setting (sweep.rrd) and the trees of the 6 best distinct settings side by side

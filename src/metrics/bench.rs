@@ -5,6 +5,7 @@
 
 pub mod partitioned;
 
+use super::timing::fastest;
 use crate::grouping::{self, Params};
 use crate::peers::{self, Method};
 use crate::query::{self, Bv, Workload};
@@ -12,7 +13,8 @@ use crate::record::{Detail, RecordOptions, Written, record};
 use crate::scene::obj::{LoadOptions, Loaded, load_path};
 use crate::scene::spec::as_loaded;
 use crate::scene::{Scene, generate};
-use anyhow::{Result, anyhow};
+use crate::stop::Stop;
+use anyhow::Result;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -78,14 +80,14 @@ pub struct TargetRow {
     pub peak_rss_bytes: Option<u64>,
 }
 
-/// Measures `scene` for the targets table: the best of `repeat` builds (at most 2 from 10^6
-/// primitives) of the grouping phase, obvhs PLOC and parry Binned, and their trees' SAH and
-/// query cost.
+/// Measures `scene` for the targets table: the fastest builds in `repeat` rounds (at most 2 from
+/// 10^6 primitives; [`fastest`]) of the grouping phase, obvhs PLOC and parry Binned among
+/// others, and their trees' SAH and query cost.
 pub fn target_row(scene: &Scene, repeat: u32) -> Result<TargetRow> {
     Ok(target_rows(scene, repeat)?.0)
 }
 
-/// One measured build: the fastest of the repeats, its SAH and its node tests per query and per
+/// One measured build: the fastest of the rounds, its SAH and its node tests per query and per
 /// contact query.
 struct Measured {
     /// The build (its time is `built.seconds`).
@@ -98,30 +100,36 @@ struct Measured {
     contact: f64,
 }
 
-/// The best of `repeat` builds of `m` on `scene` (at most 2 from 10^6 primitives), with its
-/// SAH and node tests per query and per contact query on `workload`, on the current rayon pool.
-fn measure(m: Method, scene: &Scene, repeat: u32, workload: &Workload) -> Result<Measured> {
-    let repeat = if scene.len() >= 1_000_000 {
-        repeat.min(2)
+/// The fastest builds of `methods` on `scene` in `rounds` rounds ([`fastest`]; at most 2 from
+/// 10^6 primitives), each with its SAH and node tests per query and per contact query on
+/// `workload`, on the current rayon pool; in `methods`' order.
+fn measure<const K: usize>(
+    methods: [Method; K],
+    scene: &Scene,
+    rounds: u32,
+    workload: &Workload,
+) -> Result<[Measured; K]> {
+    let rounds = if scene.len() >= 1_000_000 {
+        rounds.min(2)
     } else {
-        repeat
+        rounds
     };
-    let params = Params::default();
-    let mut best: Option<peers::Built> = None;
-    for _ in 0..repeat.max(1) {
-        let b = peers::build(m, scene, &params).map_err(|e| anyhow!(e))?;
-        if best.as_ref().is_none_or(|x| b.seconds < x.seconds) {
-            best = Some(b);
-        }
-    }
-    let built = best.expect("ran at least once");
-    let q = query::measure(&built.tree, scene, Bv::Aabb, workload);
-    Ok(Measured {
-        sah: super::sah(&built.tree),
-        tests: super::compare::query_values(&q)[6],
-        contact: q.contact.bv_tests,
-        built,
-    })
+    let built = fastest(&methods, scene, &Params::default(), rounds, &Stop::new())?;
+    let measured: Vec<Measured> = built
+        .into_iter()
+        .map(|built| {
+            let q = query::measure(&built.tree, scene, Bv::Aabb, workload);
+            Measured {
+                sah: super::sah(&built.tree),
+                tests: super::compare::query_values(&q)[6],
+                contact: q.contact.bv_tests,
+                built,
+            }
+        })
+        .collect();
+    Ok(measured
+        .try_into()
+        .unwrap_or_else(|_| unreachable!("one build per method")))
 }
 
 /// Grouping + refinement against the best peer on one scene.
@@ -186,13 +194,20 @@ pub struct SpeedupRow {
 pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, Vec<SpeedupRow>)> {
     let n = scene.len();
     let workload = Workload::standard(scene, 1);
-    let run = |m: Method| measure(m, scene, repeat, &workload);
-    let plain = run(Method::Grouping)?;
-    let tp = run(Method::ObvhsPloc)?.built.seconds;
-    let binned = run(Method::ParryBinned)?;
-    let refined = run(Method::GroupingRefine)?;
-    let reinserted = run(Method::ObvhsPlocReinsert)?;
-    let part_refined = run(Method::GroupingPartitionedRefine)?;
+    let [plain, ploc, binned, refined, reinserted, part_refined] = measure(
+        [
+            Method::Grouping,
+            Method::ObvhsPloc,
+            Method::ParryBinned,
+            Method::GroupingRefine,
+            Method::ObvhsPlocReinsert,
+            Method::GroupingPartitionedRefine,
+        ],
+        scene,
+        repeat,
+        &workload,
+    )?;
+    let tp = ploc.built.seconds;
     // The best of parry Binned and PLOC + reinsertion, per measure.
     let best_sah = binned.sah.min(reinserted.sah);
     let best_tests = binned.tests.min(reinserted.tests);
@@ -219,17 +234,25 @@ pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, 
     } else {
         (1.0, 1.0)
     };
-    let mut sped_up = Vec::new();
-    for m in [
+    let sped = [
         Method::GroupingPregroup,
         Method::GroupingInstanced,
         Method::GroupingObjects,
-    ] {
-        for threads in [1, 2] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()?;
-            let sped = pool.install(|| run(m))?;
+    ];
+    let mut on_threads = Vec::new();
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()?;
+        on_threads.push((
+            threads,
+            pool.install(|| measure(sped, scene, repeat, &workload))?,
+        ));
+    }
+    let mut sped_up = Vec::new();
+    for i in 0..sped.len() {
+        for (threads, measured) in &on_threads {
+            let sped = &measured[i];
             let tm = sped.built.seconds;
             let (bm, hm) = if volumes {
                 vol(&sped.built)
@@ -238,8 +261,8 @@ pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, 
             };
             sped_up.push(SpeedupRow {
                 scene: scene.name.clone(),
-                method: m,
-                threads,
+                method: sped.built.method,
+                threads: *threads,
                 seconds: tm,
                 per_ploc: tm / tp,
                 per_grouping: tm / t,

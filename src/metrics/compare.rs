@@ -1,8 +1,8 @@
 //! One scene, every hierarchy × wrapper: build times, quality, tightness and query cost in rows
 //! ready for a CSV and charts (`wraptree bench SCENE… -o DIR`).
 //!
-//! For each [`Method`] the hierarchy is built once per repetition (best time kept), then each
-//! [`Wrapper`] is built on it and timed. Rows carry:
+//! The hierarchies are built in rounds of every [`Method`] in turn, the fastest build of each
+//! kept ([`super::timing`]), then each [`Wrapper`] is built on each and timed. Rows carry:
 //! - the hierarchy's [`Quality`] (same for every wrapper on it);
 //! - the wrapper's tightness: mean over interior nodes of the sampled surface-to-geometry
 //!   distance divided by the node box's diagonal, estimated from at most
@@ -11,6 +11,7 @@
 //! - for box and sphere wrappers, the cost of the standard query workload
 //!   ([`crate::query::Workload::standard`]) with those wrappers as bounding volumes.
 
+use super::timing::fastest_builds;
 use super::{Quality, quality};
 use crate::grouping::{Params, SubsetTree};
 use crate::peers::{self, Method};
@@ -21,7 +22,7 @@ use crate::wrap::{
     DepthSample, Hull, MAX_VISITS, NODES_PER_DEPTH, Sphere, SphereMethod, WrapperTree, hull_tree,
     nodes_tightness, obb_tree, sphere_tree,
 };
-use anyhow::{Result, anyhow};
+use anyhow::Result;
 use std::time::Instant;
 
 /// A wrapper built on a hierarchy for the comparison.
@@ -93,8 +94,9 @@ pub struct Options {
     pub wrappers: Vec<Wrapper>,
     /// Grouping parameters.
     pub params: Params,
-    /// Timed repetitions of each build (the best is kept; see [`REPEAT_BUDGET_S`] and
-    /// [`REPEAT_FLOOR_S`]).
+    /// Rounds of builds, every method once per round (the fastest build of each is kept;
+    /// [`super::timing`]), and timed repetitions of each wrapper (the best is kept; see
+    /// [`REPEAT_BUDGET_S`] and [`REPEAT_FLOOR_S`]).
     pub repeat: u32,
     /// Tightness is measured only up to this many primitives.
     pub tightness_max_n: usize,
@@ -113,7 +115,7 @@ impl Default for Options {
             methods: Method::DEFAULT.to_vec(),
             wrappers: Wrapper::DEFAULT.to_vec(),
             params: Params::default(),
-            repeat: 3,
+            repeat: super::timing::ROUNDS,
             tightness_max_n: 1_000_000,
             tightness_nodes: NODES_PER_DEPTH,
             samples: 16,
@@ -153,19 +155,19 @@ pub struct Row {
     pub chunking: String,
 }
 
-/// Seconds after which a case is not repeated further: a run this long is timed well enough
+/// Seconds after which a wrapper is not repeated further: a run this long is timed well enough
 /// by itself, and repeating it would multiply the time of a bench.
 pub const REPEAT_BUDGET_S: f64 = 0.1;
 
-/// Seconds a case with more than one repetition is repeated to at least: a build of well under
-/// a millisecond is timed over many runs, whose best a busy machine is unlikely to have slowed
-/// in every one (`docs/benchmarks.md`).
+/// Seconds a wrapper with more than one repetition is repeated to at least: a build of well
+/// under a millisecond is timed over many runs, whose best a busy machine is unlikely to have
+/// slowed in every one (`docs/benchmarks.md`).
 pub const REPEAT_FLOOR_S: f64 = 0.02;
 
-/// The most runs of one case.
+/// The most runs of one wrapper.
 pub const REPEAT_MAX: u32 = 200;
 
-/// Whether a case is run again after `runs` runs that took `spent` seconds in all: while
+/// Whether a wrapper is run again after `runs` runs that took `spent` seconds in all: while
 /// fewer than `repeat` runs took less than [`REPEAT_BUDGET_S`], or, when `repeat` > 1, less
 /// than [`REPEAT_FLOOR_S`]; never more than [`REPEAT_MAX`] runs.
 fn run_again(runs: u32, spent: f64, repeat: u32) -> bool {
@@ -232,7 +234,7 @@ fn tightness(
 /// What `bench` is measuring, for progress reports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Step {
-    /// Building a method's hierarchy (its repetitions).
+    /// Building a method's hierarchy (once per round).
     Build(Method),
     /// Building a wrapper on it.
     Wrapper(Method, Wrapper),
@@ -253,22 +255,25 @@ impl std::fmt::Display for Step {
     }
 }
 
-/// Runs every method × wrapper of `opts` on `scene`, calling `progress` before each step;
-/// checks `stop` between steps (Err: [`Interrupted`](crate::stop::Interrupted), or why a
-/// build failed).
+/// Runs every method × wrapper of `opts` on `scene`: first the builds, `opts.repeat` rounds of
+/// every method in turn ([`fastest_builds`]), then on each method's fastest tree its wrappers,
+/// tightness and queries; calls `progress` before each step (each build of each round too) and
+/// checks `stop` before it (Err: [`Interrupted`](crate::stop::Interrupted), or why a build
+/// failed).
 pub fn evaluate(
     scene: &Scene,
     opts: &Options,
     stop: &Stop,
-    progress: &mut dyn FnMut(Step),
+    progress: &mut (dyn FnMut(Step) + Send),
 ) -> Result<Vec<Row>> {
     let workload = Workload::standard(scene, opts.seed);
     let measure_tightness = scene.len() <= opts.tightness_max_n;
+    let built = fastest_builds(&opts.methods, opts.repeat, stop, |m| {
+        progress(Step::Build(m));
+        peers::build(m, scene, &opts.params)
+    })?;
     let mut rows = Vec::new();
-    for &method in &opts.methods {
-        stop.check()?;
-        progress(Step::Build(method));
-        let (built, build_s) = build_best(method, scene, opts).map_err(|e| anyhow!(e))?;
+    for (&method, built) in opts.methods.iter().zip(&built) {
         let tree = &built.tree;
         let q = quality(tree);
         // Reference hulls for tightness (and the hull wrapper itself).
@@ -295,7 +300,7 @@ pub fn evaluate(
                 n: scene.len(),
                 method: method.name(),
                 wrapper: wrapper.name(),
-                build_s,
+                build_s: built.seconds,
                 refine_s: built.refine_seconds,
                 wrapper_s: w.seconds,
                 quality: q,
@@ -309,30 +314,6 @@ pub fn evaluate(
         }
     }
     Ok(rows)
-}
-
-/// The best of `opts.repeat` builds of `method`'s hierarchy, and its time. Err: why a build
-/// failed.
-fn build_best(
-    method: Method,
-    scene: &Scene,
-    opts: &Options,
-) -> Result<(peers::Built, f64), String> {
-    let mut failed = None;
-    let (built, build_s) = best_of(opts.repeat, || {
-        match peers::build(method, scene, &opts.params) {
-            Ok(b) => {
-                let s = b.seconds;
-                (Some(b), s)
-            }
-            Err(e) => {
-                failed = Some(e);
-                (None, f64::INFINITY)
-            }
-        }
-    });
-    let built = built.ok_or_else(|| failed.unwrap_or_default())?;
-    Ok((built, build_s))
 }
 
 /// What one wrapper on a hierarchy measured.

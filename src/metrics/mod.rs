@@ -7,7 +7,8 @@
 //!   `min(V_L, V_R) / max(V_L, V_R)`; a pair of zero-volume (flat) siblings counts as 1.
 //! - Depth: largest and mean leaf depth.
 //!
-//! Wrapper tightness per level comes from [`crate::wrap::level_tightness`]. [`compare`] runs
+//! Wrapper tightness per level comes from [`crate::wrap::level_tightness`]. [`timing`] times
+//! builders against each other (interleaved rounds, best of N); [`compare`] runs
 //! every hierarchy builder × wrapper on a scene, [`sweep`] the A/B/C grid of the grouping
 //! phase, [`bench`](mod@bench) the targets table and the cost of recording, [`stress`] every
 //! builder on pathological scenes, and [`report`] writes their CSV, charts and `.rrd`.
@@ -17,6 +18,7 @@ pub mod compare;
 pub mod report;
 pub mod stress;
 pub mod sweep;
+pub mod timing;
 
 pub use crate::grouping::{C_PRIM, C_TRAV, sah};
 

@@ -4,12 +4,14 @@
 
 use crate::grouping::{Params, Schedule};
 use crate::metrics::bench::{RecordCost, record_cost};
+use crate::metrics::timing::fastest;
 use crate::metrics::{compare, peak_rss_bytes, sah};
-use crate::peers::{self, Method};
+use crate::peers::Method;
 use crate::query::{self, Bv, Workload};
 use crate::record::Detail;
 use crate::scene::Scene;
 use crate::scene::spec::as_loaded;
+use crate::stop::Stop;
 use anyhow::{Result, anyhow};
 
 /// Thread counts of the table.
@@ -82,7 +84,8 @@ fn reset_peak() -> bool {
     std::fs::write("/proc/self/clear_refs", "5").is_ok()
 }
 
-/// Best of `repeat` builds of `m` on `threads` threads, with its tree's quality if `quality`.
+/// Best of `repeat` builds of `m` on `threads` threads ([`fastest`]), with its tree's quality if
+/// `quality`.
 fn measure(
     m: Method,
     scene: &Scene,
@@ -95,19 +98,10 @@ fn measure(
         .num_threads(threads)
         .build()
         .map_err(|e| anyhow!("building a {threads}-thread pool: {e}"))?;
-    let params = Params::default();
     reset_peak();
-    let mut best: Option<peers::Built> = None;
-    for _ in 0..repeat.max(1) {
-        let b = pool
-            .install(|| peers::build(m, scene, &params))
-            .map_err(|e| anyhow!(e))?;
-        if best.as_ref().is_none_or(|x| b.seconds < x.seconds) {
-            best = Some(b);
-        }
-    }
+    let built = pool.install(|| fastest(&[m], scene, &Params::default(), repeat, &Stop::new()))?;
     let peak_bytes = peak_rss_bytes().unwrap_or(0);
-    let b = best.expect("ran at least once");
+    let b = &built[0];
     let (sah, tests) = if quality {
         let q = query::measure(&b.tree, scene, Bv::Aabb, workload);
         (sah(&b.tree), compare::query_values(&q)[6])

@@ -4,6 +4,7 @@
 use super::{QUERY_COLUMNS, SIZE, csv_bytes, opt, query_fields, series_by, write_chart};
 use crate::metrics::compare::{Row, query_values};
 use crate::output::write_atomic;
+use crate::peers::Method;
 use crate::record::rrd::SeriesFile;
 use crate::render::chart::{Scatter, Series, pareto_front};
 use anyhow::{Result, anyhow};
@@ -149,12 +150,17 @@ fn sanitize(s: &str) -> String {
         .collect()
 }
 
-/// One scene's rows as a markdown table (what `bench` prints and logs); queries stopped at the
-/// test cap are counted beside their row's tests per query and explained below the table.
+/// One scene's rows as a markdown table (what `bench` prints and logs): with obvhs PLOC among
+/// the methods, each build time over PLOC's from the same rows; queries stopped at the test cap
+/// are counted beside their row's tests per query and explained below the table.
 pub fn bench_table(rows: &[&Row]) -> String {
     let mut md = String::from(
-        "| method | wrapper | build ms | wrapper ms | SAH | depth | tightness | tests/query | tests/contact query |\n|---|---|---|---|---|---|---|---|---|\n",
+        "| method | wrapper | build ms | / PLOC | wrapper ms | SAH | depth | tightness | tests/query | tests/contact query |\n|---|---|---|---|---|---|---|---|---|---|\n",
     );
+    let ploc = rows
+        .iter()
+        .find(|r| r.method == Method::ObvhsPloc.name())
+        .map(|r| r.build_s);
     // Contact queries run with box BVs only: other rows leave the cell empty.
     let contact = |q: &crate::query::QueryCost| {
         let c = &q.contact;
@@ -163,10 +169,12 @@ pub fn bench_table(rows: &[&Row]) -> String {
     for r in rows {
         let _ = writeln!(
             md,
-            "| {} | {} | {:.3} | {:.3} | {:.2} | {} | {} | {} | {} |",
+            "| {} | {} | {:.3} | {} | {:.3} | {:.2} | {} | {} | {} | {} |",
             r.method,
             r.wrapper,
             r.build_s * 1e3,
+            ploc.map(|p| format!("{:.2}", r.build_s / p))
+                .unwrap_or_default(),
             r.wrapper_s * 1e3,
             r.quality.sah,
             r.quality.depth_max,
