@@ -3,10 +3,51 @@
 //! Data goes to a temporary file in the destination's directory, renamed over the destination
 //! only once it is complete; an existing file is replaced only when the caller allows it. A
 //! failed or interrupted write leaves the old file untouched.
+//!
+//! Unfinished outputs (temporary files not yet moved into place, directories made for an
+//! output) are registered, so that a process ended by a stop request it could not obey in time
+//! takes them away first ([`discard_unfinished`]).
 
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Mutex, MutexGuard};
+
+/// The unfinished outputs of the process: temporary files, then directories made (deepest
+/// first within each [`output_dir`] call).
+struct Unfinished {
+    files: Vec<PathBuf>,
+    dirs: Vec<PathBuf>,
+}
+
+static UNFINISHED: Mutex<Unfinished> = Mutex::new(Unfinished {
+    files: Vec::new(),
+    dirs: Vec::new(),
+});
+
+/// The registry, whatever a panicking holder left it as.
+fn unfinished() -> MutexGuard<'static, Unfinished> {
+    UNFINISHED.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Removes every unfinished output of the process (temporary files, then the directories made
+/// for outputs that are empty then) and keeps any other thread from moving a file into place
+/// afterwards: for a process about to exit on a stop request that its current step does not
+/// check. Returns how many files it removed.
+pub fn discard_unfinished() -> usize {
+    let guard = unfinished();
+    let removed = guard
+        .files
+        .iter()
+        .filter(|f| std::fs::remove_file(f).is_ok())
+        .count();
+    for d in guard.dirs.iter().rev() {
+        let _ = std::fs::remove_dir(d);
+    }
+    // Held until the process exits: a commit waiting for it never moves its file into place.
+    std::mem::forget(guard);
+    removed
+}
 
 /// A file being written; [`Pending::commit`] moves it into place.
 #[derive(Debug)]
@@ -60,6 +101,7 @@ impl Pending {
                 .set_permissions(perms)
                 .with_context(|| format!("{}: cannot set permissions", dest.display()))?;
         }
+        unfinished().files.push(tmp.path().to_path_buf());
         Ok(Pending {
             tmp,
             dest: dest.to_path_buf(),
@@ -112,6 +154,10 @@ impl Pending {
                 .sync_all()
                 .with_context(|| format!("{}: cannot sync", dest.display()))?;
         }
+        let tmp_path = self.tmp.path().to_path_buf();
+        // Held across the rename, so that [`discard_unfinished`] sees the file whole or not.
+        let mut registry = unfinished();
+        registry.files.retain(|f| *f != tmp_path);
         self.tmp.persist(&dest).map_err(|e| {
             anyhow::anyhow!("{}: cannot move into place: {}", dest.display(), e.error)
         })?;
@@ -172,6 +218,7 @@ impl std::ops::Deref for OutDir {
 
 impl Drop for OutDir {
     fn drop(&mut self) {
+        unfinished().dirs.retain(|d| !self.made.contains(d));
         for d in &self.made {
             // Fails, and so keeps the directory, once anything was written into it.
             if std::fs::remove_dir(d).is_err() {
@@ -194,6 +241,9 @@ pub fn output_dir(given: Option<&Path>, default: &str) -> Result<OutDir> {
         std::fs::create_dir_all(&path)
             .with_context(|| format!("{}: cannot create the output directory", path.display()))?;
     }
+    // Shallowest first, so that [`discard_unfinished`] (which goes backwards) removes the
+    // deepest first.
+    unfinished().dirs.extend(made.iter().rev().cloned());
     Ok(OutDir { path, made })
 }
 

@@ -4,6 +4,7 @@ mod bench;
 mod bench_partitioned;
 mod compare;
 mod cover;
+mod deadline;
 mod group;
 mod progress;
 mod record;
@@ -357,6 +358,8 @@ impl Command {
 /// Runs the parsed command, its `--threads` pool built first, so that loading and every other
 /// step before the grouping run on it too.
 pub fn run(cli: Cli) -> Result<ExitCode> {
+    // Installed before any work, so that a stop during loading is obeyed too.
+    deadline::arm(wraptree::stop::Stop::on_signals());
     let threads = cli.command.threads();
     if threads.is_some() {
         build_pool(threads)?;

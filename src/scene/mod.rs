@@ -15,6 +15,7 @@
 //! - [`spec`] turns a command line's `KIND[:COUNT]` or OBJ path into a scene;
 //! - [`split`] cuts long thin polygons into pieces of limited aspect (§4).
 
+pub mod assembly;
 pub mod coincident;
 pub mod components;
 pub mod export;

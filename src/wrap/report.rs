@@ -83,24 +83,33 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
 
 impl Built {
     /// Builds the trees of `kinds` (OBB axes from the hulls when hulls are built too, as
-    /// [`Wrappers::build`](super::Wrappers::build) does).
-    fn new(tree: &SubsetTree, scene: &Scene, kinds: &[WrapperKind], method: SphereMethod) -> Built {
+    /// [`Wrappers::build`](super::Wrappers::build) does), checking `stop` before each.
+    fn new(
+        tree: &SubsetTree,
+        scene: &Scene,
+        kinds: &[WrapperKind],
+        method: SphereMethod,
+        stop: &Stop,
+    ) -> Result<Built, Interrupted> {
         let want = |k| kinds.contains(&k);
         let mut b = Built::default();
         if want(WrapperKind::Sphere) {
+            stop.check()?;
             b.spheres = Some(timed(|| sphere_tree(tree, scene, method)));
         }
         if want(WrapperKind::Hull) {
+            stop.check()?;
             b.hulls = Some(timed(|| hull_tree(tree, scene)));
         }
         if want(WrapperKind::Box) {
             b.boxes = Some(timed(|| tree.aabb.clone()));
         }
         if want(WrapperKind::Obb) {
+            stop.check()?;
             let hulls = b.hulls.as_ref().map(|(h, _)| h.as_slice());
             b.obbs = Some(timed(|| obb_tree(tree, scene, hulls)));
         }
-        b
+        Ok(b)
     }
 
     /// The trees built, in [`WrapperKind`] order, with their build times.
@@ -161,8 +170,8 @@ pub fn containment(tree: &SubsetTree, scene: &Scene, w: WrapperTree<'_>) -> Cont
 /// `how.samples` surface samples per wrapper, the error measured on every leaf and at most
 /// `how.per_depth` interior nodes per depth ([`level_tightness_sampled`], seed
 /// [`SAMPLE_SEED`]; 0: every node), spheres by `how.method`. The reference volumes are the
-/// hulls', built untimed when not asked for. `stop` is obeyed after the wrappers are built and
-/// before each kind is measured.
+/// hulls', built untimed when not asked for. `stop` is obeyed before each wrapper tree is built
+/// and before each kind's containment and tightness are measured.
 pub fn report(
     tree: &SubsetTree,
     scene: &Scene,
@@ -178,11 +187,12 @@ pub fn report(
     let mut kinds = kinds.to_vec();
     kinds.sort();
     kinds.dedup();
-    let built = Built::new(tree, scene, &kinds, method);
+    let built = Built::new(tree, scene, &kinds, method, stop)?;
     let own_hulls;
     let hulls = match &built.hulls {
         Some((h, _)) => h.as_slice(),
         None => {
+            stop.check()?;
             own_hulls = hull_tree(tree, scene);
             own_hulls.as_slice()
         }
@@ -192,10 +202,12 @@ pub fn report(
         .into_iter()
         .map(|(w, build_seconds)| {
             stop.check()?;
+            let containment = containment(tree, scene, w);
+            stop.check()?;
             Ok(KindReport {
                 kind: w.kind(),
                 build_seconds,
-                containment: containment(tree, scene, w),
+                containment,
                 levels: level_tightness_sampled(
                     tree,
                     scene,

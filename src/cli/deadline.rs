@@ -1,0 +1,34 @@
+//! The backstop of a stop request: every long loop checks the [`Stop`] token, but a step that
+//! cannot (inside a dependency, or a single geometric computation) may still run long. Once a
+//! stop is requested, the process gets [`GRACE`] to end on its own; then its unfinished outputs
+//! are taken away ([`discard_unfinished`]) and it exits with [`EXIT_INTERRUPTED`].
+
+use super::progress::EXIT_INTERRUPTED;
+use std::time::Duration;
+use wraptree::output::discard_unfinished;
+use wraptree::stop::Stop;
+
+/// How long a stopped run may take to end on its own: well within the second a stop promises.
+pub const GRACE: Duration = Duration::from_millis(600);
+
+/// How often the watcher looks at the token.
+const POLL: Duration = Duration::from_millis(20);
+
+/// Starts the watcher of `stop` on a thread of its own.
+pub fn arm(stop: Stop) {
+    let watcher = std::thread::Builder::new().name("stop-deadline".into());
+    // Fails only when no thread can be made; a stop is then obeyed by the loops alone.
+    let _ = watcher.spawn(move || {
+        while !stop.is_requested() {
+            std::thread::sleep(POLL);
+        }
+        std::thread::sleep(GRACE);
+        discard_unfinished();
+        eprintln!(
+            "stopped by Ctrl-C or SIGTERM; the step in progress did not end within {} ms, so it \
+             was cut short; no output written",
+            GRACE.as_millis()
+        );
+        std::process::exit(i32::from(EXIT_INTERRUPTED));
+    });
+}
