@@ -444,3 +444,63 @@ fn coincident_bodies_merge_smallest_ids_first_in_quadratic_work() {
         );
     }
 }
+
+/// The shape of the hull runaway: rigid, randomly rotated copies of a small robot link
+/// (0.2 units) beside copies of a mug 30 units wide, the link far below the `f32` resolution of
+/// the nodes that join them. Every solid hull of both p-sets' trees is closed and convex, holds its
+/// children's vertices, and is made of scene vertices only (no fallback box), and the hull
+/// p-set's bodies keep only their hulls' vertices.
+#[test]
+fn mixed_scale_assembly_gets_exact_hulls_from_both_psets() {
+    use wraptree::geom::hull::is_convex_cover;
+    use wraptree::scene::assembly::{Part, assemble};
+    let scaled = |file: &str, size: f64| {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes")
+            .join(file);
+        let mut s = wraptree::scene::load_path(&path, &Default::default())
+            .unwrap()
+            .scene;
+        let (c, d) = (s.aabb().center(), s.aabb().diameter());
+        for p in &mut s.points {
+            *p = c + (*p - c) * (size / d);
+        }
+        s
+    };
+    let parts = [
+        Part {
+            scene: scaled("kuka-link0.obj", 0.2),
+            copies: 6,
+        },
+        Part {
+            scene: scaled("mug.obj", 30.0),
+            copies: 4,
+        },
+    ];
+    let (s, _) = assemble(&parts, 11).unwrap();
+    let vertices: std::collections::HashSet<[u64; 3]> = s
+        .points
+        .iter()
+        .map(|p| p.coords.map(f64::to_bits).into())
+        .collect();
+    for params in [Params::default(), hull_pset()] {
+        let g = wraptree::grouping::group(&s, &params, ());
+        let hulls = hull_tree(&g.tree, &s);
+        for (x, [a, b]) in g.tree.children.iter().enumerate() {
+            let x = g.tree.leaves() + x;
+            let h = &hulls[x];
+            let below: Vec<P3> = [a, b]
+                .iter()
+                .flat_map(|&&c| hulls[c as usize].vertices.clone())
+                .collect();
+            // Flat nodes (coplanar faces of one copy) are polygons, checked elsewhere.
+            assert!(h.dim < 3 || is_convex_cover(h, &below, 0.0), "node {x}");
+            assert!(
+                h.vertices
+                    .iter()
+                    .all(|v| vertices.contains(&<[u64; 3]>::from(v.coords.map(f64::to_bits)))),
+                "node {x} has a vertex that is not the scene's"
+            );
+        }
+    }
+}

@@ -165,8 +165,9 @@ pub fn hull_of(mut points: Vec<P3>) -> Hull {
 }
 
 /// Whether `h` is a solid whose surface is closed (every directed edge once, its reverse once)
-/// and whose every face plane has all `points` at most `tol` in front of it: then `h` is convex
-/// and holds every point within `tol`. Zero-area faces have no plane and are not checked.
+/// and has all `points` behind or at most `tol` in front of every face: then `h` is convex and
+/// holds every point within `tol`. "Behind" is decided exactly (`orient3d`), since the `f64`
+/// normal of a sliver face can point anywhere; "at most `tol` in front" uses that normal.
 /// "Every point lies on or inside the mesh" would not be enough: a folded mesh through all the
 /// hull's vertices passes it.
 pub fn is_convex_cover(h: &Hull, points: &[P3], tol: f64) -> bool {
@@ -184,12 +185,12 @@ pub fn is_convex_cover(h: &Hull, points: &[P3], tol: f64) -> bool {
     if edges.keys().any(|&(a, b)| !edges.contains_key(&(b, a))) {
         return false;
     }
-    h.triangles.iter().all(|t| {
+    h.triangles.iter().all(|&t| {
         let [a, b, c] = t.map(|i| h.vertices[i as usize]);
-        match (b - a).cross(&(c - a)).try_normalize(0.0) {
-            Some(n) => points.iter().all(|p| n.dot(&(p - a)) <= tol),
-            None => true,
-        }
+        let n = (b - a).cross(&(c - a)).try_normalize(0.0);
+        points.iter().all(|p| {
+            quickhull::behind(&h.vertices, t, p) || n.is_some_and(|n| n.dot(&(p - a)) <= tol)
+        })
     })
 }
 

@@ -25,7 +25,7 @@ pub mod tightness;
 pub mod welzl;
 
 pub use crate::geom::Sphere;
-pub use hull::{HULL_TOL_REL, Hull, hull_tree};
+pub use hull::{HULL_TOL_REL, Hull, hull_tree, hull_tree_until};
 pub use kind::{WrapperKind, WrapperTree, Wrappers};
 pub use obb::{Obb, obb_tree};
 pub use order::LeafOrder;

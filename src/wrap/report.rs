@@ -22,7 +22,7 @@
 
 use super::{
     HULL_TOL_REL, Hull, LevelStats, Obb, Sphere, SphereMethod, WrapperKind, WrapperTree,
-    containment_excess, hull_tree, level_tightness_sampled, obb_tree, sphere_tree,
+    containment_excess, hull_tree_until, level_tightness_sampled, obb_tree, sphere_tree,
 };
 use crate::geom::Aabb;
 use crate::grouping::SubsetTree;
@@ -99,7 +99,8 @@ impl Built {
         }
         if want(WrapperKind::Hull) {
             stop.check()?;
-            b.hulls = Some(timed(|| hull_tree(tree, scene)));
+            let (hulls, t) = timed(|| hull_tree_until(tree, scene, stop));
+            b.hulls = Some((hulls?, t));
         }
         if want(WrapperKind::Box) {
             b.boxes = Some(timed(|| tree.aabb.clone()));
@@ -192,8 +193,7 @@ pub fn report(
     let hulls = match &built.hulls {
         Some((h, _)) => h.as_slice(),
         None => {
-            stop.check()?;
-            own_hulls = hull_tree(tree, scene);
+            own_hulls = hull_tree_until(tree, scene, stop)?;
             own_hulls.as_slice()
         }
     };

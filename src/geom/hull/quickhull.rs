@@ -38,6 +38,11 @@ fn above(points: &[P3], [a, b, c]: [u32; 3], q: &P3) -> f64 {
     -orient3d(p(a), p(b), p(c), coord(q))
 }
 
+/// Whether `q` lies on or below the plane of the counter-clockwise triangle `v`, exactly.
+pub(super) fn behind(points: &[P3], v: [u32; 3], q: &P3) -> bool {
+    above(points, v, q) <= 0.0
+}
+
 /// An approximate height of `q` above face `v`, used only to pick the farthest point.
 fn height(points: &[P3], [a, b, c]: [u32; 3], q: &P3) -> f64 {
     let [a, b, c] = [a, b, c].map(|i| points[i as usize]);
