@@ -19,8 +19,8 @@ use crate::scene::{PrimitiveKind, Scene};
 /// A face is degenerate when twice its area is at most `AREA_EPS` × its diameter² (the diagonal
 /// of its own AABB): the test looks at the face's shape alone, never at the rest of the scene.
 ///
-/// Edge vectors are differences of stored `f64` coordinates, each rounded to half an ulp of
-/// itself, so they are exact to a relative ε = 2⁻⁵² ≈ 2.2e-16 wherever the face lies, and twice
+/// Edge vectors are differences of stored `f64` coordinates, each difference rounded to half an
+/// ulp of itself, so they are exact to a relative ε = 2⁻⁵² ≈ 2.2e-16 wherever the face lies; twice
 /// the area computed from them is off by a few ε × diameter² (n ε for n corners). 1e-12 ≈ 4500 ε
 /// sits far above that rounding, so a face kept has a plane known to about ε / `AREA_EPS`
 /// ≈ 2e-4 rad, and far below the shape of any face a mesh means to have (a 1 : 10¹² sliver).
