@@ -1,9 +1,9 @@
 //! Polygon mode: one OBJ face becomes one convex planar polygon, or the triangles of its split.
 //!
 //! For each face (vertex order kept from the file, consecutive repeats removed):
-//! - **degenerate** — fewer than 3 distinct vertices, or twice the area ≤ [`AREA_EPS`] × the
-//!   face's own diameter² (a needle or a point, whatever its size or position): dropped and
-//!   counted;
+//! - **degenerate** — fewer than 3 distinct vertices, or an area negligible against the face's
+//!   own diameter² or below the rounding of its own corners ([`AREA_EPS`]: a needle or a point,
+//!   whatever its size and wherever it lies): dropped and counted;
 //! - **non-planar** — a vertex further than [`PLANAR_EPS`] × face diameter (the diagonal of the
 //!   face's AABB) from the plane through the vertex centroid with the Newell normal: split;
 //! - **non-convex** — in that plane, a reflex corner or a boundary winding more than once: split;
@@ -16,15 +16,22 @@
 use crate::geom::{Aabb, P3, V3};
 use crate::scene::{PrimitiveKind, Scene};
 
-/// A face is degenerate when twice its area is at most `AREA_EPS` × its diameter² (the diagonal
-/// of its own AABB): the test looks at the face's shape alone, never at the rest of the scene.
+/// A face is degenerate when twice its area is at most `AREA_EPS` × D² or [`ROUNDING_ULPS`] ε
+/// × M × D, D its diameter (the diagonal of its own AABB), M its largest absolute coordinate,
+/// ε = 2⁻⁵² ≈ 2.2e-16: its own shape and the precision of its own corners, never the rest of the
+/// scene.
 ///
-/// Edge vectors are differences of stored `f64` coordinates, each difference rounded to half an
-/// ulp of itself, so they are exact to a relative ε = 2⁻⁵² ≈ 2.2e-16 wherever the face lies; twice
-/// the area computed from them is off by a few ε × diameter² (n ε for n corners). 1e-12 ≈ 4500 ε
-/// sits far above that rounding, so a face kept has a plane known to about ε / `AREA_EPS`
-/// ≈ 2e-4 rad, and far below the shape of any face a mesh means to have (a 1 : 10¹² sliver).
+/// Edge vectors are differences of stored `f64` coordinates, each rounded to a relative ε, so
+/// twice the area computed from them is off by a few ε × D² (n ε for n corners) wherever the face
+/// lies; 1e-12 ≈ 4500 ε sits far above that, so a face kept has a plane known to about
+/// ε / `AREA_EPS` ≈ 2e-4 rad. The second term is the area a needle gains when its corners are
+/// rounded, by a few operations (parse, scale, rotation, translation) each within an ulp of M,
+/// to the coordinate grid of its position: a line placed far from the origin stays a needle,
+/// while a well-shaped face (twice the area ~ D²) is kept down to D ~ 1e-13 × M.
 pub const AREA_EPS: f64 = 1e-12;
+/// Rounding allowance of the degenerate test, in ulps of a face's largest coordinate
+/// ([`AREA_EPS`]).
+pub const ROUNDING_ULPS: f64 = 8.0;
 /// Relative distance from the face plane above which a face is non-planar (times its diameter).
 pub const PLANAR_EPS: f64 = 1e-6;
 
@@ -89,8 +96,8 @@ pub fn add(scene: &mut Scene, face: &[u32], stats: &mut PolygonStats, s: &mut Sc
     let p = |k: usize| scene.points[v[k % n] as usize];
     let o = p(0);
     let normal: V3 = (0..n).map(|k| (p(k) - o).cross(&(p(k + 1) - o))).sum();
-    let diameter = Aabb::from_points(v.iter().map(|&i| &scene.points[i as usize])).diameter();
-    if is_negligible(normal.norm(), diameter) {
+    let bounds = Aabb::from_points(v.iter().map(|&i| &scene.points[i as usize]));
+    if is_negligible(normal.norm(), &bounds) {
         stats.degenerate += 1;
         return;
     }
@@ -99,7 +106,7 @@ pub fn add(scene: &mut Scene, face: &[u32], stats: &mut PolygonStats, s: &mut Sc
         push_polygon(scene, &s.verts);
         return;
     }
-    let planar = is_planar(n, p, diameter, &nh);
+    let planar = is_planar(n, p, bounds.diameter(), &nh);
     if planar && is_convex(n, p, &nh) {
         push_polygon(scene, &s.verts);
         return;
@@ -120,8 +127,8 @@ pub fn add(scene: &mut Scene, face: &[u32], stats: &mut PolygonStats, s: &mut Sc
     for &[a, b, c] in &s.ears {
         let tri = [s.verts[a], s.verts[b], s.verts[c]];
         let [pa, pb, pc] = tri.map(|i| scene.points[i as usize]);
-        let diameter = Aabb::from_points(&[pa, pb, pc]).diameter();
-        if !is_negligible((pb - pa).cross(&(pc - pa)).norm(), diameter) {
+        let bounds = Aabb::from_points(&[pa, pb, pc]);
+        if !is_negligible((pb - pa).cross(&(pc - pa)).norm(), &bounds) {
             push_polygon(scene, &tri);
             stats.pieces += 1;
         }
@@ -134,10 +141,13 @@ fn push_polygon(scene: &mut Scene, v: &[u32]) {
     scene.push(PrimitiveKind::Polygon, v, &tris);
 }
 
-/// Whether a face of diameter `diameter` with twice the area `twice_area` is degenerate
-/// ([`AREA_EPS`]); also for a non-finite area.
-pub fn is_negligible(twice_area: f64, diameter: f64) -> bool {
-    !(twice_area > AREA_EPS * diameter * diameter && twice_area.is_finite())
+/// Whether a face with twice the area `twice_area` and corners bounded by `bounds` is
+/// degenerate ([`AREA_EPS`]); also for a non-finite area.
+pub fn is_negligible(twice_area: f64, bounds: &Aabb) -> bool {
+    let d = bounds.diameter();
+    let m = bounds.min.coords.amax().max(bounds.max.coords.amax());
+    let floor = (AREA_EPS * d).max(ROUNDING_ULPS * f64::EPSILON * m) * d;
+    !(twice_area > floor && twice_area.is_finite())
 }
 
 /// Whether `v` holds at least three distinct indices.
@@ -271,15 +281,15 @@ mod tests {
                 }
             }
         }
-        // A needle along a diagonal (its corners rounded) near the origin.
+        // A needle along a diagonal, its corners rounded to the grid of where it lies.
+        let d = V3::new(1.0, 2.0, 3.0).normalize();
         for s in SCALES {
-            let d = V3::new(1.0, 2.0, 3.0) * s;
-            let pts = [
-                P3::origin() + d,
-                P3::origin() + d * 2.0,
-                P3::origin() + d * 5.0,
-            ];
-            assert_eq!(added(&pts, &[0, 1, 2]).0, 0, "diagonal needle at scale {s}");
+            for o in OFFSETS {
+                let c = P3::new(o, -o, o / 3.0);
+                let pts = [c + d * s, c + d * (2.0 * s), c + d * (5.0 * s)];
+                let (n, _) = added(&pts, &[0, 1, 2]);
+                assert_eq!(n, 0, "diagonal needle at scale {s}, offset {o}");
+            }
         }
     }
 
