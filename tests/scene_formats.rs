@@ -619,3 +619,109 @@ fn a_split_scene_keeps_the_up_axis_it_was_loaded_with() {
     let after = split.scene.aabb();
     assert_box("split", &after, before.min.into(), before.max.into(), 1e-12);
 }
+
+/// `sphere.ply` (a closed icosphere of radius 1) with its vertices times `k`, as ASCII PLY;
+/// and its number of triangles.
+fn shrunk_sphere_ply(k: f64) -> (String, usize) {
+    let text = std::fs::read_to_string(formats("sphere.ply")).unwrap();
+    let (head, body) = text.split_once("end_header\n").unwrap();
+    let count = |what: &str| -> usize {
+        let line = head.lines().find_map(|l| l.strip_prefix(what)).unwrap();
+        line.trim().parse().unwrap()
+    };
+    let (vertices, faces) = (count("element vertex "), count("element face "));
+    let mut out = format!("{head}end_header\n");
+    for (i, line) in body.lines().enumerate() {
+        if i < vertices {
+            let v: Vec<String> = line
+                .split_whitespace()
+                .map(|x| (x.parse::<f64>().unwrap() * k).to_string())
+                .collect();
+            out += &v.join(" ");
+        } else {
+            out += line;
+        }
+        out.push('\n');
+    }
+    (out, faces)
+}
+
+/// A URDF's sensor link a few micrometres across (its mesh in the file's millimetres, scaled by
+/// 0.001), 60 units from the origin, beside a link of ordinary size: every face is kept, since
+/// a face is judged by its own shape and never by the scene's size; the robot records and the
+/// recording verifies. A needle in a link's mesh is still dropped, in a warning naming the URDF.
+#[test]
+fn a_micrometre_link_far_from_the_origin_keeps_every_face_and_records() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    std::fs::copy(formats("idler_riser.STL"), d.join("base.stl")).unwrap();
+    let (ply, sensor_faces) = shrunk_sphere_ply(0.004);
+    std::fs::write(d.join("sensor.ply"), ply).unwrap();
+    let robot = |sensor_mesh: &str| {
+        format!(
+            "<robot name=\"arm\">\
+             <link name=\"base\"><visual><geometry><mesh filename=\"base.stl\"/></geometry>\
+             </visual></link>\
+             <link name=\"sensor\"><visual><geometry><mesh filename=\"{sensor_mesh}\" \
+             scale=\"0.001 0.001 0.001\"/></geometry></visual></link>\
+             <joint name=\"mount\" type=\"fixed\"><parent link=\"base\"/><child link=\"sensor\"/>\
+             <origin xyz=\"40 44 -5\" rpy=\"0.3 -0.2 1.1\"/></joint></robot>"
+        )
+    };
+    std::fs::write(d.join("arm.urdf"), robot("sensor.ply")).unwrap();
+    let l =
+        load_path(&d.join("arm.urdf"), &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    let base_faces = load_path(&formats("idler_riser.STL"), &Z_UP)
+        .unwrap()
+        .scene
+        .len();
+    let mut per_link = [0usize; 2];
+    for i in 0..l.scene.len() {
+        per_link[l.scene.object(i) as usize] += 1;
+    }
+    assert_eq!(per_link, [base_faces, sensor_faces]);
+    // The sensor is where the joint puts it, and as small as its file says (radius 4e-6).
+    let sensor = Aabb::from_points(
+        (0..l.scene.len())
+            .filter(|&i| l.scene.object(i) == 1)
+            .flat_map(|i| l.scene.prim_vertices(i)),
+    );
+    assert!(
+        (sensor.center().coords.norm() - 59.674).abs() < 1e-3,
+        "{sensor:?}"
+    );
+    assert!(
+        sensor.diameter() > 1e-5 && sensor.diameter() < 1.4e-5,
+        "{sensor:?}"
+    );
+    for args in [
+        &[
+            "record",
+            "arm.urdf",
+            "-o",
+            "arm",
+            "--wrapper",
+            "sphere,hull,box,obb",
+        ][..],
+        &["replay", "arm.mcap", "--verify"],
+    ] {
+        let (code, err) = run(args, d);
+        assert_eq!(code, 0, "{args:?}: {err}");
+        assert!(!err.contains("dropped"), "{args:?}: {err}");
+    }
+    // The same link with one face a needle (its three corners on a line): that face alone goes.
+    let mut obj = String::new();
+    for i in 0..3 {
+        obj += &format!("v {} 0 0\n", i as f64 * 1e-3);
+    }
+    obj += "v 0 1e-3 0\nf 1 2 4\nf 1 2 3\n";
+    std::fs::write(d.join("needle.obj"), obj).unwrap();
+    std::fs::write(d.join("needle.urdf"), robot("needle.obj")).unwrap();
+    let l = load_path(&d.join("needle.urdf"), &LoadOptions::default()).unwrap();
+    assert_eq!(l.scene.len(), base_faces + 1);
+    assert_eq!(
+        l.warnings,
+        ["needle.urdf: dropped 1 degenerate faces (fewer than 3 distinct vertices or zero area)"]
+    );
+}

@@ -14,7 +14,7 @@ use super::Scene;
 use super::load::{LoadError, LoadErrorKind, LoadOptions, MAX_COORDINATE, Up};
 use super::obj::polygon::{self, PolygonStats};
 use super::obj::polyhedron::{self, PolyhedronStats};
-use crate::geom::{Aabb, P3};
+use crate::geom::P3;
 
 /// Faces over a vertex list, each in one named object.
 #[derive(Clone, Debug, Default)]
@@ -249,14 +249,13 @@ pub(crate) fn build(
         }
         warnings.extend(stats.warnings());
     } else {
-        let diag = Aabb::from_points(&scene.points).diameter();
         let mut stats = PolygonStats {
             degenerate: faces.short,
             ..PolygonStats::default()
         };
         let mut scratch = polygon::Scratch::default();
         for (f, o) in faces.faces() {
-            polygon::add(&mut scene, &face_verts(f), diag, &mut stats, &mut scratch);
+            polygon::add(&mut scene, &face_verts(f), &mut stats, &mut scratch);
             objects.resize(scene.len(), o);
         }
         warnings.extend(stats.warnings());

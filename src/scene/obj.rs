@@ -157,7 +157,6 @@ fn load_piped_from(
                 .map(|w| format!("{file_name}: {w}")),
         );
     } else {
-        let diag = crate::geom::Aabb::from_points(&scene.points).diameter();
         let mut stats = PolygonStats {
             degenerate: scanned.short_faces,
             ..PolygonStats::default()
@@ -165,7 +164,7 @@ fn load_piped_from(
         let mut scratch = polygon::Scratch::default();
         for (g, &id) in groups.iter().zip(&group_ids) {
             for face in g.faces() {
-                polygon::add(&mut scene, face, diag, &mut stats, &mut scratch);
+                polygon::add(&mut scene, face, &mut stats, &mut scratch);
             }
             scene.objects.resize(scene.len(), id);
         }

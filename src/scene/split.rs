@@ -11,7 +11,9 @@ use super::{LoadError, LoadOptions, Loaded, PrimitiveKind, Scene, load_bytes};
 use crate::geom::pca::Frame;
 use crate::geom::{P3, V3};
 
-/// Relative second extent below which a primitive counts as degenerate and is not split.
+/// Relative second extent below which a primitive counts as degenerate and is not split: like
+/// the loader's [`AREA_EPS`](super::obj::polygon::AREA_EPS), relative to the primitive's own size
+/// (its first extent), never the scene's.
 pub const DEGENERATE_REL: f64 = 1e-12;
 
 /// Smallest aspect limit used; lower values are raised to it.
@@ -295,6 +297,21 @@ mod tests {
                 aspect(&p)
             );
         }
+    }
+
+    /// A 3.6 µm sliver (aspect 18) 60 units from the origin, beside a unit triangle: it is split like any
+    /// other, and every piece survives loading the split scene back.
+    #[test]
+    fn a_tiny_polygon_far_from_the_origin_is_split_and_its_pieces_load() {
+        let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\n\
+                   v 40 44 -5\nv 40.000004 44 -5\nv 40.000004 44.0000002 -5\nv 40 44.0000002 -5\n\
+                   f 1 2 3\nf 4 5 6 7\n";
+        let loaded = load_bytes("far.obj", obj.into(), &LoadOptions::default()).unwrap();
+        assert_eq!(loaded.scene.len(), 2);
+        let (split, st) = split_loaded(loaded, 4.0).unwrap();
+        assert_eq!((st.split, st.pieces), (1, 5));
+        assert_eq!(split.scene.len(), 6);
+        assert!(split.warnings.is_empty(), "{:?}", split.warnings);
     }
 
     #[test]

@@ -98,7 +98,7 @@ pub fn add(
         .collect();
     let pts: Vec<P3> = verts.iter().map(|&i| scene.points[i as usize]).collect();
     let diag = Aabb::from_points(&pts).diameter();
-    let centroid = P3::from(pts.iter().map(|p| p.coords).sum::<V3>() / pts.len() as f64);
+    let centroid = mean(pts.iter().copied());
     let keep = |scene: &mut Scene| {
         scene.push(PrimitiveKind::Polyhedron, &verts, &tris);
         scene.labels.push(name.to_string());
@@ -128,15 +128,18 @@ pub fn add(
         .collect();
     let tol = CONVEX_EPS * diag;
     let inside = |q: &P3| planes.iter().all(|(n, a)| n.dot(&(q - a)) < -tol);
-    let face_centroid = |f: &[u32]| {
-        P3::from(
-            f.iter()
-                .map(|&i| scene.points[i as usize].coords)
-                .sum::<V3>()
-                / f.len() as f64,
-        )
+    // A face centroid's height over a plane is the mean of its vertices' heights: no centroid
+    // is rounded to the (possibly far coarser) grid of absolute coordinates.
+    let centroid_inside = |f: &[u32]| {
+        planes.iter().all(|(n, a)| {
+            let h: f64 = f
+                .iter()
+                .map(|&i| n.dot(&(scene.points[i as usize] - a)))
+                .sum();
+            h / (f.len() as f64) < -tol
+        })
     };
-    let convex = !pts.iter().any(inside) && !faces.iter().any(|f| inside(&face_centroid(f)));
+    let convex = !pts.iter().any(inside) && !faces.iter().any(|f| centroid_inside(f));
     if convex {
         keep(scene);
         return Ok(());
@@ -150,6 +153,14 @@ pub fn add(
     scene.push(PrimitiveKind::Polyhedron, &hull_verts, &hull_tris);
     scene.labels.push(name.to_string());
     Ok(())
+}
+
+/// The mean of `pts` (at least one), summed as offsets from the first so that a small group far
+/// from the origin is not moved by the rounding of large coordinates.
+fn mean(mut pts: impl Iterator<Item = P3>) -> P3 {
+    let base = pts.next().expect("a point");
+    let (sum, n) = pts.fold((V3::zeros(), 1.0), |(s, n), p| (s + (p - base), n + 1.0));
+    base + sum / n
 }
 
 /// Whether the points' smallest covariance eigenvalue is ≤ `FLAT_EPS` × `diag`².
@@ -196,4 +207,42 @@ fn hull(pts: &[P3], ids: &[u32], origin: &P3) -> Option<(Vec<u32>, Vec<[u32; 3]>
         })
         .collect::<Option<_>>()?;
     (hv.len() >= 4 && !ht.is_empty()).then_some((hv, ht))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A closed octahedron of radius `r` centred at `c`, tilted so that no coordinate is round.
+    fn octahedron(r: f64, c: P3) -> (Scene, Vec<[u32; 3]>) {
+        let mut s = Scene::new("t");
+        let rot = nalgebra::Rotation3::from_euler_angles(0.3, -0.2, 1.1);
+        for d in [V3::x(), -V3::x(), V3::y(), -V3::y(), V3::z(), -V3::z()] {
+            s.points.push(c + rot * d * r);
+        }
+        let faces = vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        (s, faces)
+    }
+
+    #[test]
+    fn a_tiny_convex_group_far_from_the_origin_is_kept_as_drawn() {
+        for (r, o) in [(1.0, 0.0), (2e-6, 60.0), (1e-6, 1e6), (1e-3, -1e9)] {
+            let (mut scene, faces) = octahedron(r, P3::new(o, -o, 0.7 * o));
+            let faces: Vec<&[u32]> = faces.iter().map(|f| &f[..]).collect();
+            let mut stats = PolyhedronStats::default();
+            add(&mut scene, "oct", &faces, true, &mut stats).unwrap();
+            assert_eq!(scene.len(), 1);
+            assert_eq!(scene.prim(0).len(), 6, "radius {r} at {o}");
+            assert_eq!(stats, PolyhedronStats::default(), "radius {r} at {o}");
+        }
+    }
 }
