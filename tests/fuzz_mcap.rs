@@ -224,7 +224,8 @@ enum Edit {
     /// Rename the k-th schema.
     SchemaRename(usize),
     /// XOR a byte of the embedded scene with the mask, or cut the scene there without one;
-    /// with `true` the recorded hash is updated to match.
+    /// with `true` the recorded hash is updated to match (and a compressed scene is edited
+    /// decompressed, else in its compressed bytes).
     Scene(f64, Option<u8>, bool),
 }
 
@@ -335,10 +336,19 @@ fn apply(m: &mut Model, e: &Edit) {
             let Some(name) = r.get("scene_file").cloned() else {
                 return;
             };
-            let Some(att) = m.attachments.iter_mut().find(|a| a.0 == name) else {
+            let zst = format!("{name}.zst");
+            let Some(att) = m.attachments.iter_mut().find(|a| a.0 == name || a.0 == zst) else {
                 return;
             };
-            let data = &mut att.2;
+            // A compressed scene is edited decompressed and compressed again when the hash is
+            // updated (reaching the scene loader), else (or when an earlier edit broke it) in its
+            // compressed bytes (reaching the decompression and the hash check).
+            let decompressed = (att.0 == zst && rehash)
+                .then(|| zstd::decode_all(&att.2[..]).ok())
+                .flatten();
+            let recompress = decompressed.is_some();
+            let mut plain = decompressed.unwrap_or_else(|| std::mem::take(&mut att.2));
+            let data = &mut plain;
             match mask {
                 Some(mask) if !data.is_empty() => {
                     let i = at(p, data.len() - 1);
@@ -350,6 +360,10 @@ fn apply(m: &mut Model, e: &Edit) {
             if rehash {
                 r.insert("scene_sha256".into(), sha256_hex(data));
             }
+            att.2 = match recompress {
+                true => zstd::encode_all(&plain[..], 3).expect("compresses"),
+                false => plain,
+            };
         }
         _ => {}
     }

@@ -6,7 +6,9 @@ Usage: python3 tests/mcap_check.py FILE.mcap N
 Uses only PyPI readers: `mcap` (with CRC validation), `mcap-protobuf-support` (decodes every
 message with the schema embedded in the file) and `foxglove-schemas-protobuf` (decodes every
 SceneUpdate again with the official schema). Checks:
-  - every message on every channel decodes; the wraptree metadata and scene attachment exist;
+  - every message on every channel decodes; the wraptree metadata and scene attachment exist,
+    the scene as it is (`model/obj`) or compressed (`<scene_file>.zst`, `application/zstd`,
+    decompressed with `zstandard`), and its SHA-256 is the metadata's `scene_sha256`;
   - /grouping/merge holds N-1 messages with steps 0..N-2 and log times increase;
   - for a finished run recorded with levels, /levels/0 .. /levels/<levels_written - 1> (the
     metadata key; depth_max + 1 with --all-levels) each hold one
@@ -27,16 +29,18 @@ Exits 0 and prints one summary line on success; prints `mcap_check: FAIL ...` an
 otherwise (2 when a required module is missing).
 """
 
+import hashlib
 import math
 import sys
 
 try:
+    import zstandard
     from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
     from mcap.reader import make_reader
     from mcap_protobuf.decoder import DecoderFactory
 except ImportError as e:  # CI installs them; a missing module must not pass silently
     print(f"mcap_check: FAIL missing Python module ({e}); "
-          "pip install mcap mcap-protobuf-support foxglove-schemas-protobuf", file=sys.stderr)
+          "pip install mcap mcap-protobuf-support foxglove-schemas-protobuf zstandard", file=sys.stderr)
     sys.exit(2)
 
 
@@ -252,9 +256,17 @@ def check_cover(updates, run, vertices, tol, hull_tol):
     return size
 
 
+def cube_corners(c):
+    """Lower and upper corners of an axis-aligned CubePrimitive."""
+    p, s = c.pose.position, c.size
+    return ((p.x - s.x / 2, p.y - s.y / 2, p.z - s.z / 2),
+            (p.x + s.x / 2, p.y + s.y / 2, p.z + s.z / 2))
+
+
 def check_detail_topics(run, merges, bodies, active):
     """Per-round active sets with merges/full; per-merge boxes (pair, then the new body, whose
-    box is the merge event's AABB) with full only."""
+    box is the merge event's AABB, or the union of the pair's where the event leaves it out)
+    with full only."""
     detail = run["detail"]
     want_active = int(run["rounds"]) if detail in ("merges", "full") else 0
     if len(active) != want_active:
@@ -272,13 +284,37 @@ def check_detail_topics(run, merges, bodies, active):
         cubes = [c for e in update.entities for c in e.cubes]
         if len(cubes) != 3:
             fail(f"/grouping/bodies message {i} has {len(cubes)} boxes, expected 3")
-        new, lo, hi = cubes[2], (m.min_x, m.min_y, m.min_z), (m.max_x, m.max_y, m.max_z)
+        new = cubes[2]
+        lo, hi = (m.min_x, m.min_y, m.min_z), (m.max_x, m.max_y, m.max_z)
+        if lo + hi == (0.0,) * 6:  # left out (read as 0): the union of the pair's boxes
+            corners = [cube_corners(c) for c in cubes[:2]]
+            lo = tuple(min(c[0][k] for c in corners) for k in range(3))
+            hi = tuple(max(c[1][k] for c in corners) for k in range(3))
         centre = (new.pose.position.x, new.pose.position.y, new.pose.position.z)
         size = (new.size.x, new.size.y, new.size.z)
         for k in range(3):
             tol = 1e-9 * max(1.0, abs(lo[k]), abs(hi[k]))
             if abs(centre[k] - (lo[k] + hi[k]) / 2) > tol or abs(size[k] - (hi[k] - lo[k])) > tol:
                 fail(f"/grouping/bodies message {i}: new body's box is not merge {i}'s AABB")
+
+
+def check_scene_attachment(run, attachments):
+    """The scene file is attached as it is or compressed, and hashes to `scene_sha256`."""
+    name = run.get("scene_file")
+    scene = None
+    for a_name, media_type, data in attachments:
+        if a_name == name and media_type == "model/obj":
+            scene = data
+        elif a_name == f"{name}.zst" and media_type == "application/zstd":
+            try:
+                scene = zstandard.ZstdDecompressor().stream_reader(data).read()
+            except zstandard.ZstdError as e:
+                fail(f"scene attachment {a_name!r} does not decompress: {e}")
+    if scene is None:
+        have = [(n, mt, len(d)) for n, mt, d in attachments]
+        fail(f"scene attachment {name!r} missing (have {have})")
+    if hashlib.sha256(scene).hexdigest() != run.get("scene_sha256"):
+        fail(f"scene attachment of {name!r} does not match scene_sha256")
 
 
 def main():
@@ -296,7 +332,7 @@ def main():
     with open(path, "rb") as f:
         reader = make_reader(f, validate_crcs=True, decoder_factories=[DecoderFactory()])
         meta = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
-        attachments = [(a.name, a.media_type, len(a.data)) for a in reader.iter_attachments()]
+        attachments = [(a.name, a.media_type, bytes(a.data)) for a in reader.iter_attachments()]
         try:
             for schema, channel, message, decoded in reader.iter_decoded_messages():
                 topic = channel.topic
@@ -326,8 +362,7 @@ def main():
     run = meta.get("wraptree")
     if run is None:
         fail("no `wraptree` metadata record")
-    if not any(name == run.get("scene_file") and mt == "model/obj" for name, mt, _ in attachments):
-        fail(f"scene attachment {run.get('scene_file')!r} missing (have {attachments})")
+    check_scene_attachment(run, attachments)
     if int(run["primitives"]) != n:
         fail(f"metadata says {run['primitives']} primitives, expected {n}")
     if len(merges) != n - 1:

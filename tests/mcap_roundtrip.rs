@@ -363,12 +363,14 @@ impl Seek for FailAfter {
     }
 }
 
-/// Records `loaded` at full detail into `sink`, returning `finish`'s result (or `new`'s error).
+/// Records `loaded` at full detail into `sink`, chunks uncompressed (so that a few MB of scene
+/// give a file of several chunks), returning `finish`'s result (or `start`'s error).
 fn record_into<W: Write + Seek>(loaded: &Loaded, sink: W) -> anyhow::Result<W> {
     let params = Params::default();
     let resolved = params.resolve(&loaded.scene);
     let info = run_info(loaded, &resolved, Detail::Full);
-    let mut rec = McapRecorder::new(sink, &info)?;
+    let mut rec = McapRecorder::start(sink, &info, wraptree::record::mcap::Compression::None)?;
+    rec.write_scene();
     let g = group(&loaded.scene, &params, &mut rec);
     let spheres = sphere_tree(&g.tree, &loaded.scene, SphereMethod::default());
     let outcome = Outcome {
@@ -515,25 +517,20 @@ fn record_cli_cover_level_passes_the_python_checker() {
     assert!(!m.contains_key("cover_budget"));
 }
 
-/// The chunks are compressed as asked, `auto` picks by scene size, and every kind reads back
-/// to the same run.
+/// The chunks are compressed as asked (zstd by default), the scene is attached compressed
+/// unless nothing is, and every kind reads back to the same run and scene.
 #[test]
 fn chunks_are_compressed_as_asked_and_read_back_alike() {
-    use wraptree::record::mcap::{AUTO_UNCOMPRESSED_FROM, Compression};
-    assert_eq!(Compression::Auto.for_scene(3), Compression::Lz4);
-    assert_eq!(
-        Compression::Auto.for_scene(AUTO_UNCOMPRESSED_FROM),
-        Compression::None
-    );
-    assert_eq!(Compression::Zstd.for_scene(10_000_000), Compression::Zstd);
+    use wraptree::record::mcap::Compression;
+    assert_eq!(Compression::default(), Compression::Zstd);
     let loaded = load_grid();
     let params = Params::default();
     let resolved = params.resolve(&loaded.scene);
     let info = run_info(&loaded, &resolved, Detail::Full);
     let mut merges = Vec::new();
+    let mut scenes = Vec::new();
     for (kind, name) in [
         (Compression::None, ""),
-        (Compression::Auto, "lz4"),
         (Compression::Lz4, "lz4"),
         (Compression::Zstd, "zstd"),
     ] {
@@ -546,10 +543,33 @@ fn chunks_are_compressed_as_asked_and_read_back_alike() {
         for c in &summary.chunk_indexes {
             assert_eq!(c.compression, name, "{kind:?}");
         }
+        let attached: Vec<_> = summary
+            .attachment_indexes
+            .iter()
+            .map(|a| (a.name.as_str(), a.media_type.as_str(), a.data_size))
+            .collect();
+        let file = &loaded.source.file_name;
+        let size = loaded.source.bytes.len() as u64;
+        match kind {
+            Compression::None => assert_eq!(attached, [(file.as_str(), "model/obj", size)]),
+            _ => {
+                let zst = format!("{file}.zst");
+                assert_eq!(attached.len(), 1, "{attached:?}");
+                assert_eq!(attached[0].0, zst);
+                assert_eq!(attached[0].1, "application/zstd");
+                assert!(
+                    attached[0].2 < size,
+                    "{attached:?}, {size} bytes uncompressed"
+                );
+            }
+        }
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("c.mcap");
         std::fs::write(&path, &bytes).unwrap();
-        merges.push(read_recording(&path).unwrap().merges);
+        let rec = read_recording(&path).unwrap();
+        merges.push(rec.merges);
+        scenes.push(rec.scene_bytes);
     }
     assert!(merges.iter().all(|m| *m == merges[0] && !m.is_empty()));
+    assert!(scenes.iter().all(|s| *s == loaded.source.bytes));
 }

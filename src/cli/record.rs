@@ -55,9 +55,9 @@ pub struct RecordCmd {
     /// Wrapper kinds the cover chooses from, comma-separated: sphere, box (or aabb), obb, hull.
     #[arg(long, default_value = "sphere,box,hull", value_delimiter = ',', value_parser = WrapperKind::parse)]
     cover_kinds: Vec<WrapperKind>,
-    /// Compress the .mcap's chunks: auto (lz4 below 500,000 primitives, none from there on),
-    /// none (fastest to write and read), lz4, or zstd (smallest).
-    #[arg(long, value_enum, default_value_t = Compression::Auto)]
+    /// Compress the .mcap's chunks: zstd (smallest; `auto` is the same), lz4 (faster), or none
+    /// (fastest to write and read, the scene attached uncompressed too).
+    #[arg(long, value_enum, default_value_t = Compression::default())]
     mcap_compression: Compression,
     /// Write every level to the .mcap (default: from the root down to the last level whose cut
     /// is less than half leaves; the .rrd always has every level).

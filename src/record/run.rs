@@ -56,7 +56,7 @@ pub struct RecordOptions {
     /// Refine the finished tree with these parameters ([`crate::refine`]), recording each
     /// move; the levels are then the refined tree's.
     pub refine: Option<crate::refine::RefineParams>,
-    /// How the `.mcap`'s chunks are compressed.
+    /// How the `.mcap`'s chunks and attached scene are compressed.
     pub mcap_compression: Compression,
     /// Live streams that see the run as it is recorded (`--connect`, `--serve`, `--spawn`,
     /// `--foxglove-ws`), started with [`Live::start`]; the files are the same with or without.
@@ -65,7 +65,7 @@ pub struct RecordOptions {
 
 impl Default for RecordOptions {
     /// Full detail, sphere Wrapper Trees, no cover, no limits, existing files kept,
-    /// `.mcap` chunks compressed as [`Compression::Auto`] decides.
+    /// `.mcap` chunks and attached scene compressed with Zstandard.
     fn default() -> Self {
         RecordOptions {
             detail: Detail::Full,
@@ -77,7 +77,7 @@ impl Default for RecordOptions {
             cover: None,
             all_levels: false,
             refine: None,
-            mcap_compression: Compression::Auto,
+            mcap_compression: Compression::default(),
             live: Live::default(),
         }
     }

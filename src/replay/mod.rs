@@ -22,11 +22,11 @@ use crate::grouping::{
 };
 use crate::output::with_ext;
 use crate::record::compare::{CompareRun, divergence, write_comparison};
-use crate::record::mcap::{Recorded, read_recording};
+use crate::record::mcap::{Recorded, read_with_scene};
 use crate::record::{RecordOptions, Written, record};
 use crate::refine::{self, Step};
-use crate::scene::{Loaded, load_bytes};
-use anyhow::{Context, Result, bail};
+use crate::scene::Loaded;
+use anyhow::{Result, bail};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -97,21 +97,7 @@ pub fn open(path: &Path) -> Result<Replay> {
     if let Some(why) = not_an_mcap(path) {
         bail!("{why}");
     }
-    let rec = read_recording(path)?;
-    let name = path.display().to_string();
-    let loaded = load_bytes(
-        &rec.scene_file_name,
-        rec.scene_bytes.clone(),
-        &rec.load_options,
-    )
-    .with_context(|| format!("{name}: the embedded scene does not load"))?;
-    if loaded.scene.len() as u32 != rec.primitives {
-        bail!(
-            "{name}: the embedded scene has {} primitives, the metadata says {}",
-            loaded.scene.len(),
-            rec.primitives
-        );
-    }
+    let (rec, loaded) = read_with_scene(path)?;
     Ok(Replay { rec, loaded })
 }
 

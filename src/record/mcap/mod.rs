@@ -21,7 +21,7 @@ mod read;
 pub mod scene_msgs;
 
 pub use compare::write_comparison_mcap;
-pub use read::{Recorded, read_recording};
+pub use read::{Recorded, read_recording, read_with_scene};
 
 use crate::events::{RefineParams, Step};
 use crate::geom::Aabb;
@@ -36,45 +36,35 @@ use std::collections::BTreeMap;
 use std::io::{Seek, Write};
 
 /// LZ4 level of every chunk with [`Compression::Lz4`]: 0, the fast (not high-compression)
-/// mode: faster than Zstandard, for chunks a little larger (`docs/recordings.md`, "Sizes").
+/// mode.
 pub const LZ4_LEVEL: u32 = 0;
-/// Zstandard level of every chunk with [`Compression::Zstd`].
-pub const ZSTD_LEVEL: u32 = 2;
-
-/// Scenes of at least this many primitives get uncompressed chunks under
-/// [`Compression::Auto`]: there LZ4 costs about as much as the grouping for a file little
-/// smaller (`docs/recordings.md`, "`.mcap` (Foxglove)").
-pub const AUTO_UNCOMPRESSED_FROM: usize = 500_000;
+/// Zstandard level of every chunk with [`Compression::Zstd`] and of the attached scene
+/// (`docs/recordings.md`, "Sizes").
+pub const ZSTD_LEVEL: u32 = 3;
 
 /// How the `.mcap`'s chunks are compressed (`record --mcap-compression`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
 pub enum Compression {
-    /// LZ4 below [`AUTO_UNCOMPRESSED_FROM`] primitives, none from there on.
+    /// Zstandard, level [`ZSTD_LEVEL`], single-threaded: the smallest (also accepted as `auto`,
+    /// its former name).
     #[default]
-    Auto,
-    /// Not at all: the fastest to write and to read, 25–30 % larger than LZ4 on real scenes.
-    None,
-    /// LZ4 frames, fast mode ([`LZ4_LEVEL`]), single-threaded.
-    Lz4,
-    /// Zstandard, level [`ZSTD_LEVEL`], single-threaded: the smallest, the slowest.
+    #[value(alias = "auto")]
     Zstd,
-}
-
-impl Compression {
-    /// The compression used for a scene of `n` primitives ([`Compression::Auto`] decided).
-    pub fn for_scene(self, n: usize) -> Compression {
-        match self {
-            Compression::Auto if n >= AUTO_UNCOMPRESSED_FROM => Compression::None,
-            Compression::Auto => Compression::Lz4,
-            c => c,
-        }
-    }
+    /// LZ4 frames, fast mode ([`LZ4_LEVEL`]), single-threaded: faster, larger.
+    Lz4,
+    /// Not at all, the scene attached as it is: the fastest to write and to read.
+    None,
 }
 
 /// Target uncompressed chunk size.
 pub const CHUNK_SIZE: u64 = 1 << 20;
-/// Media type of the embedded scene.
+/// Media type of the embedded scene, attached as it is (`--mcap-compression none`).
 pub const SCENE_MEDIA_TYPE: &str = "model/obj";
+/// Media type of the embedded scene compressed with Zstandard, attached as
+/// `<scene file>`[`ZSTD_SUFFIX`].
+pub const ZSTD_MEDIA_TYPE: &str = "application/zstd";
+/// Appended to the scene file's name when it is attached compressed.
+pub const ZSTD_SUFFIX: &str = ".zst";
 /// The MCAP header's profile (none of the registered profiles applies).
 pub const PROFILE: &str = "";
 /// The MCAP header's library string.
@@ -128,6 +118,8 @@ pub struct McapRecorder<'a, W: Write + Seek> {
     refine: Option<(metadata::RefineSummary, Topic)>,
     reproducible: bool,
     all_levels: bool,
+    /// Whether the scene is attached as it is (`--mcap-compression none`), not compressed.
+    raw_scene: bool,
     error: Option<anyhow::Error>,
     buf: Vec<u8>,
 }
@@ -178,6 +170,8 @@ fn write_options(compression: Option<mcap::Compression>, level: u32) -> mcap::Wr
     mcap::WriteOptions::new()
         .compression(compression)
         .compression_level(level)
+        // One thread: zstd's multithreaded mode gives other bytes than its single-threaded one.
+        .compression_threads(0)
         .chunk_size(Some(CHUNK_SIZE))
         .use_chunks(true)
         // Each chunk is built in memory and then appended: the file is written front to
@@ -217,11 +211,11 @@ fn emit<T: Encode, W: Write + Seek>(
 }
 
 impl<'a, W: Write + Seek> McapRecorder<'a, W> {
-    /// Starts a recording with [`Compression::Auto`]: writes the header, schemas, channels, the
+    /// Starts a recording with the default [`Compression`]: writes the header, schemas, channels, the
     /// `/scene` message and the scene attachment ([`McapRecorder::start`] then
     /// [`McapRecorder::write_scene`]).
     pub fn new(writer: W, info: &RunInfo<'a>) -> Result<Self> {
-        let mut rec = Self::start(writer, info, Compression::Auto)?;
+        let mut rec = Self::start(writer, info, Compression::default())?;
         rec.write_scene();
         match rec.error.take() {
             Some(e) => Err(e),
@@ -244,8 +238,8 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
         compression: Compression,
         live: Option<McapTee>,
     ) -> Result<Self> {
-        let (compression, level) = match compression.for_scene(info.scene.len()) {
-            Compression::None | Compression::Auto => (None, 0),
+        let (compression, level) = match compression {
+            Compression::None => (None, 0),
             Compression::Lz4 => (Some(mcap::Compression::Lz4), LZ4_LEVEL),
             Compression::Zstd => (Some(mcap::Compression::Zstd), ZSTD_LEVEL),
         };
@@ -290,13 +284,15 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             refine: None,
             reproducible: false,
             all_levels: false,
+            raw_scene: compression.is_none(),
             error: None,
             buf: Vec::new(),
             scene_topic,
         })
     }
 
-    /// Writes the `/scene` message (every primitive, once) and attaches the scene file; must
+    /// Writes the `/scene` message (every primitive, once) and attaches the scene file
+    /// (compressed unless the chunks are not); must
     /// come before the first event. A failure is kept and returned by [`McapRecorder::finish`],
     /// like a write error during the run.
     pub fn write_scene(&mut self) {
@@ -316,13 +312,23 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             0,
             &update,
         )?;
+        let source = &self.info.source;
+        let (name, media_type, data) = if self.raw_scene {
+            let data = std::borrow::Cow::Borrowed(&source.bytes[..]);
+            (source.file_name.clone(), SCENE_MEDIA_TYPE, data)
+        } else {
+            let data = zstd::bulk::compress(&source.bytes, ZSTD_LEVEL as i32)
+                .context("compressing the scene")?;
+            let name = format!("{}{ZSTD_SUFFIX}", source.file_name);
+            (name, ZSTD_MEDIA_TYPE, std::borrow::Cow::Owned(data))
+        };
         self.writer
             .attach(&mcap::Attachment {
                 log_time: 0,
                 create_time: 0,
-                name: self.info.source.file_name.clone(),
-                media_type: SCENE_MEDIA_TYPE.to_string(),
-                data: std::borrow::Cow::Borrowed(&self.info.source.bytes),
+                name,
+                media_type: media_type.to_string(),
+                data,
             })
             .context("attaching the scene")?;
         Ok(())
@@ -442,11 +448,17 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
         emit(&mut self.writer, &mut self.buf, active_topic, t, &update)
     }
 
-    /// A merge on `/grouping/merge`; keeps the new body's box, and with `--detail full` draws
-    /// the pair and the new body on `/grouping/bodies` for the last [`BODIES_CAP`] merges.
+    /// A merge on `/grouping/merge`, its AABB left out when it is the union of the pair's;
+    /// keeps the new body's box, and with `--detail full` draws the pair and the new body on
+    /// `/grouping/bodies` for the last [`BODIES_CAP`] merges.
     fn record_merge(&mut self, t: u64, m: &Merge) -> Result<()> {
         let (w, buf) = (&mut self.writer, &mut self.buf);
-        emit(w, buf, &mut self.topics.merge, t, &MergeEvent::from(m))?;
+        let get = |id: u32| self.bodies.get(id as usize);
+        let msg = match (get(m.a), get(m.b)) {
+            (Some(a), Some(b)) if a.merge(b) == m.aabb => MergeEvent::from(m).without_box(),
+            _ => MergeEvent::from(m),
+        };
+        emit(w, buf, &mut self.topics.merge, t, &msg)?;
         let new = m.new as usize;
         if self.bodies.len() <= new {
             self.bodies.resize(new + 1, Aabb::EMPTY);

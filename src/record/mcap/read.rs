@@ -12,8 +12,8 @@ use super::metadata;
 use crate::geom::Aabb;
 use crate::grouping::{EventLog, Merge, Part, ResolvedParams, SubsetTree};
 use crate::record::Detail;
-use crate::scene::{LoadOptions, Scene};
-use anyhow::{Result, anyhow, bail};
+use crate::scene::{LoadOptions, Loaded, Scene, load_bytes};
+use anyhow::{Context, Result, anyhow, bail};
 use mcap::records::Record;
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use sha2::{Digest, Sha256};
@@ -98,8 +98,13 @@ struct Raw {
     schemas: HashMap<u16, String>,
     channels: HashMap<u16, (String, u16, String)>,
     metadata: Vec<(String, BTreeMap<String, String>)>,
-    attachments: Vec<(String, Vec<u8>)>,
+    /// (name, media type, data) of every attachment.
+    attachments: Vec<(String, String, Vec<u8>)>,
+    /// The most bytes a record, or the attached scene decompressed, may hold.
+    limit: usize,
     merges: Vec<Merge>,
+    /// Per merge, its AABB when the message holds one (else the children's boxes give it).
+    boxes: Vec<Option<Aabb>>,
     rounds: Vec<RoundEvent>,
     dormant: Vec<DormantEvent>,
     finish: Option<FinishEvent>,
@@ -133,9 +138,12 @@ impl Raw {
         }
         let bad = |e: String| format!("bad {topic} message: {e}");
         match topic.as_str() {
-            "/grouping/merge" => self
-                .merges
-                .push(Merge::from(&MergeEvent::decode(data).map_err(bad)?)),
+            "/grouping/merge" => {
+                let decoded = MergeEvent::decode(data).and_then(|e| e.to_merge());
+                let (merge, aabb) = decoded.map_err(bad)?;
+                self.merges.push(merge);
+                self.boxes.push(aabb);
+            }
             "/grouping/round" => self.rounds.push(RoundEvent::decode(data).map_err(bad)?),
             "/grouping/dormant" => self.dormant.push(DormantEvent::decode(data).map_err(bad)?),
             "/refine/step" => self.refine.push(crate::refine::Step::from(
@@ -161,7 +169,8 @@ impl Raw {
             }
             Record::Message { header, data } => self.message(header.channel_id, &data)?,
             Record::Attachment { header, data, .. } => {
-                self.attachments.push((header.name, data.into_owned()))
+                self.attachments
+                    .push((header.name, header.media_type, data.into_owned()))
             }
             Record::Metadata(m) => self.metadata.push((m.name, m.metadata)),
             _ => {}
@@ -209,7 +218,10 @@ fn scan(bytes: &[u8]) -> Result<Raw, String> {
             .with_check_finishes_after_end_magic(true)
             .with_record_length_limit(limit),
     );
-    let mut raw = Raw::default();
+    let mut raw = Raw {
+        limit,
+        ..Raw::default()
+    };
     let mut rest = bytes;
     while let Some(event) = reader.next_event() {
         match event.map_err(|e| describe(&e))? {
@@ -252,13 +264,51 @@ fn check_merges(merges: &[Merge], n: u32, complete: bool) -> Result<(), String> 
     Ok(())
 }
 
-/// Checks what was read against the run record and assembles the [`Recorded`] run.
-fn interpret(raw: Raw) -> Result<Recorded> {
+/// The embedded scene loaded as recorded. Err: it does not load, or has another number of
+/// primitives than the metadata says.
+fn load_scene(name: &str, bytes: &[u8], options: &LoadOptions, primitives: u32) -> Result<Loaded> {
+    let loaded =
+        load_bytes(name, bytes.to_vec(), options).context("the embedded scene does not load")?;
+    if loaded.scene.len() as u64 != u64::from(primitives) {
+        bail!(
+            "the embedded scene has {} primitives, the metadata says {primitives}",
+            loaded.scene.len()
+        );
+    }
+    Ok(loaded)
+}
+
+/// Gives each merge whose message left its AABB out the union of its children's boxes: the
+/// primitives' of `scene`, then the earlier merges'. The merges must be consistent
+/// ([`check_merges`]).
+fn fill_boxes(merges: &mut [Merge], boxes: &[Option<Aabb>], scene: &Scene) {
+    let mut body: Vec<Aabb> = (0..scene.len()).map(|i| scene.prim_aabb(i)).collect();
+    for (m, aabb) in merges.iter_mut().zip(boxes) {
+        let (a, b) = (body[m.a as usize], body[m.b as usize]);
+        m.aabb = aabb.unwrap_or_else(|| a.merge(&b));
+        body.push(m.aabb);
+    }
+}
+
+/// Checks what was read against the run record, loads the embedded scene and assembles the
+/// [`Recorded`] run.
+fn interpret(mut raw: Raw) -> Result<(Recorded, Loaded)> {
     let (m, timing) = run_and_timing(raw.metadata)?;
-    let (scene_file_name, scene_bytes) = embedded_scene(raw.attachments, &m)?;
+    let (scene_file_name, scene_bytes) = embedded_scene(raw.attachments, &m, raw.limit)?;
     let complete = metadata::parse::<bool>(&m, "complete")?;
     let primitives = metadata::parse::<u32>(&m, "primitives")?;
     check_merges(&raw.merges, primitives, complete).map_err(|e| anyhow!(e))?;
+    let load_options = LoadOptions {
+        polyhedra: metadata::parse(&m, "polyhedra")?,
+        strict: metadata::parse(&m, "strict")?,
+        // Written only when the scene was loaded with an up axis (`--up`).
+        up: match m.contains_key("up") {
+            true => Some(metadata::parse(&m, "up")?),
+            false => None,
+        },
+    };
+    let loaded = load_scene(&scene_file_name, &scene_bytes, &load_options, primitives)?;
+    fill_boxes(&mut raw.merges, &raw.boxes, &loaded.scene);
     let refine = metadata::refine(&m)?;
     check_refine_steps(&raw.refine, refine.map_or(0, |r| r.steps as usize))?;
     let round_starts = raw.rounds.iter().filter(|r| !r.doubling);
@@ -266,19 +316,11 @@ fn interpret(raw: Raw) -> Result<Recorded> {
         Some(_) => metadata::parse(&m, "rounds")?,
         None => round_starts.clone().count() as u32,
     };
-    Ok(Recorded {
+    let recorded = Recorded {
         params: metadata::params(&m)?,
         detail: metadata::detail(&m)?,
         scene_name: metadata::get(&m, "scene")?.to_string(),
-        load_options: LoadOptions {
-            polyhedra: metadata::parse(&m, "polyhedra")?,
-            strict: metadata::parse(&m, "strict")?,
-            // Written only when the scene was loaded with an up axis (`--up`).
-            up: match m.contains_key("up") {
-                true => Some(metadata::parse(&m, "up")?),
-                false => None,
-            },
-        },
+        load_options,
         scene_file_name,
         scene_bytes,
         primitives,
@@ -301,7 +343,8 @@ fn interpret(raw: Raw) -> Result<Recorded> {
         parts: raw.parts,
         metadata: m,
         timing,
-    })
+    };
+    Ok((recorded, loaded))
 }
 
 /// A metadata record's keys and values.
@@ -328,15 +371,31 @@ fn run_and_timing(records: Vec<(String, KeyValues)>) -> Result<(KeyValues, KeyVa
     Ok((m, timing))
 }
 
-/// The attached scene file named by the run record `m`, with its name. Err: missing, or its
-/// SHA-256 is not the recorded one.
-fn embedded_scene(attachments: Vec<(String, Vec<u8>)>, m: &KeyValues) -> Result<(String, Vec<u8>)> {
+/// The attached scene file named by the run record `m`, with its name: attached as it is, or
+/// compressed with Zstandard as `<name>.zst` (decompressed to at most `limit` bytes). Err:
+/// missing, not decompressing, or its SHA-256 is not the recorded one.
+fn embedded_scene(
+    attachments: Vec<(String, String, Vec<u8>)>,
+    m: &KeyValues,
+    limit: usize,
+) -> Result<(String, Vec<u8>)> {
     let scene_file_name = metadata::get(m, "scene_file")?.to_string();
-    let scene_bytes = attachments
-        .into_iter()
-        .find(|(name, _)| *name == scene_file_name)
-        .map(|(_, data)| data)
-        .ok_or_else(|| anyhow!("the embedded scene `{scene_file_name}` is missing"))?;
+    let compressed = format!("{scene_file_name}{}", super::ZSTD_SUFFIX);
+    let mut found = None;
+    for (name, media_type, data) in attachments {
+        if name == scene_file_name {
+            found = Some(data);
+            break;
+        }
+        if name == compressed && media_type == super::ZSTD_MEDIA_TYPE {
+            found = Some(decompress(&data, limit).map_err(|e| {
+                anyhow!("the embedded scene `{compressed}` does not decompress: {e}")
+            })?);
+            break;
+        }
+    }
+    let scene_bytes =
+        found.ok_or_else(|| anyhow!("the embedded scene `{scene_file_name}` is missing"))?;
     let sha256: String = Sha256::digest(&scene_bytes)
         .iter()
         .map(|b| format!("{b:02x}"))
@@ -345,6 +404,21 @@ fn embedded_scene(attachments: Vec<(String, Vec<u8>)>, m: &KeyValues) -> Result<
         bail!("the embedded scene `{scene_file_name}` does not match its recorded sha256");
     }
     Ok((scene_file_name, scene_bytes))
+}
+
+/// Decompresses a Zstandard stream of at most `limit` bytes.
+fn decompress(data: &[u8], limit: usize) -> Result<Vec<u8>, String> {
+    use std::io::Read as _;
+    let decoder = zstd::stream::read::Decoder::new(data).map_err(|e| one_line(&e))?;
+    let mut out = Vec::new();
+    decoder
+        .take(limit as u64 + 1)
+        .read_to_end(&mut out)
+        .map_err(|e| one_line(&e))?;
+    if out.len() > limit {
+        return Err(format!("more than {limit} bytes"));
+    }
+    Ok(out)
 }
 
 /// Checks that the refinement steps are the `steps_named` of the metadata, numbered in order.
@@ -361,6 +435,13 @@ fn check_refine_steps(steps: &[crate::refine::Step], steps_named: usize) -> Resu
 /// Reads a wraptree `.mcap` recording. Truncated, corrupted or foreign files give one error line
 /// naming the file and the problem.
 pub fn read_recording(path: &Path) -> Result<Recorded> {
+    read_with_scene(path).map(|(recorded, _)| recorded)
+}
+
+/// Reads a wraptree `.mcap` recording and its embedded scene, loaded with the recorded options
+/// ([`read_recording`]); an embedded scene that does not load or does not match the metadata is
+/// one error line too.
+pub fn read_with_scene(path: &Path) -> Result<(Recorded, Loaded)> {
     let name = path.display();
     let bytes =
         std::fs::read(path).map_err(|e| anyhow!("{name}: cannot read: {}", one_line(&e)))?;

@@ -139,19 +139,21 @@ impl TryFrom<&PartEvent> for Part {
 }
 
 impl From<&Merge> for MergeEvent {
+    /// Every field, the AABB included.
     fn from(m: &Merge) -> Self {
+        let (lo, hi) = (m.aabb.min, m.aabb.max);
         MergeEvent {
             step: m.step,
             round: m.round,
             a: m.a,
             b: m.b,
             new: m.new,
-            min_x: m.aabb.min.x,
-            min_y: m.aabb.min.y,
-            min_z: m.aabb.min.z,
-            max_x: m.aabb.max.x,
-            max_y: m.aabb.max.y,
-            max_z: m.aabb.max.z,
+            min_x: Some(lo.x),
+            min_y: Some(lo.y),
+            min_z: Some(lo.z),
+            max_x: Some(hi.x),
+            max_y: Some(hi.y),
+            max_z: Some(hi.z),
             diameter: m.diameter,
             fill: m.fill,
             balance: m.balance,
@@ -162,25 +164,49 @@ impl From<&Merge> for MergeEvent {
     }
 }
 
-impl From<&MergeEvent> for Merge {
-    fn from(e: &MergeEvent) -> Self {
-        Merge {
-            step: e.step,
-            round: e.round,
-            a: e.a,
-            b: e.b,
-            new: e.new,
-            aabb: Aabb {
-                min: P3::new(e.min_x, e.min_y, e.min_z),
-                max: P3::new(e.max_x, e.max_y, e.max_z),
-            },
-            diameter: e.diameter,
-            fill: e.fill,
-            balance: e.balance,
-            cost: e.cost,
-            queue_len: e.queue_len,
-            active: e.active,
+impl MergeEvent {
+    /// The message without its AABB, which readers derive from the children's boxes.
+    pub fn without_box(self) -> MergeEvent {
+        MergeEvent {
+            min_x: None,
+            min_y: None,
+            min_z: None,
+            max_x: None,
+            max_y: None,
+            max_z: None,
+            ..self
         }
+    }
+
+    /// The merge, its AABB `None` when the message leaves it out. Err: only some of its six
+    /// values present.
+    pub fn to_merge(&self) -> Result<(Merge, Option<Aabb>), String> {
+        let corners = [
+            self.min_x, self.min_y, self.min_z, self.max_x, self.max_y, self.max_z,
+        ];
+        let aabb = match present(corners) {
+            Some([x0, y0, z0, x1, y1, z1]) => Some(Aabb {
+                min: P3::new(x0, y0, z0),
+                max: P3::new(x1, y1, z1),
+            }),
+            None if corners.iter().all(Option::is_none) => None,
+            None => return Err("an AABB with only some of its corners".into()),
+        };
+        let merge = Merge {
+            step: self.step,
+            round: self.round,
+            a: self.a,
+            b: self.b,
+            new: self.new,
+            aabb: aabb.unwrap_or(Aabb::EMPTY),
+            diameter: self.diameter,
+            fill: self.fill,
+            balance: self.balance,
+            cost: self.cost,
+            queue_len: self.queue_len,
+            active: self.active,
+        };
+        Ok((merge, aabb))
     }
 }
 

@@ -58,7 +58,8 @@ macro_rules! flat_message {
 }
 
 flat_message! {
-    /// One merge of step 4(a), on `/grouping/merge`: every field of [`Merge`](crate::grouping::Merge).
+    /// One merge of step 4(a), on `/grouping/merge`: every field of [`Merge`](crate::grouping::Merge),
+    /// the AABB only where the children's boxes do not give it.
     MergeEvent {
         /// 0-based merge index.
         step: u32,
@@ -70,18 +71,21 @@ flat_message! {
         b: u32,
         /// New body id (N + step).
         new: u32,
-        /// AABB lower corner, x.
-        min_x: f64,
+        /// AABB lower corner, x. This and the five below are left out when the AABB is the
+        /// union of `a`'s and `b`'s (always, in a grouping run; protobuf readers see 0, and
+        /// `replay` derives it from the scene's primitives and the earlier merges). Recordings
+        /// made before hold them.
+        min_x: Option<f64>,
         /// AABB lower corner, y.
-        min_y: f64,
+        min_y: Option<f64>,
         /// AABB lower corner, z.
-        min_z: f64,
+        min_z: Option<f64>,
         /// AABB upper corner, x.
-        max_x: f64,
+        max_x: Option<f64>,
         /// AABB upper corner, y.
-        max_y: f64,
+        max_y: Option<f64>,
         /// AABB upper corner, z.
-        max_z: f64,
+        max_z: Option<f64>,
         /// Diameter of the new body.
         diameter: f64,
         /// Fill.

@@ -30,7 +30,28 @@ fn merge_round_trips_with_distinct_values() {
         active: true,
     };
     let bytes = encode(&MergeEvent::from(&m));
-    assert_eq!(Merge::from(&MergeEvent::decode(&bytes).unwrap()), m);
+    let decoded = MergeEvent::decode(&bytes).unwrap().to_merge().unwrap();
+    assert_eq!(decoded, (m, Some(m.aabb)));
+    // Without its box the message is 54 bytes shorter and reads back without it; a box with
+    // only some corners is refused.
+    let short = encode(&MergeEvent::from(&m).without_box());
+    assert_eq!(short.len() + 6 * 9, bytes.len());
+    let (read, aabb) = MergeEvent::decode(&short).unwrap().to_merge().unwrap();
+    assert_eq!(
+        (read, aabb),
+        (
+            Merge {
+                aabb: Aabb::EMPTY,
+                ..m
+            },
+            None
+        )
+    );
+    let partial = MergeEvent {
+        max_z: None,
+        ..MergeEvent::from(&m)
+    };
+    assert!(partial.to_merge().is_err());
     let r = RoundEvent {
         doubling: true,
         round: 2,
