@@ -53,8 +53,11 @@ enum Command {
     /// Compare hierarchy builders × wrappers on scenes (CSV, charts, .rrd), or print the targets
     /// table against obvhs PLOC and parry Binned. Build times are taken as in the tables of
     /// docs/benchmarks.md: rounds that build every method in turn, the fastest build of each
-    /// kept (--repeat). Stacked coincident copies take long: their queries test every tied
-    /// pair, up to a cap. How long a bench takes: docs/benchmarks.md.
+    /// kept (--repeat). Every step's work is bounded by the scene's size (hulls from the
+    /// children's hull vertices, tightness and queries sampled or capped), so with the defaults
+    /// a scene of up to 2·10^5 primitives, assemblies of mixed-scale parts included, takes
+    /// minutes. Stacked coincident copies take longest: their queries test every tied pair, up
+    /// to a cap. How long a bench takes: docs/benchmarks.md.
     Bench(bench::BenchCmd),
     /// Run the A/B/C grid of the grouping Cost on a scene: table, heat maps, the series of every
     /// setting (sweep.rrd) and the trees of the 6 best distinct settings side by side
