@@ -317,9 +317,8 @@ fn soup(dir: &Path, name: &str, n: usize) {
 }
 
 /// Starts `record big.obj -o big --detail levels` (plus `extra`) in `dir`, sends it `signal`
-/// after 400 ms, and waits for it. The handler is installed before loading; whether the
-/// signal lands while loading or while grouping, the run stops before the root (200k triangles
-/// take over a second to load and group).
+/// 400 ms after the recording has begun, and waits for it: the run stops before the root
+/// (200k triangles take over a second to group).
 fn record_big_then_signal(dir: &Path, extra: &[&str], signal: &str) -> Output {
     let child = Command::new(env!("CARGO_BIN_EXE_wraptree"))
         .args(["record", "big.obj", "-o", "big", "--detail", "levels"])
@@ -329,6 +328,17 @@ fn record_big_then_signal(dir: &Path, extra: &[&str], signal: &str) -> Output {
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
+    // Signalled once the recording has begun (its temporary files exist) and is grouping: a
+    // stop while the scene is still loading leaves nothing, as nothing was recorded.
+    let started = || {
+        std::fs::read_dir(dir)
+            .unwrap()
+            .any(|e| e.unwrap().file_name().to_string_lossy().ends_with(".tmp"))
+    };
+    let t = std::time::Instant::now();
+    while !started() && t.elapsed() < std::time::Duration::from_secs(60) {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
     std::thread::sleep(std::time::Duration::from_millis(400));
     let kill = Command::new("kill")
         .args([signal, &child.id().to_string()])

@@ -103,24 +103,7 @@ pub fn assemble(parts: &[Part], seed: u64) -> Result<(Scene, Vec<String>), Strin
             let at = grid * cell + V3::from(jitter.map(|x| (2.0 * x - 1.0) * room));
             let rot = random_rotation(&mut rng);
             let object = names.len() as u32;
-            let off = out.points.len() as u32;
-            out.points.extend(
-                scene
-                    .points
-                    .iter()
-                    .map(|p| P3::from(at) + rot * (p - centre)),
-            );
-            let (pp, tp) = (out.prim_points.len() as u32, out.tris.len() as u32);
-            out.prim_points
-                .extend(scene.prim_points.iter().map(|i| i + off));
-            out.tris
-                .extend(scene.tris.iter().map(|t| t.map(|i| i + off)));
-            out.prim_start
-                .extend(scene.prim_start[1..].iter().map(|s| s + pp));
-            out.tri_start
-                .extend(scene.tri_start[1..].iter().map(|s| s + tp));
-            out.objects.extend(std::iter::repeat_n(object, scene.len()));
-            out.kind = out.kind.or(scene.kind);
+            out.append_copy(scene, |p| P3::from(at) + rot * (p - centre), object);
             names.push(format!("{stem}_{k}"));
         }
     }

@@ -220,33 +220,21 @@ pub fn replicate(scene: &Scene, copies: usize, seed: u64) -> Scene {
         (bbox.center(), bbox.diameter())
     };
     let side = 0.6 * diam * (copies as f64).cbrt();
-    let np = scene.points.len() as u32;
     let mut out = Scene::new(format!("{}s{copies}", scene.name));
     out.kind = scene.kind;
     for k in 0..copies {
-        if k == 0 {
-            out.points.extend_from_slice(&scene.points);
-        } else {
+        let moved = (k > 0).then(|| {
             let rot = random_rotation(&mut rng);
             let t: [f64; 3] = rng.random();
-            let shift = V3::from(t.map(|x| (x - 0.5) * side));
-            out.points
-                .extend(scene.points.iter().map(|p| c + rot * (p - c) + shift));
-        }
-        let off = k as u32 * np;
-        let (pp, tp) = (out.prim_points.len() as u32, out.tris.len() as u32);
-        out.prim_points
-            .extend(scene.prim_points.iter().map(|i| i + off));
-        out.tris
-            .extend(scene.tris.iter().map(|t| t.map(|i| i + off)));
-        out.prim_start
-            .extend(scene.prim_start[1..].iter().map(|s| s + pp));
-        out.tri_start
-            .extend(scene.tri_start[1..].iter().map(|s| s + tp));
+            (rot, V3::from(t.map(|x| (x - 0.5) * side)))
+        });
+        let place = |p: &P3| match moved {
+            Some((rot, shift)) => c + rot * (p - c) + shift,
+            None => *p,
+        };
+        out.append_copy(scene, place, k as u32);
         out.labels
             .extend(scene.labels.iter().map(|l| format!("{l}#{k}")));
-        out.objects
-            .extend(std::iter::repeat_n(k as u32, scene.len()));
     }
     out
 }

@@ -88,6 +88,24 @@ impl Scene {
         }
     }
 
+    /// Appends a copy of `part`, every vertex moved by `place`, its primitives in object
+    /// `object` (labels are not copied).
+    pub fn append_copy(&mut self, part: &Scene, place: impl Fn(&P3) -> P3, object: u32) {
+        let off = self.points.len() as u32;
+        self.points.extend(part.points.iter().map(place));
+        let (pp, tp) = (self.prim_points.len() as u32, self.tris.len() as u32);
+        self.prim_points
+            .extend(part.prim_points.iter().map(|i| i + off));
+        self.tris
+            .extend(part.tris.iter().map(|t| t.map(|i| i + off)));
+        self.prim_start
+            .extend(part.prim_start[1..].iter().map(|s| s + pp));
+        self.tri_start
+            .extend(part.tri_start[1..].iter().map(|s| s + tp));
+        self.objects.extend(std::iter::repeat_n(object, part.len()));
+        self.kind = self.kind.or(part.kind);
+    }
+
     /// Number of primitives N.
     pub fn len(&self) -> usize {
         self.prim_start.len().saturating_sub(1)
