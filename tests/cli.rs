@@ -317,7 +317,7 @@ fn soup(dir: &Path, name: &str, n: usize) {
 }
 
 /// Starts `record big.obj -o big --detail levels` (plus `extra`) in `dir`, sends it `signal`
-/// 400 ms after the recording has begun, and waits for it: the run stops before the root
+/// 400 ms after the grouping has begun, and waits for it: the run stops before the root
 /// (200k triangles take over a second to group).
 fn record_big_then_signal(dir: &Path, extra: &[&str], signal: &str) -> Output {
     let child = Command::new(env!("CARGO_BIN_EXE_wraptree"))
@@ -328,12 +328,15 @@ fn record_big_then_signal(dir: &Path, extra: &[&str], signal: &str) -> Output {
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
-    // Signalled once the recording has begun (its temporary files exist) and is grouping: a
-    // stop while the scene is still loading leaves nothing, as nothing was recorded.
+    // Signalled once the grouping has begun: the `.mcap` being written holds the compressed
+    // scene (written before the first merge, megabytes for this soup). A stop while the scene
+    // is loaded or written may leave nothing, as nothing was recorded yet.
     let started = || {
-        std::fs::read_dir(dir)
-            .unwrap()
-            .any(|e| e.unwrap().file_name().to_string_lossy().ends_with(".tmp"))
+        std::fs::read_dir(dir).unwrap().any(|e| {
+            let e = e.unwrap();
+            let name = e.file_name().to_string_lossy().into_owned();
+            name.starts_with(".big.mcap") && e.metadata().is_ok_and(|m| m.len() > 4 << 20)
+        })
     };
     let t = std::time::Instant::now();
     while !started() && t.elapsed() < std::time::Duration::from_secs(60) {
