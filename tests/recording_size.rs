@@ -8,8 +8,9 @@ use common::wraptree;
 
 /// The most bytes each file may hold per byte of the scene's OBJ. Both files of this soup take
 /// less (`docs/recordings.md`, "Sizes"); the `.mcap` with LZ4 chunks and the scene attached
-/// uncompressed, as recorded before, took about 2.4×.
-const MAX_RATIO: [(&str, f64); 2] = [("soup.rrd", 1.5), ("soup.mcap", 1.75)];
+/// uncompressed, as recorded before, took about 2.4×, and its drawn geometry (the `/scene`
+/// mesh, the levels' leaves) only compresses since it is rounded to `f32`.
+const MAX_RATIO: [(&str, f64); 2] = [("soup.rrd", 1.5), ("soup.mcap", 1.45)];
 
 #[test]
 fn a_default_recording_is_small_and_replays_without_its_scene_file() {

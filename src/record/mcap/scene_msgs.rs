@@ -40,6 +40,24 @@ fn vector(x: f64, y: f64, z: f64) -> Option<Vector3> {
     Some(Vector3 { x, y, z })
 }
 
+/// `x` rounded to `f32`, the precision viewers draw in (kept as it is beyond `f32`'s range). The
+/// low mantissa bits are then zero, so the chunk compression shrinks drawn geometry that would
+/// not shrink otherwise. Only drawn geometry is rounded: `replay` and `snapshot` read the
+/// attached scene, and merge boxes keep their exact values.
+fn shown(x: f64) -> f64 {
+    let r = f64::from(x as f32);
+    if r.is_finite() { r } else { x }
+}
+
+/// A scene or wrapper vertex as drawn (see [`shown`]).
+fn point(p: &P3) -> Point3 {
+    Point3 {
+        x: shown(p.x),
+        y: shown(p.y),
+        z: shown(p.z),
+    }
+}
+
 fn pose_at(p: &P3) -> Option<Pose> {
     Some(Pose {
         position: vector(p.x, p.y, p.z),
@@ -122,19 +140,11 @@ pub fn obb_cube(b: &Obb, rgba: [f64; 4]) -> CubePrimitive {
     }
 }
 
-/// One indexed triangle list drawing the hull `h`, its vertices once. A segment hull is one
-/// degenerate triangle `[a, b, b]` and a point hull `[a, a, a]` (they draw nothing but keep
-/// their geometry), so readers get exactly one primitive per hull.
+/// One indexed triangle list drawing the hull `h`, its vertices once ([`shown`]). A segment
+/// hull is one degenerate triangle `[a, b, b]` and a point hull `[a, a, a]` (they draw nothing
+/// but keep their geometry), so readers get exactly one primitive per hull.
 pub fn hull_triangles(h: &Hull, rgba: [f64; 4]) -> TriangleListPrimitive {
-    let points = h
-        .vertices
-        .iter()
-        .map(|p| Point3 {
-            x: p.x,
-            y: p.y,
-            z: p.z,
-        })
-        .collect();
+    let points = h.vertices.iter().map(point).collect();
     let indices = match (h.triangles.is_empty(), h.vertices.len()) {
         (false, _) => h.triangles.iter().flatten().copied().collect(),
         (true, 0) => Vec::new(),
@@ -150,20 +160,22 @@ pub fn hull_triangles(h: &Hull, rgba: [f64; 4]) -> TriangleListPrimitive {
     }
 }
 
-/// A sphere primitive: pose at the centre, size = the diameter along every axis.
+/// A sphere primitive: pose at the centre, size = the diameter along every axis (both
+/// [`shown`]).
 pub fn sphere(s: &Sphere, rgba: [f64; 4]) -> SpherePrimitive {
-    let d = 2.0 * s.radius;
+    let d = shown(2.0 * s.radius);
+    let c = s.center.map(shown);
     SpherePrimitive {
-        pose: pose_at(&s.center),
+        pose: pose_at(&c),
         size: vector(d, d, d),
         color: color(rgba),
     }
 }
 
 /// An indexed triangle list of scene primitives, built up by [`SceneMesh::add`]: each scene
-/// vertex the primitives use appears once in `points`, and the triangles index it (unless the
-/// index is the identity). Adding keeps what is there, so nested sets (the leaves of successive
-/// levels) are built once.
+/// vertex the primitives use appears once in `points` ([`shown`]), and the triangles index it
+/// (unless the index is the identity). Adding keeps what is there, so nested sets (the leaves
+/// of successive levels) are built once.
 #[derive(Debug)]
 pub struct SceneMesh<'s> {
     scene: &'s Scene,
@@ -193,12 +205,7 @@ impl<'s> SceneMesh<'s> {
                     let slot = &mut self.slot[v as usize];
                     if *slot == u32::MAX {
                         *slot = self.points.len() as u32;
-                        let p = &scene.points[v as usize];
-                        self.points.push(Point3 {
-                            x: p.x,
-                            y: p.y,
-                            z: p.z,
-                        });
+                        self.points.push(point(&scene.points[v as usize]));
                     }
                     self.indices.push(*slot);
                 }
@@ -245,14 +252,7 @@ fn mesh_triangles(g: &Geometry, rgba: [f64; 4]) -> TriangleListPrimitive {
     let (v, t) = export::mesh(g);
     TriangleListPrimitive {
         pose: pose_at(&P3::origin()),
-        points: v
-            .iter()
-            .map(|p| Point3 {
-                x: p.x,
-                y: p.y,
-                z: p.z,
-            })
-            .collect(),
+        points: v.iter().map(point).collect(),
         color: color(rgba),
         colors: Vec::new(),
         indices: t.iter().flatten().copied().collect(),
@@ -338,5 +338,27 @@ mod tests {
         assert_eq!(kept, moved);
         assert_eq!(moved.indices.len(), 3 * lamp.tris.len());
         assert!(moved.points.len() < moved.indices.len());
+    }
+
+    #[test]
+    fn drawn_vertices_are_the_scene_rounded_to_f32() {
+        let soup = generate::soup(50, 1);
+        let mut mesh = SceneMesh::new(&soup);
+        mesh.add(0..soup.len());
+        let list = mesh.into_primitive(SCENE_COLOR);
+        let mut rounded = 0;
+        for (q, p) in list.points.iter().zip(&soup.points) {
+            for (drawn, exact) in [(q.x, p.x), (q.y, p.y), (q.z, p.z)] {
+                assert_eq!(drawn, f64::from(exact as f32));
+                rounded += usize::from(drawn != exact);
+            }
+        }
+        assert!(
+            rounded > 0,
+            "the soup's coordinates are not all f32 already"
+        );
+        // Beyond f32's range a coordinate is kept rather than drawn at infinity.
+        assert_eq!(shown(1e300), 1e300);
+        assert_eq!(shown(-1e300), -1e300);
     }
 }
