@@ -126,10 +126,7 @@ fn cases() -> Vec<Case> {
     let commands: Vec<(&str, Vec<String>)> = vec![
         (
             "record",
-            vec!["record", "{in}/soup.obj", "-o", "run"]
-                .into_iter()
-                .map(String::from)
-                .collect(),
+            words("record {in}/soup.obj -o run --wrapper sphere,hull,box,obb"),
         ),
         ("wrap sphere", words("wrap {in}/soup.obj --wrapper sphere")),
         ("wrap hull", words("wrap {in}/soup.obj --wrapper hull")),
@@ -183,9 +180,9 @@ fn signals_end_every_long_command_within_a_second_leaving_nothing() {
             "scene",
             "assembly",
             "--part",
-            &format!("{scenes}/kuka-link0.obj:8"),
+            &format!("{scenes}/kuka-link0.obj:32"),
             "--part",
-            &format!("{scenes}/mug.obj:6"),
+            &format!("{scenes}/mug.obj:24"),
             "-o",
             "assembly.obj",
         ],

@@ -44,7 +44,7 @@ fn vector(x: f64, y: f64, z: f64) -> Option<Vector3> {
 /// low mantissa bits are then zero, so the chunk compression shrinks drawn geometry that would
 /// not shrink otherwise. Only drawn geometry is rounded: `replay` and `snapshot` read the
 /// attached scene, and merge boxes keep their exact values.
-fn shown(x: f64) -> f64 {
+pub fn shown(x: f64) -> f64 {
     let r = f64::from(x as f32);
     if r.is_finite() { r } else { x }
 }
