@@ -186,12 +186,12 @@ fn initial_tetrahedron(points: &[P3]) -> Option<[u32; 4]> {
     })?;
     let [a, b, c] = [i0, i1, i2].map(|i| coord(&points[i]));
     let i3 = far(&|p| orient3d(a, b, c, coord(p)).abs())?;
-    let o = orient3d(a, b, c, coord(&points[i3]));
-    if o == 0.0 {
-        // Whatever the floating-point choice, an exact witness may still exist.
-        let i3 = (0..points.len()).find(|&i| orient3d(a, b, c, coord(&points[i])) != 0.0)?;
-        return tetrahedron(points, [i0, i1, i2, i3]);
-    }
+    // Whatever the floating-point choice said, an exact witness may still exist.
+    let i3 = if orient3d(a, b, c, coord(&points[i3])) == 0.0 {
+        (0..points.len()).find(|&i| orient3d(a, b, c, coord(&points[i])) != 0.0)?
+    } else {
+        i3
+    };
     tetrahedron(points, [i0, i1, i2, i3])
 }
 
