@@ -1,5 +1,5 @@
 //! Data buffered as columns and sent with `send_columns` in batches: per merge, the scalar
-//! series (always) and the merged pair's and new body's boxes (with per-merge geometry); per
+//! series (always; the rows [`Envelope`] keeps) and the merged pair's and new body's boxes (with per-merge geometry); per
 //! round start, doubling and finish, the text log lines and the active bodies' boxes.
 //!
 //! Every `send_columns` call becomes one chunk, and the SDK has a fixed cost per chunk whatever
@@ -12,6 +12,7 @@ use rerun::external::arrow::array::StringBuilder;
 use rerun::{RecordingStream, SerializedComponentBatch, TimeColumn};
 
 use super::BoxF32;
+use super::envelope::Envelope;
 use crate::grouping::Merge;
 
 /// Merges buffered before their columns are sent.
@@ -59,10 +60,10 @@ pub(super) fn log_styles(rec: &RecordingStream, path: &str) -> anyhow::Result<()
 /// Column buffers of the rows not sent yet: merges, text lines and active sets.
 #[derive(Default)]
 pub(super) struct Columns {
-    step: Vec<i64>,
-    round: Vec<i64>,
-    /// Per [`SERIES`] entity, its rows' scalars one after the other.
-    series: [Vec<f64>; 4],
+    /// Merges buffered since the last flush.
+    merges: usize,
+    /// Per [`SERIES`] entity, the rows kept.
+    series: [Envelope; 4],
     /// (merge, round) ticks of the merges drawn as boxes (`record::BODIES_CAP`).
     box_ticks: Vec<(i64, i64)>,
     /// Per merge drawn, the pair's two boxes then the new body's.
@@ -81,6 +82,14 @@ pub(super) struct Columns {
 }
 
 impl Columns {
+    /// Empty buffers for a run of at most `merges` merges.
+    pub(super) fn new(merges: usize) -> Columns {
+        Columns {
+            series: SERIES.map(|(_, names)| Envelope::new(names.len(), merges)),
+            ..Columns::default()
+        }
+    }
+
     /// Buffers one merge; `boxes` are the pair's and the new body's boxes when this merge is
     /// drawn.
     pub(super) fn push(
@@ -90,16 +99,15 @@ impl Columns {
         glimit: f64,
         boxes: Option<([BoxF32; 2], BoxF32)>,
     ) {
-        self.step.push(m.step as i64);
-        self.round.push(m.round as i64);
+        self.merges += 1;
         let values: [&[f64]; 4] = [
             &[m.cost],
             &[m.diameter, dlimit, glimit],
             &[m.fill, m.balance],
             &[m.queue_len as f64],
         ];
-        for (column, v) in self.series.iter_mut().zip(values) {
-            column.extend_from_slice(v);
+        for (rows, v) in self.series.iter_mut().zip(values) {
+            rows.push(m.step as i64, v);
         }
         if let Some(([a, b], new)) = boxes {
             self.box_ticks.push((m.step as i64, m.round as i64));
@@ -134,7 +142,12 @@ impl Columns {
 
     /// Number of buffered merges.
     pub(super) fn len(&self) -> usize {
-        self.step.len()
+        self.merges
+    }
+
+    /// Ends the series' open buckets: the run has no more merges.
+    pub(super) fn close_series(&mut self) {
+        self.series.iter_mut().for_each(Envelope::close);
     }
 
     /// Sends every buffered merge and empties the buffers.
@@ -146,9 +159,7 @@ impl Columns {
 
     /// Empties every buffer.
     fn clear(&mut self) {
-        self.step.clear();
-        self.round.clear();
-        self.series.iter_mut().for_each(Vec::clear);
+        self.merges = 0;
         self.box_ticks.clear();
         self.box_centers.clear();
         self.box_halves.clear();
@@ -170,9 +181,8 @@ impl Columns {
     pub(super) fn flush_rounds(&mut self, rec: &RecordingStream) -> anyhow::Result<Columns> {
         let sent = self.send_rounds(rec);
         let held = Columns {
-            step: std::mem::take(&mut self.step),
-            round: std::mem::take(&mut self.round),
-            series: std::mem::take(&mut self.series),
+            merges: self.merges,
+            series: self.series.each_mut().map(Envelope::split_off),
             box_ticks: std::mem::take(&mut self.box_ticks),
             box_centers: std::mem::take(&mut self.box_centers),
             box_halves: std::mem::take(&mut self.box_halves),
@@ -183,7 +193,7 @@ impl Columns {
     }
 
     /// Sends a batch of merges held back by [`Columns::flush_rounds`].
-    pub(super) fn send_held(&self, rec: &RecordingStream) -> anyhow::Result<()> {
+    pub(super) fn send_held(mut self, rec: &RecordingStream) -> anyhow::Result<()> {
         self.send_merges(rec)
     }
 
@@ -225,16 +235,16 @@ impl Columns {
         Ok(())
     }
 
-    fn send_merges(&self, rec: &RecordingStream) -> anyhow::Result<()> {
-        let k = self.len();
-        if k == 0 {
-            return Ok(());
-        }
-        let merge = || TimeColumn::new_sequence("merge", self.step.iter().copied());
-        for ((path, names), values) in SERIES.iter().zip(&self.series) {
-            let scalars = rerun::Scalars::new(values.iter().copied())
-                .columns(std::iter::repeat_n(names.len(), k))?;
-            rec.send_columns(*path, [merge()], scalars)?;
+    fn send_merges(&mut self, rec: &RecordingStream) -> anyhow::Result<()> {
+        for ((path, _), rows) in SERIES.iter().zip(&mut self.series) {
+            let scalars = rows.scalars();
+            let (ticks, values) = rows.take();
+            if ticks.is_empty() {
+                continue;
+            }
+            let k = ticks.len();
+            let scalars = rerun::Scalars::new(values).columns(std::iter::repeat_n(scalars, k))?;
+            rec.send_columns(*path, [TimeColumn::new_sequence("merge", ticks)], scalars)?;
         }
         if !self.box_ticks.is_empty() {
             let boxes = rerun::Boxes3D::update_fields()

@@ -265,10 +265,8 @@ fn level_obbs(interior: &[u32], obbs: &[Obb], origin: &P3) -> rerun::Boxes3D {
 
 /// The polygons of `leaves` as one shaded mesh.
 fn leaf_mesh(mesh: &PrimMesh, leaves: &[u32]) -> rerun::Mesh3D {
-    let m = mesh.subset(leaves);
-    rerun::Mesh3D::new(m.positions.iter().copied())
-        .with_vertex_normals(m.normals.iter().copied())
-        .with_triangle_indices(nonempty(m.all_tris().to_vec()))
+    mesh.subset(leaves)
+        .to_mesh3d()
         .with_albedo_factor(LEAF_ORANGE)
 }
 

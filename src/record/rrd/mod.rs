@@ -20,6 +20,7 @@
 
 mod blueprint;
 mod columns;
+mod envelope;
 mod compare;
 mod header;
 mod levels;
@@ -250,7 +251,7 @@ impl RrdRecorder {
             primitives: scene.len(),
             origin,
             boxes,
-            columns: Columns::default(),
+            columns: Columns::new(scene.len().saturating_sub(1)),
             held: hold.then(Vec::new),
             refine: refine::RefineColumns::default(),
             parts: parts::PartLines::default(),
@@ -498,6 +499,7 @@ impl RrdRecorder {
         if outcome.grouping.is_none() {
             self.mark_incomplete(outcome)?;
         }
+        self.columns.close_series();
         self.flush_columns()?;
         let rec = self.rec.as_ref().ok_or_else(closed)?;
         self.refine.finish(rec)?;
