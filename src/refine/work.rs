@@ -2,7 +2,7 @@
 //! movable root, cached box areas and the running sum of interior areas (the SAH numerator).
 //!
 //! Ids are the input tree's: leaves `0..N` never change, and an interior id names a *slot*
-//! that a move may hang elsewhere ([`WorkTree::reinsert`]). [`super::renumber`] turns the slots
+//! that a move may hang elsewhere ([`WorkTree::reinsert`]). The renumbering above this file turns the slots
 //! back into a Subset Tree's merge order at the end.
 
 use crate::geom::Aabb;
@@ -92,7 +92,7 @@ impl WorkTree {
 
     /// The working form of `tree`, made of its own arrays (parents, children, boxes: moved,
     /// not copied), with the depths and diameters it does not use given back for
-    /// [`WorkTree::into_tree`] and [`super::renumber`].
+    /// [`WorkTree::into_tree`] and the renumbering.
     ///
     /// Only the areas are new: on rayon's threads for large trees ([`tabulate`]), the interior
     /// sum taken in id order, so it is the same for any number of threads.
