@@ -2,8 +2,8 @@
 //! movable root, cached box areas and the running sum of interior areas (the SAH numerator).
 //!
 //! Ids are the input tree's: leaves `0..N` never change, and an interior id names a *slot*
-//! that a move may hang elsewhere ([`WorkTree::reinsert`]). The renumbering above this file turns the slots
-//! back into a Subset Tree's merge order at the end.
+//! that a move may hang elsewhere ([`WorkTree::reinsert`]). The renumbering (`renumber.rs`)
+//! turns the slots back into a Subset Tree's merge order at the end.
 
 use crate::geom::Aabb;
 use crate::geom::area;
