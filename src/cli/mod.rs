@@ -1,7 +1,6 @@
 //! Argument definitions and dispatch for every subcommand.
 
 mod bench;
-mod bench_partitioned;
 mod compare;
 mod cover;
 mod deadline;
