@@ -48,13 +48,11 @@ enum Command {
     /// Generate a seeded synthetic scene as Wavefront OBJ (linear in its size).
     Scene(scene_cmd::SceneCmd),
     /// Compare hierarchy builders × wrappers on scenes (CSV, charts, .rrd), or print the targets
-    /// table against obvhs PLOC and parry Binned. Build times are taken as in the tables of
-    /// docs/benchmarks.md: rounds that build every method in turn, the fastest build of each
-    /// kept (--repeat). Every step's work is bounded by the scene's size (hulls from the
-    /// children's hull vertices, tightness and queries sampled or capped), so with the defaults
-    /// a scene of up to 2·10^5 primitives, assemblies of mixed-scale parts included, takes
-    /// minutes. Stacked coincident copies take longest: their queries test every tied pair, up
-    /// to a cap. How long a bench takes: docs/benchmarks.md.
+    /// table against obvhs PLOC and parry Binned. Builds are timed in rounds that build every
+    /// method in turn, the fastest build of each kept (--repeat). Every step's work is bounded
+    /// by the scene's size (hulls from the children's hull vertices, tightness and queries
+    /// sampled or capped); stacked coincident copies take longest, their queries testing every
+    /// tied pair up to a cap. Times: docs/benchmarks.md.
     Bench(bench::BenchCmd),
     /// Run the A/B/C grid of the grouping Cost on a scene: table, heat maps, the series of every
     /// setting (sweep.rrd) and the trees of the 6 best distinct settings side by side
@@ -64,8 +62,8 @@ enum Command {
     /// grouping, then rasterising: linear in the scene and the frames).
     Snapshot(snapshot::SnapshotCmd),
     /// Build Wrapper Trees and print their per-level tightness (error sampled per depth) and
-    /// containment check (every node): linear in the scene with the defaults (tightness is
-    /// sampled per depth), grouping included.
+    /// containment check (every node); linear in the scene with the defaults, grouping
+    /// included.
     Wrap(wrap_cmd::WrapCmd),
     /// The fewest wrappers that model a scene within --tolerance, or the best --budget of them
     /// (one grouping and one Wrapper Tree per kind, then a pass over the tree).
