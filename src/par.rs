@@ -3,8 +3,8 @@
 //! Called from such a thread (a program's main thread, for one), each parallel step of a build
 //! (a `join`, a parallel iterator that splits) is handed to the pool, and the caller sleeps
 //! until a worker has woken and finished it; the step's results are then in that worker's
-//! cache, not the caller's. On a 2-core VM this cost the fast path 10–30 % of its time at
-//! 10^3–10^5 primitives, on one thread and on two. So the builds run their parallel parts, in
+//! cache, not the caller's: a hand-over and a cold cache per step, a large share of a small
+//! build's time. So the builds run their parallel parts, in
 //! one piece, on one of the pool's threads ([`on_pool`]), where those steps are plain calls.
 
 /// Fewest primitives for which a build is handed to the pool: below this the hand over alone

@@ -275,7 +275,7 @@ fn bench_sets_the_partitioned_chunks_and_refuses_them_where_they_set_nothing() {
         o,
     ]);
     common::assert_one_line_error(&out, "--chunk-delta sets grouping-partitioned's chunks");
-    let out = wraptree(&["bench", "--partitioned", "--chunk-top", "64", "-o", o]);
+    let out = wraptree(&["bench", "--record", "--chunk-top", "64", "-o", o]);
     common::assert_one_line_error(&out, "--chunk-top needs SCENEs");
     let out = wraptree(&[
         "bench",

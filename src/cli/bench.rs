@@ -16,7 +16,6 @@ use wraptree::metrics::report::{
 use wraptree::metrics::timing::ROUNDS;
 use wraptree::output::{check_absent, output_dir};
 use wraptree::peers::Method;
-use wraptree::scene::generate;
 use wraptree::scene::spec::scene_spec;
 use wraptree::stop::Stop;
 
@@ -51,12 +50,11 @@ pub struct BenchCmd {
     /// every node, exact queries: slow on large scenes).
     #[arg(long, value_name = "N", default_value_t = wraptree::wrap::NODES_PER_DEPTH)]
     tightness_nodes: usize,
-    /// Largest soup size in the targets table (10^4, 10^5, 10^6 by default; 10000000 adds a
-    /// 10^7 soup to the partitioned table).
+    /// Largest soup size in the targets table (10^4, 10^5, 10^6 by default).
     #[arg(long, default_value_t = 1_000_000)]
     max_soup: usize,
     /// Threads of the rayon pool the comparison uses (partitioned grouping, the exact run's
-    /// scans, obvhs PLOC) [default: all cores]; the partitioned table sets 1 and 2 itself.
+    /// scans, obvhs PLOC) [default: all cores].
     #[arg(long, value_name = "N")]
     pub(super) threads: Option<usize>,
     /// Timed runs. With SCENEs the builds run in this many rounds, each building every method
@@ -73,11 +71,6 @@ pub struct BenchCmd {
     /// 12,144-polygon scenes and a 10^5-triangle soup.
     #[arg(long)]
     record: bool,
-    /// Instead: only the targets' partitioned-schedule table (exact and partitioned grouping
-    /// and obvhs PLOC on 1 and 2 threads, quality, peak memory) on the SCENEs, or without
-    /// scenes on the targets scenes (and a 10^7 soup with --max-soup 10000000).
-    #[arg(long, conflicts_with = "record")]
-    partitioned: bool,
     /// The chunks of grouping-partitioned and grouping-partitioned+refine.
     #[command(flatten)]
     chunks: ChunkArgs,
@@ -147,7 +140,7 @@ impl BenchCmd {
         let threads = super::build_pool(self.threads)?;
         eprintln!("threads: {threads} (rayon pool)");
         if let Some(flag) = self.chunks.first_set()
-            && (self.record || self.partitioned || self.scenes.is_empty())
+            && (self.record || self.scenes.is_empty())
         {
             anyhow::bail!(
                 "{flag} needs SCENEs (it sets grouping-partitioned's chunks in their table)"
@@ -155,9 +148,6 @@ impl BenchCmd {
         }
         if self.record {
             return self.run_record();
-        }
-        if self.partitioned {
-            return self.run_partitioned();
         }
         if self.scenes.is_empty() {
             return self.run_targets();
@@ -239,7 +229,7 @@ impl BenchCmd {
 
     /// The targets: grouping time against obvhs PLOC, SAH and query cost against parry Binned.
     fn run_targets(&self) -> Result<ExitCode> {
-        let mut cases = target_scenes(self.max_soup)?;
+        let cases = target_scenes(self.max_soup)?;
         print!("{}", targets_header());
         let stop = Stop::on_signals();
         let mut refined = Vec::new();
@@ -257,28 +247,6 @@ impl BenchCmd {
         print!("{}", targets_notes());
         print!("{}", refine_table(&refined));
         print!("{}", speedup_table(&sped_up, rayon::current_num_threads()));
-        if self.max_soup >= 10_000_000 {
-            cases.push(generate::soup(10_000_000, 1));
-        }
-        super::bench_partitioned::print_table(&cases, self.repeat_else())?;
-        Ok(ExitCode::SUCCESS)
-    }
-
-    /// The partitioned schedule's table alone, on the given scenes or the targets scenes.
-    fn run_partitioned(&self) -> Result<ExitCode> {
-        let cases = if self.scenes.is_empty() {
-            let mut cases = target_scenes(self.max_soup)?;
-            if self.max_soup >= 10_000_000 {
-                cases.push(generate::soup(10_000_000, 1));
-            }
-            cases
-        } else {
-            self.scenes
-                .iter()
-                .map(|s| load_spec(s))
-                .collect::<Result<Vec<_>>>()?
-        };
-        super::bench_partitioned::print_table(&cases, self.repeat_else())?;
         Ok(ExitCode::SUCCESS)
     }
 

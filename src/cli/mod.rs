@@ -1,7 +1,6 @@
 //! Argument definitions and dispatch for every subcommand.
 
 mod bench;
-mod bench_partitioned;
 mod compare;
 mod cover;
 mod deadline;
@@ -34,45 +33,40 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Run the grouping phase on a scene and print the Subset Tree's summary (a 2·10^5-triangle
-    /// soup: about 2 s on 2 cores; --max-seconds bounds it).
+    /// Run the grouping phase on a scene and print the Subset Tree's summary (--max-seconds
+    /// bounds it; times: docs/benchmarks.md).
     Group(group::GroupCmd),
     /// Group a scene step by step and record it to PREFIX.rrd (Rerun) and PREFIX.mcap (Foxglove)
-    /// (with the defaults about 1 s per 10^5 primitives on 2 cores; a 2·10^5-triangle soup: 2 s,
-    /// 150 MB).
+    /// (time and file sizes grow with the scene and --detail; sizes: docs/recordings.md).
     Record(record::RecordCmd),
-    /// Rebuild a run from its .mcap; --verify re-runs it; --a/--b/--c re-weights it (2·10^5
-    /// primitives on 2 cores: about 1 s, with --verify 2 s, re-weighted 5 s).
+    /// Rebuild a run from its .mcap; --verify re-runs it; --a/--b/--c re-weights it (reading is
+    /// one pass over the file; a re-run costs one grouping, a re-weighting one recording).
     Replay(replay::ReplayCmd),
     /// Two or more .mcap recordings of one scene side by side in one .rrd, their first
-    /// divergence marked (two runs of 2·10^5 primitives: about 3 s on 2 cores).
+    /// divergence marked (one pass over each file, linear in the runs' merges).
     Compare(compare::CompareCmd),
-    /// Generate a seeded synthetic scene as Wavefront OBJ (2·10^5 triangles: under 1 s; n-gons,
-    /// 1,024 vertices each: about 0.6 s per 1,000).
+    /// Generate a seeded synthetic scene as Wavefront OBJ (linear in its size).
     Scene(scene_cmd::SceneCmd),
     /// Compare hierarchy builders × wrappers on scenes (CSV, charts, .rrd), or print the targets
-    /// table against obvhs PLOC and parry Binned. Build times are taken as in the tables of
-    /// docs/benchmarks.md: rounds that build every method in turn, the fastest build of each
-    /// kept (--repeat). Every step's work is bounded by the scene's size (hulls from the
-    /// children's hull vertices, tightness and queries sampled or capped), so with the defaults
-    /// a scene of up to 2·10^5 primitives, assemblies of mixed-scale parts included, takes
-    /// minutes. Stacked coincident copies take longest: their queries test every tied pair, up
-    /// to a cap. How long a bench takes: docs/benchmarks.md.
+    /// table against obvhs PLOC and parry Binned. Builds are timed in rounds that build every
+    /// method in turn, the fastest build of each kept (--repeat). Every step's work is bounded
+    /// by the scene's size (hulls from the children's hull vertices, tightness and queries
+    /// sampled or capped); stacked coincident copies take longest, their queries testing every
+    /// tied pair up to a cap. Times: docs/benchmarks.md.
     Bench(bench::BenchCmd),
     /// Run the A/B/C grid of the grouping Cost on a scene: table, heat maps, the series of every
     /// setting (sweep.rrd) and the trees of the 6 best distinct settings side by side
-    /// (compare.rrd). With the defaults about 1 min per 10^5 primitives on 2 cores, plus
-    /// --max-seconds (60 s) per setting left out (a 2·10^5-triangle soup: 4 min).
+    /// (compare.rrd). One grouping per setting of the grid, each bounded by --max-seconds.
     Sweep(sweep::SweepCmd),
-    /// Render the input and chosen tree levels as PNG/SVG frames and a figure sheet (with the
-    /// defaults about 20 s per 10^5 primitives on 2 cores).
+    /// Render the input and chosen tree levels as PNG/SVG frames and a figure sheet (one
+    /// grouping, then rasterising: linear in the scene and the frames).
     Snapshot(snapshot::SnapshotCmd),
     /// Build Wrapper Trees and print their per-level tightness (error sampled per depth) and
-    /// containment check (every node): about 5–8 s per 10^5 primitives on 2 cores with the
-    /// defaults, grouping included (2·10^5-triangle soup: 15 s).
+    /// containment check (every node); linear in the scene with the defaults, grouping
+    /// included.
     Wrap(wrap_cmd::WrapCmd),
     /// The fewest wrappers that model a scene within --tolerance, or the best --budget of them
-    /// (about 10 s per 10^5 primitives on 2 cores with the default kinds).
+    /// (one grouping and one Wrapper Tree per kind, then a pass over the tree).
     Cover(cover::CoverCmd),
     /// Every builder on pathological scenes (spaghetti, slabs, …) under a time budget per case
     /// (the whole run within 226 × (--budget + 1 s)).
@@ -161,8 +155,8 @@ fn parse_joint(s: &str) -> Result<(String, f64), String> {
 pub struct GroupArgs {
     /// Cost exponent A in Cost = diameter^A × (B·Fill + C·Balance) (with B = C = 0 the
     /// bracket is 1). A = B = C = 0 makes every Cost 1, so pairs merge in id order, far from
-    /// each other's best: about 30× slower (a 2·10^5-triangle soup: 7 min; in group, record
-    /// and cover --max-seconds bounds it).
+    /// each other's best: many times slower (in group, record and cover --max-seconds bounds
+    /// it).
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     pub a: f64,
     /// Fill weight B.
@@ -275,19 +269,16 @@ impl GroupArgs {
 #[derive(Args, Debug, Clone, Default)]
 pub struct ChunkArgs {
     /// Partitioned schedule: about how many bodies its root step (the exact schedule's) starts
-    /// from; scenes of at most 1.5× this are grouped whole. Smaller is faster on scenes of
-    /// 10^4–10^5 primitives and further from the exact tree; 0 = AAC's reduction alone
+    /// from; scenes of at most 1.5× this are grouped whole. Smaller is faster on mid-sized
+    /// scenes and further from the exact tree; 0 = AAC's reduction alone
     /// [default: 8192].
     #[arg(long, value_name = "N")]
     pub chunk_top: Option<u32>,
     /// Partitioned schedule: δ, the largest range of primitives grouped as one chunk (by the
     /// exact step, down to δ/2 bodies at ε = 0.5), at least 2; 0 = by the scene's size
-    /// [default: 0, 2 with --fast]. By size, scenes of up to 262,144 (2^18) primitives take
-    /// 4096, which kept every real mesh tried within 2 % of the exact tree's SAH and of its
-    /// node tests on point and distance queries, at about the exact schedule's time on one
-    /// thread, spread over the threads (0.4–0.8× its time on two above 3·10^4 primitives);
-    /// larger scenes take 4, several times faster there
-    /// (use --fast for speed on smaller ones).
+    /// [default: 0, 2 with --fast]. By size: 4096 up to 2^18 primitives (close to the exact
+    /// tree, the exact schedule's work spread over the threads), 4 above (faster). For speed
+    /// on smaller scenes use --fast. Measurements: docs/benchmarks.md.
     #[arg(long, value_name = "N")]
     pub chunk_delta: Option<u32>,
     /// Partitioned schedule: ε of AAC's reduction f(n) = ⌈c·n^(1/2 − ε)⌉, c = δ^(1/2 + ε)/2,

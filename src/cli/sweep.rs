@@ -44,8 +44,8 @@ pub struct SweepCmd {
     #[arg(long, default_value_t = 3)]
     repeat: u32,
     /// Largest wall time of one grouping run, in seconds: a setting whose run takes longer is
-    /// left out and named under the table (the all-ties corner A = 0, B = C = 0 grows about as
-    /// N^1.8: 7 min on a 2·10^5-triangle soup).
+    /// left out and named under the table (the all-ties corner A = 0, B = C = 0 grows faster
+    /// than linearly in the scene).
     #[arg(long, value_name = "S", default_value_t = 60.0)]
     max_seconds: f64,
 }

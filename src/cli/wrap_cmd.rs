@@ -30,8 +30,8 @@ pub struct WrapCmd {
     samples: u32,
     /// Interior nodes per tree depth whose error is measured, drawn by a seeded hash, besides
     /// every leaf: a level's error mean is then an estimate, its max the largest measured;
-    /// volumes and containment cover every node (0: every node's error, exact queries, about
-    /// twice as long).
+    /// volumes and containment cover every node (0: every node's error, exact queries,
+    /// longer).
     #[arg(long, value_name = "N", default_value_t = NODES_PER_DEPTH)]
     tightness_nodes: usize,
     /// Print one JSON object instead of text.

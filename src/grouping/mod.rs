@@ -46,7 +46,7 @@ use std::sync::atomic::AtomicBool;
 
 /// Fewest items per piece of the grouping's parallel per-primitive passes (boxes, diameters,
 /// Morton codes): below it a pass stays on the calling thread, where waking another costs more
-/// than the pass (a 200-triangle scene took 25 % longer on 2 threads than on 1 without it).
+/// than the pass.
 pub(crate) const PAR_MIN_LEN: usize = 4096;
 
 /// Counters of one run, for benchmarks and the stability study.

@@ -1,9 +1,6 @@
 //! The measurements of `wraptree bench` besides the builder × wrapper comparison
 //! ([`compare`](super::compare)): the targets table against obvhs PLOC and parry Binned
-//! ([`target_row`]), the partitioned schedule's table ([`partitioned`]) and what recording
-//! costs ([`record_cost`]).
-
-pub mod partitioned;
+//! ([`target_row`]) and what recording costs ([`record_cost`]).
 
 use super::timing::fastest;
 use crate::grouping::{self, Params};

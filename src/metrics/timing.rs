@@ -1,4 +1,4 @@
-//! How build times are compared (`wraptree bench`, `examples/method_timing`, and so the tables
+//! How build times are compared (`wraptree bench`, `wraptree-bench`'s `method_timing`, and so the tables
 //! of `docs/benchmarks.md`): in rounds, each building every method once, in the order given, so
 //! that a slow spell of the machine falls on all of them alike; each method keeps its fastest
 //! build, the best of the rounds. The rounds run in one piece on a thread of the current rayon

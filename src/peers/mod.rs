@@ -1,6 +1,6 @@
 //! Our grouping phase beside its peers, on the same primitives, each as a [`SubsetTree`] so
 //! that quality measures (SAH, depth, balance), Wrapper Trees ([`crate::wrap`]) and queries
-//! ([`crate::query`]) measure every hierarchy the same way (`docs/benchmarks.md`, "What is
+//! ([`crate::query`]) measure every hierarchy the same way (`docs/benchmarks.md`, "How it is
 //! measured").
 //!
 //! - [`Method::Grouping`], [`Method::GroupingHull`], [`Method::GroupingPartitioned`]: the

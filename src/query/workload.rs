@@ -1,6 +1,6 @@
 //! A seeded standard query workload for one scene and its mean cost per query (eq. (1)):
 //! 256 points around the scene, 8 near poses and 8 touching poses of a rotated copy
-//! ([`Workload::standard`]), run by [`measure`]. `docs/benchmarks.md` ("What is measured")
+//! ([`Workload::standard`]), run by [`measure`]. `docs/benchmarks.md` ("How it is measured")
 //! describes it as the benchmarks use it.
 
 use super::{
@@ -40,8 +40,7 @@ pub const MAX_TESTS_PER_PRIM: u64 = 256;
 /// scene), and a query tests at most about `5n²`.
 pub const MAX_TESTS_PER_PAIR: u64 = 2;
 
-/// The largest floor of the per-query cap ([`Workload::cap`]): 2^24 ≈ 1.7·10^7 tests, about
-/// 2 s.
+/// The largest floor of the per-query cap ([`Workload::cap`]): 2^24 ≈ 1.7·10^7 tests.
 pub const MIN_MAX_TESTS: u64 = 1 << 24;
 
 /// Query points and poses of a copy of the scene (see [`Workload::standard`]).
@@ -202,8 +201,8 @@ pub struct QueryCost {
     /// depend on the two trees alone.
     ///
     /// Run with box BVs only (with sphere BVs no query, `queries` 0): with spheres they make
-    /// about ten times the tests, within 1 % of each other for every builder on real meshes
-    /// (the spheres' looseness, not the tree), and on an assembly of rigid copies some reach
+    /// many times the tests, about equal for every builder (the spheres' looseness, not the
+    /// tree), and on an assembly of rigid copies some reach
     /// the test cap, which is meant for exact ties.
     pub contact: MeanCost,
     /// Touching primitive pairs the contact queries found, summed over the poses.

@@ -32,18 +32,11 @@ use work::WorkTree;
 /// treelets low in the tree, then two reinsertion passes. The split leaves
 /// its lowest levels as binned cuts made without regard to their neighbours; treelets of 5
 /// leaves at every node of at least 8 rebuild them optimally, which the reinsertion's
-/// candidates (children of large, inefficient parents) seldom reach. Against three reinsertion
-/// passes alone, on 69 real meshes (with [`FAST_SMALL_PARAMS`] below 1,024 primitives): the
-/// point and distance queries at or below the best peer's on 53 instead of 44, the contact
-/// queries on 53 instead of 44, SAH on 67 for both, in 1.14–1.17× the time from 1,024 primitives up
-/// (median; `docs/benchmarks.md`, "The fast path on 69 meshes" and "The fast path: variants
-/// measured and not kept"). Pass k of the reinsertion searches a fixed share of the nodes, so
-/// the work stays proportional to the tree's size.
-///
-/// Treelets of 7 leaves rooted at every node of at least 8 gave the best trees measured (the
-/// point and distance queries at or below the best peer's on 57 of 69) in about twice the
-/// refinement's time; those of 4 leaves, or rooted only from 16 or 32 leaves, gave less than
-/// 5 leaves from 8.
+/// candidates (children of large, inefficient parents) seldom reach; against reinsertion
+/// passes alone it gives trees at or below the best peer's on more meshes for a little more
+/// time (`docs/benchmarks.md`). Pass k of the reinsertion searches a fixed share of the
+/// nodes, so the work stays proportional to the tree's size. Larger treelets give better
+/// trees in more time; smaller ones, or treelets rooted only higher up, worse ones.
 pub const FAST: RefineParams = RefineParams {
     passes: 2,
     batch: 0.1,
@@ -56,17 +49,16 @@ pub const FAST: RefineParams = RefineParams {
 pub const FAST_LARGE: usize = 1 << 14;
 
 /// The first batch of the fast path's refinement on trees of at least [`FAST_LARGE`] leaves:
-/// 7 % of the nodes instead of 10 %. On the 29 real meshes above 10^4 triangles measured it
-/// kept SAH at or below the best peer's on all of them (worst 0.999) and took 0.71–0.89× the
-/// refinement's time; below 10^4 it left six of 40 above the best peer's SAH (up to 1.3 %).
+/// 7 % of the nodes instead of 10 %: on large trees the smaller batch loses no SAH and saves
+/// time; on small ones it costs SAH, so they keep 10 %.
 pub const FAST_LARGE_BATCH: f64 = 0.07;
 
 /// Trees of fewer leaves than this take [`FAST_SMALL_PARAMS`] in [`fast_for`] (2^10).
 pub const FAST_SMALL: usize = 1 << 10;
 
 /// The fast path's refinement below [`FAST_SMALL`] leaves: three reinsertion passes and no
-/// treelet pass. There PLOC builds a tree in tens of microseconds and the treelet pass cost
-/// 0.2–0.6× of it (the 200-triangle `franka-link0` went from 1.73× to 2.26–2.33× PLOC's time).
+/// treelet pass. So small a tree is built in microseconds, and there the treelet pass costs a
+/// large share of the build for little gain.
 pub const FAST_SMALL_PARAMS: RefineParams = RefineParams {
     passes: 3,
     treelet_passes: 0,
@@ -91,7 +83,7 @@ pub fn fast_for(n: usize) -> RefineParams {
 
 /// Knobs of a refinement run that recordings do not name (so `record --refine` and
 /// `replay --verify` always use [`Tuning::default`]); for measuring variants
-/// (`examples/refine_cost.rs`) through [`refine_tuned`].
+/// (`wraptree-bench`'s `refine_cost`) through [`refine_tuned`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Tuning {
     /// Treelets are rooted only at nodes whose subtree has at least this many leaves (Karras
@@ -107,7 +99,7 @@ pub struct Tuning {
 
 impl Default for Tuning {
     /// γ by the tree's size, treelets on every height, before the reinsertion passes (measured
-    /// against the other variants in `docs/benchmarks.md`, "Refinement variants").
+    /// against the other variants with `wraptree-bench`'s `refine_cost`).
     fn default() -> Self {
         Tuning {
             treelet_min: 0,

@@ -152,9 +152,8 @@ pub fn spatial_order(w: &WorkTree, candidates: &[u32]) -> Vec<u32> {
     keys.into_iter().map(|(_, x)| x).collect()
 }
 
-/// Fewest candidates searched in parallel on a pool of several threads (256, with the split's
-/// finer grains: `docs/benchmarks.md`, "Thread scaling on 16 cores"; a 5,804-triangle mesh's
-/// first batch of 1,161 searches is then shared by the threads).
+/// Fewest candidates searched in parallel on a pool of several threads (with the split's finer
+/// grains; `docs/benchmarks.md`, "How does it scale with threads?").
 pub const PARALLEL_MIN: usize = 256;
 
 /// Fewest candidates searched in [`spatial_order`] on one thread, and the size from which a
@@ -178,7 +177,7 @@ pub fn still_valid(w: &WorkTree, m: &Move) -> bool {
 /// its inefficiency over its smaller child, after Bittner 2013's m_min × m_area measure, which
 /// that paper found best; here it ranks the children of inefficient, large parents. Of the
 /// rankings tried (A(x) as obvhs and madmann91/bvh, A(p), A(p)² / (A(x) + A(s))) it gave the
-/// lowest SAH and node tests for the same time (`docs/benchmarks.md`, "Refinement variants").
+/// lowest SAH and node tests for the same time (`wraptree-bench`'s `refine_cost`).
 ///
 /// The set is what matters ([`find_all`]'s moves are sorted by gain afterwards), so it is
 /// selected, not sorted, and returned in the order it is found (the chosen slots' children in

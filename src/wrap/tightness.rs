@@ -17,8 +17,7 @@
 //! Measuring every node costs far more than building the tree, so summaries over a whole tree
 //! ([`DepthSample`]) measure at most [`NODES_PER_DEPTH`] interior nodes per depth, drawn by a
 //! seeded hash of their ids, each query stopping after [`MAX_VISITS`] node visits: a bounded
-//! cost, and the same result for any thread count (`docs/benchmarks.md`, "What is measured",
-//! gives the error against measuring every node).
+//! cost, and the same result for any thread count.
 
 use super::distance::point_node_within;
 use super::hull::{BOX_TRIANGLES, Hull};

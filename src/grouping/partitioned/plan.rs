@@ -27,8 +27,7 @@ pub struct Chunking {
     /// Ranges of at most this many primitives are chunks; 0 = δ. AAC's chunks have fewer than
     /// δ (δ − 1 here); a range of exactly δ cut in two halves that keep all their bodies gives
     /// its node the same δ bodies (but for a 1 + 3 cut), so by default it is one chunk and its
-    /// cut is saved (about 5 % of the fast path's time, SAH and node tests within 0.2 % on 37
-    /// scenes).
+    /// cut is saved (time saved, the trees as good).
     pub chunk_max: u32,
     /// Ranges of 3 up to this many primitives (at most [`Chunking::FEW_MAX`]) that are cut, not
     /// chunks, try every partition for the best binary tree over their leaves instead of the
@@ -63,15 +62,13 @@ impl Chunking {
 
     /// δ for scenes of up to [`Chunking::BY_SIZE_UP_TO`] primitives when none is given:
     /// chunks of 4,096 primitives make most merges the exact run's own, so the tree stays
-    /// within 2 % of the exact one's SAH and point and distance queries on every real mesh
-    /// measured (25 whose split runs), where δ = 4 was 2.1–4.3 % off on five of them. It costs
-    /// about the exact run's time on one thread and spreads it over the threads
-    /// (docs/benchmarks.md, "Chunks of δ primitives").
+    /// close to the exact one's, closer than with δ = 4. It costs about the exact run's work,
+    /// spread over the threads (docs/benchmarks.md).
     pub const FAITHFUL_DELTA: u32 = 4096;
 
     /// The most primitives that [`Chunking::FAITHFUL_DELTA`] applies to when δ is not given
-    /// (2^18); larger scenes take [`Chunking::DEFAULT`]'s δ = 4. At 10^6 primitives chunks of
-    /// 4,096 took 6.4× the time of chunks of 4 for a worse tree than theirs (the exact Cost's
+    /// (2^18); larger scenes take [`Chunking::DEFAULT`]'s δ = 4. On large scenes chunks of
+    /// 4,096 take several times the time of chunks of 4 for no better a tree (the exact Cost's
     /// own tree is further from PLOC's there).
     pub const BY_SIZE_UP_TO: usize = 1 << 18;
 
@@ -92,12 +89,9 @@ impl Chunking {
     /// primitives, Morton cuts above), under a root step of about 16 bodies; only scenes of at
     /// most 24 primitives are grouped whole. Its trees are further from the exact schedule's
     /// than the default's; the fast path's refinement (`refine::fast_for`) takes their SAH back
-    /// down. Root shares of 16–256 gave the same SAH and node tests after the refinement on 37
-    /// scenes; 16 against 32 took 10–23 % off scenes under 1,000 primitives (the root step's
-    /// Cost table is a quarter the size) and left the larger ones as they were, on 69 real
-    /// meshes. δ = 2 against 4 (with the executor's lean recursion for such subtrees) took about
-    /// a fifth off the time and left as good trees (`docs/benchmarks.md`, "The fast path:
-    /// variants measured and not kept").
+    /// down. Larger root shares gave the same trees after the refinement in more time on small
+    /// scenes (the root step's Cost table grows with the square of the share); δ = 2 against 4
+    /// (with the executor's lean recursion for such subtrees) saves time for as good trees.
     pub const FAST: Chunking = Chunking {
         top: 16,
         delta: 2,
@@ -195,10 +189,9 @@ pub(super) fn post_order(nodes: &[Node]) -> Vec<u32> {
     order
 }
 
-/// Ranges of at least this many primitives plan their halves in parallel (on 16 cores, 256
-/// against 1,024, with [`executor`](super::executor)'s grain and the refinement's search
-/// threshold lowered alike, took the fast path's median time on 69 real meshes from 1.16× to
-/// 1.07× PLOC's on 4 threads and from 1.16× to 1.01–1.06× on 16: `docs/benchmarks.md`).
+/// Ranges of at least this many primitives plan their halves in parallel (a finer grain than
+/// 1,024, with [`executor`](super::executor)'s grain and the refinement's search threshold
+/// lowered alike, made the fast path faster on 4 and 16 threads: `docs/benchmarks.md`).
 const PLAN_GRAIN: u32 = 1 << 8;
 
 /// The split of the primitives into chunks, nodes in pre-order (the root first): `codes`

@@ -4,8 +4,8 @@
 //! each run then by insertion). The pairs are distinct (ids differ), so the order is the one
 //! any sort gives, whatever the number of threads. `par_sort_unstable` partitions the whole
 //! array on one thread first, which this avoids. Fewer pairs, from [`LSD_MIN`], are sorted by
-//! least-significant digit first ([`lsd`]: on one thread 1.5–2× faster than a comparison sort
-//! at 10^4–5·10^4 pairs), the fewest by comparison.
+//! least-significant digit first ([`lsd`]: linear in the pairs, faster than a comparison sort
+//! there), the fewest by comparison.
 
 use rayon::prelude::*;
 

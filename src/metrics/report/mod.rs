@@ -5,21 +5,16 @@
 //! - `bench`: `results.csv`, the two charts per scene and `bench.rrd`;
 //! - `sweep`: `sweep.csv`, the heat maps and `sweep.rrd`;
 //! - `stress`: `stress.csv` and the spaghetti sweep charts;
-//! - the targets tables, the partitioned table and `bench --record`'s table as text
-//!   ([`targets_header`], [`partitioned_header`] …).
+//! - the targets tables and `bench --record`'s table as text ([`targets_header`] …).
 
 mod bench;
 mod group;
-mod partitioned;
 mod stress;
 mod sweep;
 mod targets;
 
 pub use bench::{bench_charts, bench_csv, bench_outputs, bench_table, write_bench};
 pub use group::{group_json, group_text, pregrouping_lines};
-pub use partitioned::{
-    partitioned_header, partitioned_line, partitioned_notes, partitioned_record_line,
-};
 pub use stress::{StressRow, stress_csv, stress_sweep_chart, stress_table};
 pub use sweep::{SweepRrd, setting_name, sweep_csv, sweep_heat_maps, sweep_table, write_sweep};
 pub use targets::{

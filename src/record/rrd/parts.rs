@@ -1,7 +1,7 @@
 //! The `.rrd`'s part lines (`log/doublings`): one per part of the run, except the partitioned
 //! schedule's smallest chunks. A 10^6-triangle run has ~600,000 chunks of 3 or 4 bodies; a line
-//! each made the log 600,000 lines long (nothing a reader scrolls through) and cost the
-//! recording ~0.07 s and 19.5 MB. Each run of consecutive small chunks becomes one line at the
+//! each made the log 600,000 lines long (nothing a reader scrolls through) and cost time and
+//! space for nothing. Each run of consecutive small chunks becomes one line at the
 //! merge where the run starts; the `.mcap` still has every part on `/grouping/part`.
 
 use crate::grouping::{Part, PartKind};

@@ -2,9 +2,9 @@
 //! scenes: SAH and node tests per query (AABB BVs, standard workload; all queries, and the
 //! point and distance queries alone) of each chunking's tree over the exact tree's, and its
 //! grouping time on one thread. How the defaults were chosen
-//! (`docs/benchmarks.md`).
+//! (`docs/benchmarks.md`, "How close is the partitioned schedule to the exact tree, and how fast?").
 //!
-//! `cargo run --release --example partitioned_chunking [MAX_SOUP] [DELTA:EPSILON[:TOP[:SAH]] ...]
+//! `cargo run --release -p wraptree-bench --bin partitioned_chunking [MAX_SOUP] [DELTA:EPSILON[:TOP[:SAH]] ...]
 //! [FILE ...]` — default 100000 and the default chunking and 20:0.1 (AAC's high-quality
 //! setting); δ = 0 is the default's δ by the scene's size (`Chunking::delta_for`); scene files are grouped after the targets scenes (held-out scenes). `THREADS=T` runs
 //! every build in a pool of T threads instead of one.

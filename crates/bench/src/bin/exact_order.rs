@@ -4,9 +4,9 @@
 //! default partitioned tree of each order; SAH and node tests per query (AABB BVs, the standard
 //! workload of the scene as given) over the input order's exact tree. Ties between equal costs
 //! break by id, and the voxel hash is walked in id order, so the order is the only thing that
-//! changes (`docs/benchmarks.md`, "The exact tree under another input order").
+//! changes (a variant study; its table is in the git history of `docs/benchmarks.md`).
 //!
-//! `cargo run --release --example exact_order -- FILE...`
+//! `cargo run --release -p wraptree-bench --bin exact_order -- FILE...`
 
 use rand::SeedableRng;
 use rand::seq::SliceRandom;

@@ -3,9 +3,9 @@
 //! as the unlimited run's), then the default partitioned schedule on the bodies left, from the
 //! scene's own DLimit0 and GLimit0. Prints, per scene and share, the spliced tree's SAH and node
 //! tests per query over the exact tree's, and what each stage took of the exact run's time, one
-//! thread (`docs/benchmarks.md`, "Exact first merges, then the split").
+//! thread (a variant study; its table is in the git history of `docs/benchmarks.md`).
 //!
-//! `cargo run --release --example exact_prefix -- SHARES FILE...` — SHARES as `0.5,0.25`.
+//! `cargo run --release -p wraptree-bench --bin exact_prefix -- SHARES FILE...` — SHARES as `0.5,0.25`.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;

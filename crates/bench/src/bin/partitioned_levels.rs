@@ -1,9 +1,9 @@
 //! Where the partitioned tree's SAH differs from the exact tree's: the interior boxes' areas
 //! (over the root box's) summed by the size of each node's leaf set, 2^k to 2^(k+1) − 1
 //! leaves, for the exact schedule and the default partitioned schedule, one thread
-//! (`docs/benchmarks.md`, "Where the SAH differs").
+//! (a variant study; its table is in the git history of `docs/benchmarks.md`).
 //!
-//! `cargo run --release --example partitioned_levels -- FILE...`
+//! `cargo run --release -p wraptree-bench --bin partitioned_levels -- FILE...`
 
 use wraptree::geom::area;
 use wraptree::grouping::partitioned::{Chunking, group_with};

@@ -4,7 +4,7 @@
 //! a shared machine; the PLOC CPU column includes converting its boxes and tree). With `STATS`
 //! set, the work counters go to stderr.
 //!
-//! `cargo run --release --example exact_timing -- [--threads 1,2] [--repeat 5] FILE...`
+//! `cargo run --release -p wraptree-bench --bin exact_timing -- [--threads 1,2] [--repeat 5] FILE...`
 
 use std::hash::{Hash, Hasher};
 use std::path::Path;

@@ -1,18 +1,18 @@
-//! The partitioned schedule's table: the exact and the partitioned grouping beside obvhs PLOC,
-//! each in a rayon pool of 1 and 2 threads, with the partitioned tree's quality against the
-//! exact tree's and the builds' peak memory (`wraptree bench --partitioned`).
+//! The measurements: the exact and the partitioned grouping beside obvhs PLOC, each in a rayon
+//! pool of 1 and 2 threads, with the partitioned tree's quality against the exact tree's and
+//! the builds' peak memory.
 
-use crate::grouping::{Params, Schedule};
-use crate::metrics::bench::{RecordCost, record_cost};
-use crate::metrics::timing::fastest;
-use crate::metrics::{compare, peak_rss_bytes, sah};
-use crate::peers::Method;
-use crate::query::{self, Bv, Workload};
-use crate::record::Detail;
-use crate::scene::Scene;
-use crate::scene::spec::as_loaded;
-use crate::stop::Stop;
 use anyhow::{Result, anyhow};
+use wraptree::grouping::{Params, Schedule};
+use wraptree::metrics::bench::{RecordCost, record_cost};
+use wraptree::metrics::timing::fastest;
+use wraptree::metrics::{compare, peak_rss_bytes, sah};
+use wraptree::peers::Method;
+use wraptree::query::{self, Bv, Workload};
+use wraptree::record::Detail;
+use wraptree::scene::Scene;
+use wraptree::scene::spec::as_loaded;
+use wraptree::stop::Stop;
 
 /// Thread counts of the table.
 pub const THREADS: [usize; 2] = [1, 2];

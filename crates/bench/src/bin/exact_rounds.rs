@@ -2,9 +2,9 @@
 //! step 3, timed up to its `RoundStart` event, the first round's with the run's set-up) and its
 //! merges (step 4, up to its `Doubling` or the run's `Finish`),
 //! with the round's active bodies, eligible pairs and merges; one thread, one run per file
-//! (`docs/benchmarks.md`, "The exact schedule alone, against obvhs PLOC").
+//! (`docs/benchmarks.md`, "What does the exact run cost?").
 //!
-//! `cargo run --release --example exact_rounds -- FILE...`
+//! `cargo run --release -p wraptree-bench --bin exact_rounds -- FILE...`
 
 use std::time::Instant;
 use wraptree::grouping::{Event, Observer, Params, group};

@@ -2,9 +2,9 @@
 //! contact query (every touching pair), per builder: the fast path, parry Binned, obvhs PLOC
 //! and PLOC + reinsertion, AABB BVs, on the touching poses of the standard workloads of seeds
 //! 1 to SEEDS (8 each). Then per builder the sums, and each sum over the least of the peers'
-//! (`docs/benchmarks.md`, "Contact queries: the touching poses measured by the trees alone").
+//! (a study; its table is in the git history of `docs/benchmarks.md`).
 //!
-//! `cargo run --release --example touching_poses -- SEEDS FILE`
+//! `cargo run --release -p wraptree-bench --bin touching_poses -- SEEDS FILE`
 
 use std::path::Path;
 use wraptree::grouping::Params;

@@ -1,8 +1,8 @@
-//! What `bench --partitioned` prints: the partitioned schedule's table
-//! ([`crate::metrics::bench::partitioned`]) with its header and notes.
+//! What this program prints: the partitioned schedule's table ([`crate::measure`]) with its
+//! header and notes.
 
-use crate::metrics::bench::RecordCost;
-use crate::metrics::bench::partitioned::{Case, Row};
+use crate::measure::{Case, Row};
+use wraptree::metrics::bench::RecordCost;
 
 /// The partitioned table's header line (after a blank line).
 pub fn partitioned_header() -> String {

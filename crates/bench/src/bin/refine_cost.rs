@@ -4,7 +4,7 @@
 //! over the best peer's (the lower of parry Binned and obvhs PLOC + reinsertion, as
 //! `wraptree bench`). How the refinement's defaults were chosen (`docs/benchmarks.md`).
 //!
-//! `cargo run --release --example refine_cost [MAX_SOUP] [REPEAT] [VARIANT ...]` — default
+//! `cargo run --release -p wraptree-bench --bin refine_cost [MAX_SOUP] [REPEAT] [VARIANT ...]` — default
 //! 100000, 3 and the default refinement; `scene=NAME` arguments keep only those scenes. A
 //! variant is `T:K:P:B[:G[:E[:after]]]`: T treelet passes of K leaves rooted at the nodes of at
 //! least G leaves on every E-th height (defaults: [`Tuning::default`]'s; G = 0 is γ by the

@@ -26,7 +26,7 @@
 //! passes), `TREELETS` (treelet passes before them), `TK` (a treelet's leaves) and `GAMMA` (the
 //! fewest leaves under a treelet root).
 //!
-//! `cargo run --release --example method_timing -- [--threads 1] [--repeat 5]
+//! `cargo run --release -p wraptree-bench --bin method_timing -- [--threads 1] [--repeat 5]
 //! [--methods fast,grouping] FILE...` (a FILE may be a generated scene's spec: `soup:1000000`)
 
 use std::path::Path;
