@@ -64,7 +64,7 @@ const VARIED: [&str; 9] = [
 /// `method` built, the fast path with the settings the environment varies (without them, as
 /// `wraptree bench` builds it).
 fn build_varied(method: Method, scene: &Scene, params: &Params) -> Result<Built, String> {
-    if method != Method::Fast || !VARIED.iter().any(|v| std::env::var_os(v).is_some()) {
+    if method != Method::FAST || !VARIED.iter().any(|v| std::env::var_os(v).is_some()) {
         return build(method, scene, params);
     }
     let mut p = params.clone();
@@ -128,7 +128,7 @@ impl Row {
 fn main() -> anyhow::Result<()> {
     let mut threads = 1usize;
     let mut repeat = 5u32;
-    let mut methods = vec![Method::Fast];
+    let mut methods = vec![Method::FAST];
     let mut files = Vec::new();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -175,12 +175,12 @@ fn main() -> anyhow::Result<()> {
     let quality = env::<u32>("QUALITY") != Some(0);
     let peers: &[Method] = if quality {
         &[
-            Method::ParryBinned,
-            Method::ObvhsPloc,
-            Method::ObvhsPlocReinsert,
+            Method::PARRY_BINNED,
+            Method::OBVHS_PLOC,
+            Method::OBVHS_PLOC_REINSERT,
         ]
     } else {
-        &[Method::ObvhsPloc]
+        &[Method::OBVHS_PLOC]
     };
     let ploc_slot = if quality { 1 } else { 0 };
     let mut mirrored_rows = Vec::new();
