@@ -336,10 +336,11 @@ proptest! {
         params in arb_params(),
     ) {
         // The default chunking gives these scenes (≤ `top` primitives) the exact tree; AAC's
-        // reduction alone and a small root share run the chunks.
+        // reduction alone and a small root share run the chunks (of δ = 4, the default's for
+        // large scenes).
         let resolved = params.resolve(&scene);
         for top in [Chunking::DEFAULT.top, 0, 100] {
-            let chunking = Chunking { top, ..Chunking::DEFAULT };
+            let chunking = Chunking { top, ..Chunking::DEFAULT.for_size(usize::MAX) };
             let run = || {
                 let mut log = EventLog::default();
                 let g = group_with(&scene, &resolved, &chunking, &mut log, &Budget::default());

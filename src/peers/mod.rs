@@ -104,8 +104,9 @@ impl Builder {
     }
 }
 
-/// A hierarchy method: a builder, then optionally a refinement of its tree.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+/// A hierarchy method: a builder, then optionally a refinement of its tree. Serialised as its
+/// name ([`Method::name`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct Method {
     /// The builder.
     pub builder: Builder,
@@ -269,6 +270,12 @@ impl Method {
             "delta={} epsilon={} top={} sah={}",
             c.delta, c.epsilon, c.top, c.sah_below
         ))
+    }
+}
+
+impl serde::Serialize for Method {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
     }
 }
 

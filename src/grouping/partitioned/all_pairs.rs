@@ -1,11 +1,11 @@
-//! The brute-force step ([`brute_force`](super::brute_force)) for subproblems of at most
+//! The brute-force step (`brute_force`) for subproblems of at most
 //! [`MAX_BODIES`] bodies,
 //! most of the partitioned schedule's subproblems (AAC's chunks and the levels just above).
 //!
 //! With so few bodies, keeping each body's cheapest partner costs more than it saves: every
 //! step looks at all pairs of the bodies left. The pair merged next is the least by (its
 //! round, clamped to the current round; Cost; smaller tie tag; larger tie tag), which is the
-//! pair [`partner_table`](super::partner_table) merges: the cheapest pair eligible in the current round, or, when none is,
+//! pair `partner_table` merges: the cheapest pair eligible in the current round, or, when none is,
 //! the cheapest of those eligible first in a later round, which becomes the current one. The
 //! counters (eligible pairs at each round start, candidates, pops, rounds) and the events'
 //! queue length (bodies with an eligible partner after the merge) are those of `brute_force`.
@@ -88,7 +88,7 @@ impl Pairs {
 /// [`run`] for two bodies `x` and `y` (in slot order) that become one, without the table of
 /// pairs: the same merge (slot 0 of `out`), event and counters (added to `stats`); returns the
 /// new body. Below the root's share of the fast path's split every node does this
-/// ([`Executor::merge_down`](super::executor::Executor::merge_down)).
+/// (`Executor::merge_down`).
 pub(super) fn pair(
     ctx: &RunInputs,
     x: &Body,
@@ -112,9 +112,9 @@ pub(super) fn pair(
     body
 }
 
-/// [`brute_force::combine`](super::brute_force::combine) for at most [`MAX_BODIES`] bodies (more
+/// `brute_force::combine` for at most [`MAX_BODIES`] bodies (more
 /// than `keep`).
-pub(super) fn combine(
+pub(super) fn combine_few(
     ctx: &RunInputs,
     body: &mut [Body],
     parts: [Leftover; 2],

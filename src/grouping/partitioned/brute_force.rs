@@ -7,8 +7,8 @@ use super::subproblem::{Body, Leftover, MergeSlots, PairList, RunInputs};
 use super::{all_pairs, partner_table};
 
 /// The most bodies a subproblem may have to be solved by brute force (more go to
-/// [`voxel_step`](super::voxel_step)).
-pub(super) const MAX_BODIES: usize = 64;
+/// `voxel_step`).
+pub(super) const MAX_BODIES: usize = partner_table::MAX_BODIES;
 
 /// Groups the bodies of `body` (at most [`MAX_BODIES`]: the first `parts[0].n` of one half, then
 /// `parts[1].n` of the other) until `keep` remain, writing merge `i` to `out` at index `i`
@@ -31,7 +31,7 @@ pub(super) fn combine(
         };
     }
     if body.len() <= all_pairs::MAX_BODIES {
-        return all_pairs::combine(ctx, body, parts, keep, out, export);
+        return all_pairs::combine_few(ctx, body, parts, keep, out, export);
     }
-    partner_table::combine(ctx, body, parts, keep, out, export)
+    partner_table::combine_by_partners(ctx, body, parts, keep, out, export)
 }

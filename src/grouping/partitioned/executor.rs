@@ -131,7 +131,7 @@ impl Executor<'_> {
                 export,
             ));
         }
-        voxel_step::combine(self.ctx, arena[..m].to_vec(), keep, own).map(|bodies| {
+        voxel_step::combine_by_voxels(self.ctx, arena[..m].to_vec(), keep, own).map(|bodies| {
             arena[..bodies.len()].copy_from_slice(&bodies);
             Leftover {
                 n: bodies.len(),

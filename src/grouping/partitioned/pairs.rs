@@ -1,5 +1,5 @@
-//! What both brute-force solvers ([`partner_table`](super::partner_table) and
-//! [`all_pairs`](super::all_pairs)) share: a pair's Cost and first eligible round, every pair of
+//! What both brute-force solvers (`partner_table` and
+//! `all_pairs`) share: a pair's Cost and first eligible round, every pair of
 //! a subproblem, the merged body, the merge written out with what its events read, and the
 //! bodies left with their pairs.
 

@@ -1,5 +1,5 @@
 //! The agglomerative step of §2.2 by brute force with a table of every pair, for subproblems of
-//! more than [`all_pairs::MAX_BODIES`](super::all_pairs::MAX_BODIES) and at most
+//! more than `all_pairs::MAX_BODIES` and at most
 //! [`MAX_BODIES`] bodies.
 //!
 //! Every pair of bodies gets, once, its Cost and the first round in which it is eligible: the
@@ -14,12 +14,14 @@
 //! was solved here passes its bodies' pairs up with them (`Leftover`), so its parent evaluates only
 //! the pairs across the two halves (a pair's Cost and round depend on its two bodies alone).
 
-use super::brute_force::MAX_BODIES;
 use super::pairs::{eval, leave, merged, pairs_of, put_merge};
 use super::round_limits::NO_ROUND;
 use super::subproblem::{Body, Counters, Leftover, MergeSlots, RunInputs};
 use crate::grouping::cluster::tie_tag;
 use std::cell::RefCell;
+
+/// The most bodies a subproblem solved here may have (the brute-force limit).
+pub(super) const MAX_BODIES: usize = 64;
 
 /// The pairs of a subproblem: Cost (as [`order_bits`]) and first eligible round of every
 /// ordered pair of slots, each body's cheapest partner eligible in the current round, and the
@@ -115,8 +117,8 @@ thread_local! {
 }
 
 /// Groups the bodies of `body` down to `keep` with the thread's table (see
-/// [`combine`](super::brute_force::combine)).
-pub(super) fn combine(
+/// `combine`).
+pub(super) fn combine_by_partners(
     ctx: &RunInputs,
     body: &mut [Body],
     parts: [Leftover; 2],
@@ -127,7 +129,7 @@ pub(super) fn combine(
     TABLE.with(|t| with_table(ctx, body, parts, keep, out, export, &mut t.borrow_mut()))
 }
 
-/// [`combine`] with table `t`.
+/// [`combine_by_partners`] with table `t`.
 fn with_table(
     ctx: &RunInputs,
     body: &mut [Body],

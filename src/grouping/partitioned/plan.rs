@@ -67,14 +67,14 @@ pub(super) fn post_order(nodes: &[Node]) -> Vec<u32> {
 }
 
 /// Ranges of at least this many primitives plan their halves in parallel (on 16 cores, 256
-/// against 1,024, with [`executor`](super::executor)'s grain and the refinement's search
+/// against 1,024, with `executor`'s grain and the refinement's search
 /// threshold lowered alike, took the fast path's median time on 69 real meshes from 1.16× to
 /// 1.07× PLOC's on 4 threads and from 1.16× to 1.01–1.06× on 16: `docs/benchmarks.md`).
 const PLAN_GRAIN: u32 = 1 << 8;
 
 /// The split of the primitives into chunks, nodes in pre-order (the root first): `codes`
 /// sorted, `leaves` the primitives in the same order. Ranges of at most
-/// [`Chunking::sah_below`] primitives are cut by binned SAH ([`split`](super::split)), which
+/// [`Chunking::sah_below`] primitives are cut by binned SAH (`split`), which
 /// reorders `codes` and `leaves` alike within them; the nodes' ranges index the new order.
 /// Halves of large ranges are planned in parallel into blocks of nodes, laid end to end at the
 /// end (the same nodes and order as one sequential pass, whatever the number of threads).

@@ -83,7 +83,7 @@ fn solve_parts(
         None => {
             let [a, b] = parts;
             let bodies = [a.bodies, b.bodies].concat();
-            part(&voxel_step::combine(ctx, bodies, keep, &mut out).unwrap())
+            part(&voxel_step::combine_by_voxels(ctx, bodies, keep, &mut out).unwrap())
         }
     };
     let merges = (0..m)
@@ -226,7 +226,7 @@ fn two_bodies_merge_as_the_table_of_pairs_merges_them() {
                     };
                     (left, stats)
                 } else {
-                    let left = all_pairs::combine(&ctx, &mut arena, parts, 1, &mut out, true);
+                    let left = all_pairs::combine_few(&ctx, &mut arena, parts, 1, &mut out, true);
                     (left, out.stats)
                 };
                 let stats = format!("{stats:?}");
