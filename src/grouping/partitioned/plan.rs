@@ -305,25 +305,10 @@ const PLACEHOLDER: Node = Node {
 };
 
 #[cfg(test)]
-pub(super) mod tests {
+mod tests {
+    use super::super::sort::tests::codes;
     use super::*;
     use rand::{Rng, SeedableRng};
-
-    /// `n` pairs in id order with codes from a few clustered values (many ties) and random
-    /// ones.
-    pub(in crate::grouping::partitioned) fn codes(n: usize, seed: u64) -> Vec<(u64, u32)> {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        (0..n as u32)
-            .map(|i| {
-                let code = if rng.random_bool(0.3) {
-                    rng.random_range(0..4u64) << 40
-                } else {
-                    rng.random::<u64>() >> 1
-                };
-                (code, i)
-            })
-            .collect()
-    }
 
     /// A leaf for each of `codes`: a small box at a random place (not its code's).
     fn leaves(codes: &[(u64, u32)], seed: u64) -> Vec<Body> {
