@@ -118,36 +118,29 @@ fn incomplete(m: &Record) -> bool {
 }
 
 /// The record `m` in the current form: as it is with the current `format_version`; without
-/// one (older recordings), with [`LEGACY_DEFAULTS`] filled in and the older spellings of two
-/// settings rewritten (`refine` = `reinsert`, refinement without treelet passes; `chunk_max`,
-/// which was 0 = δ, dropped). A newer `format_version`, or an older run this version cannot
+/// one (older recordings), with the legacy defaults (`LEGACY_DEFAULTS`) filled in and the older
+/// spellings of two settings rewritten (`refine` = `reinsert`, refinement without treelet
+/// passes; `chunk_max`, which was 0 = δ, dropped). A newer `format_version`, or an older run this version cannot
 /// re-run (chunks of fewer than δ primitives), is one error line.
 pub fn current_form(mut m: Record) -> Result<Record> {
-    match m.get("format_version") {
-        Some(v) => {
-            let v: u32 = v
-                .parse()
-                .map_err(|_| anyhow!("`{RUN}` metadata has a bad `format_version`: {v:?}"))?;
-            if v > FORMAT_VERSION {
-                return Err(anyhow!(
-                    "the recording's format_version is {v}, newer than this wraptree reads \
-                     ({FORMAT_VERSION}): read it with a newer wraptree"
-                ));
-            }
-            return Ok(m);
+    if let Some(v) = m.get("format_version") {
+        let v: u32 = v
+            .parse()
+            .map_err(|_| anyhow!("`{RUN}` metadata has a bad `format_version`: {v:?}"))?;
+        if v > FORMAT_VERSION {
+            return Err(anyhow!(
+                "the recording's format_version is {v}, newer than this wraptree reads \
+                 ({FORMAT_VERSION}): read it with a newer wraptree"
+            ));
         }
-        None => {}
+        return Ok(m);
     }
-    if partitioned(&m) {
-        match m.remove("chunk_max").as_deref() {
-            Some("0") => {}
-            _ => {
-                return Err(anyhow!(
-                    "`{RUN}` metadata: the run cut its split into chunks of fewer than δ \
-                     primitives (no `chunk_max` = 0), which this wraptree no longer does"
-                ));
-            }
-        }
+    // `chunk_max` was always 0 (= δ) but in runs made before it was written.
+    if partitioned(&m) && m.remove("chunk_max").as_deref() != Some("0") {
+        return Err(anyhow!(
+            "`{RUN}` metadata: the run cut its split into chunks of fewer than δ primitives \
+             (no `chunk_max` = 0), which this wraptree no longer does"
+        ));
     }
     if m.get("refine").map(String::as_str) == Some("reinsert") {
         m.insert("refine".into(), "treelet+reinsert".into());
