@@ -13,7 +13,7 @@ use wraptree::stop::{Stop, is_interrupted};
 #[test]
 fn every_method_is_built_once_per_round_in_turn_and_keeps_its_fastest_build() {
     let scene = generate::robot_base();
-    let methods = [Method::Grouping, Method::Fast, Method::ObvhsPloc];
+    let methods = [Method::GROUPING, Method::FAST, Method::OBVHS_PLOC];
     // The clock, per call in order: grouping's fastest in round 3, the fast path's in round 2
     // (tied in round 4: the first is kept), PLOC's in round 1.
     let clock = [
@@ -44,9 +44,9 @@ fn every_method_is_built_once_per_round_in_turn_and_keeps_its_fastest_build() {
     assert_eq!(
         kept,
         [
-            (Method::Grouping, 4.0, 6.0),
-            (Method::Fast, 2.0, 4.0),
-            (Method::ObvhsPloc, 1.0, 2.0),
+            (Method::GROUPING, 4.0, 6.0),
+            (Method::FAST, 2.0, 4.0),
+            (Method::OBVHS_PLOC, 1.0, 2.0),
         ]
     );
     for b in &built {
@@ -59,7 +59,7 @@ fn a_stop_ends_the_rounds_before_the_next_build() {
     let scene = generate::soup(50, 1);
     let stop = Stop::new();
     let mut calls = 0;
-    let r = fastest_builds(&[Method::Grouping, Method::ObvhsPloc], 5, &stop, |m| {
+    let r = fastest_builds(&[Method::GROUPING, Method::OBVHS_PLOC], 5, &stop, |m| {
         calls += 1;
         if calls == 3 {
             stop.request();
@@ -74,7 +74,7 @@ fn a_stop_ends_the_rounds_before_the_next_build() {
 fn bench_builds_in_rounds_before_its_wrappers_and_its_table_divides_by_ploc_s_time() {
     let scene = generate::replicate(&generate::robot_base(), 3, 1);
     let opts = Options {
-        methods: vec![Method::Fast, Method::ObvhsPloc],
+        methods: vec![Method::FAST, Method::OBVHS_PLOC],
         wrappers: vec![Wrapper::Box],
         repeat: 3,
         tightness_max_n: 0,
@@ -83,7 +83,7 @@ fn bench_builds_in_rounds_before_its_wrappers_and_its_table_divides_by_ploc_s_ti
     let mut steps = Vec::new();
     let rows = evaluate(&scene, &opts, &Stop::new(), &mut |s| steps.push(s)).unwrap();
     let builds: Vec<Step> = steps.iter().copied().take(6).collect();
-    let rounds: Vec<Step> = [Method::Fast, Method::ObvhsPloc]
+    let rounds: Vec<Step> = [Method::FAST, Method::OBVHS_PLOC]
         .repeat(3)
         .into_iter()
         .map(Step::Build)
@@ -95,7 +95,7 @@ fn bench_builds_in_rounds_before_its_wrappers_and_its_table_divides_by_ploc_s_ti
     assert!(!steps[6..].iter().any(|s| matches!(s, Step::Build(_))));
     // The table's `/ PLOC` column: each row's build time over PLOC's row's.
     let build_s = |m: Method| rows.iter().find(|r| r.method == m.name()).unwrap().build_s;
-    let (fast, ploc) = (build_s(Method::Fast), build_s(Method::ObvhsPloc));
+    let (fast, ploc) = (build_s(Method::FAST), build_s(Method::OBVHS_PLOC));
     let table = bench_table(&rows.iter().collect::<Vec<_>>());
     let header: Vec<&str> = table
         .lines()

@@ -54,15 +54,15 @@ fn the_fast_path_is_a_valid_tree_and_the_same_on_1_and_2_threads() {
     for scene in scenes() {
         // Split into many subproblems (not grouped whole).
         assert!(!Chunking::FAST.whole(scene.len()), "{}", scene.name);
-        for m in [Method::GroupingFast, Method::Fast] {
+        for m in [Method::GROUPING_FAST, Method::FAST] {
             let one = tree_on(1, m, &scene);
             let two = tree_on(2, m, &scene);
             check_cover(&one, &scene);
             assert_eq!(one.children, two.children, "{} {}", scene.name, m.name());
             assert_eq!(one.aabb, two.aabb, "{} {}", scene.name, m.name());
         }
-        let grouped = tree_on(2, Method::GroupingFast, &scene);
-        let fast = tree_on(2, Method::Fast, &scene);
+        let grouped = tree_on(2, Method::GROUPING_FAST, &scene);
+        let fast = tree_on(2, Method::FAST, &scene);
         assert!(sah(&fast) <= sah(&grouped), "{}", scene.name);
     }
 }
@@ -101,8 +101,8 @@ fn the_fast_flag_groups_partitioned_with_the_fast_split_and_parses_like_the_othe
         "{err}"
     );
     // The bench method by name.
-    assert_eq!(Method::parse("fast"), Ok(Method::Fast));
-    assert_eq!(Method::parse("grouping-fast"), Ok(Method::GroupingFast));
+    assert_eq!(Method::parse("fast"), Ok(Method::FAST));
+    assert_eq!(Method::parse("grouping-fast"), Ok(Method::GROUPING_FAST));
 }
 
 #[test]
@@ -112,8 +112,8 @@ fn the_bench_method_refines_with_a_smaller_first_batch_from_2_14_primitives_up()
     use wraptree::refine::{self, FAST, FAST_LARGE, fast_for};
     for n in [5_000, FAST_LARGE + 1_000] {
         let scene = generate::soup(n, 11);
-        let bench = tree_on(1, Method::Fast, &scene);
-        let grouped = tree_on(1, Method::GroupingFast, &scene);
+        let bench = tree_on(1, Method::FAST, &scene);
+        let grouped = tree_on(1, Method::GROUPING_FAST, &scene);
         let ours = refine::refine(&grouped, &fast_for(n), ()).tree;
         assert_eq!(bench, ours, "{n} primitives");
         let tenth = refine::refine(&grouped, &FAST, ()).tree;
@@ -131,8 +131,8 @@ fn below_2_10_primitives_the_bench_method_refines_without_its_treelet_pass() {
     use wraptree::refine::{self, FAST, FAST_SMALL, FAST_SMALL_PARAMS, fast_for};
     let n = 700;
     let scene = generate::soup(n, 5);
-    let bench = tree_on(1, Method::Fast, &scene);
-    let grouped = tree_on(1, Method::GroupingFast, &scene);
+    let bench = tree_on(1, Method::FAST, &scene);
+    let grouped = tree_on(1, Method::GROUPING_FAST, &scene);
     assert_eq!(bench, refine::refine(&grouped, &FAST_SMALL_PARAMS, ()).tree);
     assert_ne!(bench, refine::refine(&grouped, &FAST, ()).tree);
     assert_eq!(fast_for(FAST_SMALL - 1), FAST_SMALL_PARAMS);
@@ -165,7 +165,7 @@ fn record_fast_refine_gives_the_bench_tree_and_replays() {
     let r = rec.refine.expect("the metadata names the refinement");
     let scene = load_path(&bunny, &LoadOptions::default()).unwrap().scene;
     assert_eq!(r.params, fast_for(scene.len()), "the recorded parameters");
-    let bench = tree_on(1, Method::Fast, &scene);
+    let bench = tree_on(1, Method::FAST, &scene);
     assert_eq!(
         refine(&rec.tree(&scene).unwrap(), &r.params, ()).tree,
         bench

@@ -17,9 +17,22 @@ use wraptree::grouping::{
 use wraptree::scene::pathological as path;
 use wraptree::scene::{LoadOptions, generate};
 
+/// The chunking of a partitioned `mode`.
+fn chunking(mode: &Mode) -> Chunking {
+    *mode.schedule.chunking().expect("a partitioned schedule")
+}
+
+/// The chunking an older recording's `wraptree` record `m` (without `format_version`) is read
+/// with.
+fn legacy(m: &std::collections::BTreeMap<String, String>) -> anyhow::Result<Chunking> {
+    use wraptree::record::mcap::metadata;
+    let params = metadata::params(&metadata::current_form(m.clone())?)?;
+    Ok(chunking(&params.mode))
+}
+
 fn partitioned(mut p: Params) -> Params {
     p.mode = Mode {
-        schedule: Schedule::Partitioned,
+        schedule: Schedule::PARTITIONED,
         ..Mode::default()
     };
     p
@@ -172,7 +185,10 @@ fn a_scene_smaller_than_a_chunk_gets_the_exact_tree() {
     // up to 63 primitives; and a root share of 40, whose scenes of up to 60 primitives are one
     // subproblem ([`Chunking::whole`]).
     for (chunking, max_n) in [
-        (Chunking::DEFAULT, Chunking::DEFAULT.delta as usize),
+        (
+            Chunking::DEFAULT.for_size(usize::MAX),
+            Chunking::LARGE_DELTA as usize,
+        ),
         (
             Chunking {
                 top: 40,
@@ -222,39 +238,15 @@ fn a_scene_smaller_than_a_chunk_gets_the_exact_tree() {
 }
 
 #[test]
-fn the_largest_chunk_is_delta_unless_set_and_aacs_rule_still_runs() {
-    // AAC's rule (chunks of fewer than δ, how recordings without `chunk_max` were split) cuts
-    // ranges of δ, some of them 1 + 3, which gives another tree; both are valid.
-    let scene = generate::soup(3_000, 12);
-    let resolved = Params::default().resolve(&scene);
-    let run = |chunk_max| {
-        let chunking = Chunking {
-            top: 32,
-            chunk_max,
-            ..Chunking::DEFAULT
-        };
-        let mut log = EventLog::default();
-        let g = group_with(&scene, &resolved, &chunking, &mut log, &Budget::default()).unwrap();
-        check_tree(&scene, &g, &log);
-        g.tree
-    };
-    let by_delta = run(0);
-    assert_eq!(by_delta, run(Chunking::DEFAULT.delta));
-    assert_ne!(by_delta, run(Chunking::DEFAULT.delta - 1));
-}
-
-#[test]
-fn with_delta_2_nodes_merge_their_halves_and_larger_chunks_still_group_whole() {
-    // δ = 2 (the fast path's): below the root share every node keeps one body. Chunks of up
-    // to 6 primitives then group down to one body each inside such subtrees; both trees are
+fn with_delta_2_nodes_merge_their_halves_the_same_on_any_thread_count() {
+    // δ = 2 (the fast path's): below the root share every node keeps one body; the tree is
     // valid, announced in full, and the same on 1 and 2 threads.
     let scene = generate::soup(3_000, 13);
     let resolved = Params::default().resolve(&scene);
-    let run = |chunk_max, threads| {
+    let run = |threads| {
         let chunking = Chunking {
             top: 32,
             delta: 2,
-            chunk_max,
             ..Chunking::DEFAULT
         };
         let pool = rayon::ThreadPoolBuilder::new()
@@ -268,14 +260,7 @@ fn with_delta_2_nodes_merge_their_halves_and_larger_chunks_still_group_whole() {
         check_tree(&scene, &g, &log);
         g.tree
     };
-    for chunk_max in [0, 6] {
-        assert_eq!(
-            run(chunk_max, 1),
-            run(chunk_max, 2),
-            "chunk_max {chunk_max}"
-        );
-    }
-    assert_ne!(run(0, 1), run(6, 1));
+    assert_eq!(run(1), run(2));
 }
 
 #[test]
@@ -283,7 +268,7 @@ fn the_fast_path_merges_identical_boxes_first_the_same_on_any_thread_count() {
     // Every triangle twice (double-sided faces), three times, and 300 copies of one triangle:
     // the fast path merges identical boxes first, announced as one part, then splits the rest.
     let mut fast = Params::default();
-    fast.mode = fast.mode.fast();
+    fast.mode.schedule = Schedule::FAST;
     let cases = [
         (path::duplicates(4_000, 2, 3), 2_000, 4_000),
         (path::duplicates(900, 3, 5), 600, 900),
@@ -315,7 +300,10 @@ fn the_fast_path_merges_identical_boxes_first_the_same_on_any_thread_count() {
     // A scene without identical boxes gets the tree it got without the twins step; with them
     // off, a doubled scene is split whole (another valid tree, no twins part).
     let mut off = fast.clone();
-    off.mode.chunk_twins = false;
+    off.mode.schedule = Schedule::Partitioned(Chunking {
+        twins: false,
+        ..Chunking::FAST
+    });
     let soup = generate::soup(3_000, 9);
     let (with, log) = run(&soup, &fast);
     assert_eq!(with.tree, group(&soup, &off, ()).tree);
@@ -348,10 +336,11 @@ proptest! {
         params in arb_params(),
     ) {
         // The default chunking gives these scenes (≤ `top` primitives) the exact tree; AAC's
-        // reduction alone and a small root share run the chunks.
+        // reduction alone and a small root share run the chunks (of δ = 4, the default's for
+        // large scenes).
         let resolved = params.resolve(&scene);
         for top in [Chunking::DEFAULT.top, 0, 100] {
-            let chunking = Chunking { top, ..Chunking::DEFAULT };
+            let chunking = Chunking { top, ..Chunking::DEFAULT.for_size(usize::MAX) };
             let run = || {
                 let mut log = EventLog::default();
                 let g = group_with(&scene, &resolved, &chunking, &mut log, &Budget::default());
@@ -476,9 +465,9 @@ fn replay_verifies_a_partitioned_recording() {
         dir.path(),
     );
     let rec = recorded(&out, &dir.path().join("p.mcap"));
-    assert_eq!(rec.params.mode.schedule, Schedule::Partitioned);
+    assert!(rec.params.mode.schedule.is_partitioned());
     // δ by the scene's size: chunks of up to 4,096 primitives.
-    assert_eq!(rec.params.mode.chunk_delta, 4096);
+    assert_eq!(rec.params.mode.schedule.chunking().unwrap().delta, 4096);
     assert!(rec.parts.len() > 2, "{} parts recorded", rec.parts.len());
     let (_, log) = run(&scene, &partitioned(Params::default()));
     assert_eq!(rec.parts, log.parts);
@@ -532,7 +521,7 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
         dir.path(),
     );
     let rec = recorded(&out, &dir.path().join("p.mcap"));
-    assert_eq!(rec.params.mode.chunk_top, 256);
+    assert_eq!(rec.params.mode.schedule.chunking().unwrap().top, 256);
     assert!(rec.parts.len() > 10, "{} parts recorded", rec.parts.len());
     let out = wraptree(&["replay", "p.mcap", "--verify"], dir.path());
     let text = String::from_utf8_lossy(&out.stdout);
@@ -547,7 +536,7 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
         dir.path(),
     );
     let rec_e = recorded(&out, &dir.path().join("e.mcap"));
-    assert_eq!(rec_e.params.mode.chunk_epsilon, 0.2);
+    assert_eq!(rec_e.params.mode.schedule.chunking().unwrap().epsilon, 0.2);
     assert_ne!(rec_e.merges, rec.merges);
     let out = wraptree(&["replay", "e.mcap", "--verify"], dir.path());
     let text = String::from_utf8_lossy(&out.stdout);
@@ -559,37 +548,54 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
         dir.path(),
     );
     let rec_m = recorded(&out, &dir.path().join("m.mcap"));
-    assert_eq!(rec.params.mode.chunk_sah, Chunking::DEFAULT.sah_below);
-    assert_eq!(rec_m.params.mode.chunk_sah, 0);
+    assert_eq!(
+        rec.params.mode.schedule.chunking().unwrap().sah_below,
+        Chunking::DEFAULT.sah_below
+    );
+    assert_eq!(rec_m.params.mode.schedule.chunking().unwrap().sah_below, 0);
     assert_ne!(rec_m.merges, rec.merges);
     let out = wraptree(&["replay", "m.mcap", "--verify"], dir.path());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success() && text.contains("verified"), "{text}");
+    // A recording without `format_version` (older) and without `chunk_sah` was cut at Morton
+    // bits throughout.
     let mut old = rec.metadata.clone();
+    assert_eq!(old.remove("format_version").as_deref(), Some("1"));
+    old.insert("chunk_max".into(), "0".into());
     old.remove("chunk_sah");
-    let params = wraptree::record::mcap::metadata::params(&old).unwrap();
-    assert_eq!(params.mode.chunk_sah, 0);
-    // The largest chunk is recorded (0 = δ); a recording without it made chunks of fewer
-    // than δ primitives, as AAC does, and is replayed so.
-    assert_eq!(rec.metadata.get("chunk_max").map(String::as_str), Some("0"));
-    assert_eq!(rec.params.mode.chunk_max, 0);
-    old.remove("chunk_max");
-    let params = wraptree::record::mcap::metadata::params(&old).unwrap();
-    assert_eq!(params.mode.chunk_max, Chunking::DEFAULT.delta - 1);
-    // δ is recorded and read back as the run used it (4 here, 2 on the fast path), and a
-    // partitioned recording without it was made with 4.
+    assert_eq!(legacy(&old).unwrap().sah_below, 0);
+    // The largest chunk was recorded as 0 (= δ) before it was dropped; an older recording
+    // without it made chunks of fewer than δ primitives, which no longer runs: one error.
+    let mut fewer = old.clone();
+    fewer.remove("chunk_max");
+    let err = legacy(&fewer).unwrap_err().to_string();
+    assert!(err.contains("chunks of fewer than δ"), "{err}");
+    // δ is recorded and read back as the run used it (4 here, 2 on the fast path), and an
+    // older partitioned recording without it was made with 4.
     assert_eq!(
         rec.metadata.get("chunk_delta").map(String::as_str),
         Some("4")
     );
     old.remove("chunk_delta");
-    let params = wraptree::record::mcap::metadata::params(&old).unwrap();
-    assert_eq!(params.mode.chunk_delta, Chunking::DEFAULT.delta);
+    assert_eq!(legacy(&old).unwrap().delta, 4);
+    // A newer format is one error naming the versions.
+    let mut newer = rec.metadata.clone();
+    newer.insert("format_version".into(), "2".into());
+    let err = wraptree::record::mcap::metadata::current_form(newer)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("format_version is 2, newer than"), "{err}");
+    // A current recording lacking a key is an error naming it, not a guess.
+    let mut lacking = rec.metadata.clone();
+    lacking.remove("chunk_sah");
+    let lacking = wraptree::record::mcap::metadata::current_form(lacking).unwrap();
+    let err = wraptree::record::mcap::metadata::params(&lacking).unwrap_err();
+    assert!(err.to_string().contains("lacks `chunk_sah`"), "{err}");
     // A bad value gives one error naming the key.
     let rejects = |key: &str, value: &str, why: &str| {
         let mut bad = old.clone();
         bad.insert(key.into(), value.into());
-        let err = wraptree::record::mcap::metadata::params(&bad).unwrap_err();
+        let err = legacy(&bad).unwrap_err();
         assert!(err.to_string().contains(why), "{err}");
     };
     rejects(
@@ -603,7 +609,10 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
     rejects("chunk_few", "5", "chunk_few must be at most 4, got 5");
     let out = wraptree(&["record", "s.obj", "--fast", "-o", "q"], dir.path());
     let rec_q = recorded(&out, &dir.path().join("q.mcap"));
-    assert_eq!(rec_q.params.mode.chunk_delta, Chunking::FAST.delta);
+    assert_eq!(
+        rec_q.params.mode.schedule.chunking().unwrap().delta,
+        Chunking::FAST.delta
+    );
     assert_eq!(Chunking::FAST.delta, 2);
     assert_eq!(
         rec_q.metadata.get("chunk_few").map(String::as_str),
@@ -619,18 +628,20 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
         rec_q.metadata.get("chunk_twins").map(String::as_str),
         Some("true")
     );
-    assert!(rec_q.params.mode.chunk_twins);
+    assert!(rec_q.params.mode.schedule.chunking().unwrap().twins);
     rejects(
         "chunk_twins",
         "yes",
         "metadata has a bad `chunk_twins`: \"yes\"",
     );
     let mut fast_old = rec_q.metadata.clone();
+    fast_old.remove("format_version");
+    fast_old.insert("chunk_max".into(), "0".into());
     fast_old.remove("chunk_few");
     fast_old.remove("chunk_twins");
-    let params = wraptree::record::mcap::metadata::params(&fast_old).unwrap();
-    assert_eq!(params.mode.chunk_few, 0);
-    assert!(!params.mode.chunk_twins);
+    let old_fast = legacy(&fast_old).unwrap();
+    assert_eq!(old_fast.few, 0);
+    assert!(!old_fast.twins);
     let out = wraptree(&["replay", "q.mcap", "--verify"], dir.path());
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success() && text.contains("verified"), "{text}");
@@ -642,7 +653,10 @@ fn a_chosen_root_share_epsilon_and_sah_cuts_are_recorded_and_replayed() {
     // The default share groups this scene whole: one part, the top.
     let out = wraptree(&[&args[..], &["d"]].concat(), dir.path());
     let rec = recorded(&out, &dir.path().join("d.mcap"));
-    assert_eq!(rec.params.mode.chunk_top, Chunking::DEFAULT.top);
+    assert_eq!(
+        rec.params.mode.schedule.chunking().unwrap().top,
+        Chunking::DEFAULT.top
+    );
     assert_eq!(rec.parts.len(), 1);
     let out = wraptree(&["group", "s.obj", "--chunk-top", "64"], dir.path());
     common::assert_one_line_error(&out, "--chunk-top needs --schedule partitioned");
@@ -673,7 +687,7 @@ fn a_chosen_chunk_size_is_recorded_replayed_and_checked() {
         dir.path(),
     );
     let rec = recorded(&out, &dir.path().join("c.mcap"));
-    assert_eq!(rec.params.mode.chunk_delta, 64);
+    assert_eq!(rec.params.mode.schedule.chunking().unwrap().delta, 64);
     assert_eq!(
         rec.metadata.get("chunk_delta").map(String::as_str),
         Some("64")
@@ -697,7 +711,7 @@ fn a_chosen_chunk_size_is_recorded_replayed_and_checked() {
     // recorded as the δ used.
     let out = wraptree(&[&args[..], &["-o", "s"]].concat(), dir.path());
     let by_size = recorded(&out, &dir.path().join("s.mcap"));
-    assert_eq!(by_size.params.mode.chunk_delta, 4096);
+    assert_eq!(by_size.params.mode.schedule.chunking().unwrap().delta, 4096);
     assert_eq!(by_size.merges, exact.merges);
     // `group` says when the scene is one subproblem (at most 1.5 × the root share), where no
     // chunk setting changes the tree.
@@ -758,19 +772,23 @@ fn the_default_chunk_size_is_resolved_by_the_scene_s_size() {
     // stays as given.
     let boxes =
         |n: usize| vec![wraptree::geom::Aabb::from_points([&wraptree::geom::P3::origin()]); n];
+    let delta = |p: &Params, n| chunking(&p.resolve_boxes(&boxes(n)).mode).delta;
     let p = partitioned(Params::default());
-    assert_eq!(p.mode.chunk_delta, 0);
+    assert_eq!(chunking(&p.mode).delta, 0);
     let at = Chunking::BY_SIZE_UP_TO;
-    assert_eq!(p.resolve_boxes(&boxes(at)).mode.chunk_delta, 4096);
-    assert_eq!(p.resolve_boxes(&boxes(at + 1)).mode.chunk_delta, 4);
+    assert_eq!(delta(&p, at), 4096);
+    assert_eq!(delta(&p, at + 1), 4);
     assert_eq!(
-        Params::default().resolve_boxes(&boxes(10)).mode.chunk_delta,
-        0
+        Params::default().resolve_boxes(&boxes(10)).mode.schedule,
+        Schedule::Exact
     );
     let mut given = partitioned(Params::default());
-    given.mode.chunk_delta = 16;
-    assert_eq!(given.resolve_boxes(&boxes(10)).mode.chunk_delta, 16);
+    given.mode.schedule = Schedule::Partitioned(Chunking {
+        delta: 16,
+        ..Chunking::DEFAULT
+    });
+    assert_eq!(delta(&given, 10), 16);
     let mut fast = Params::default();
-    fast.mode = fast.mode.fast();
-    assert_eq!(fast.resolve_boxes(&boxes(10)).mode.chunk_delta, 2);
+    fast.mode.schedule = Schedule::FAST;
+    assert_eq!(delta(&fast, 10), 2);
 }

@@ -163,10 +163,10 @@ fn bundled() -> Vec<Scene> {
 #[test]
 fn refined_trees_are_valid_and_no_worse_on_every_bundled_scene() {
     for scene in bundled() {
-        for m in [Method::Grouping, Method::ParryBinned, Method::ObvhsPloc] {
+        for m in [Method::GROUPING, Method::PARRY_BINNED, Method::OBVHS_PLOC] {
             let b = peers::build(m, &scene, &Params::default()).unwrap();
             let r = check_refinement(&scene, &b.tree);
-            if m == Method::Grouping && scene.len() > 100 {
+            if m == Method::GROUPING && scene.len() > 100 {
                 assert!(
                     r.sah_after < r.sah_before,
                     "{}: the grouping's tree improves",
@@ -353,7 +353,7 @@ proptest! {
             },
             ..Params::default()
         };
-        let m = [Method::Grouping, Method::ParryBinned, Method::MedianSplit][which];
+        let m = [Method::GROUPING, Method::PARRY_BINNED, Method::MEDIAN_SPLIT][which];
         let b = peers::build(m, &scene, &params).unwrap();
         check_valid(&scene, &b.tree);
         check_refinement(&scene, &b.tree);
@@ -361,7 +361,7 @@ proptest! {
 
     #[test]
     fn treelet_restructuring_of_any_builder_is_valid(scene in arb_scene(), which in 0usize..3, k in 3u32..=7) {
-        let m = [Method::Grouping, Method::ParryBinned, Method::MedianSplit][which];
+        let m = [Method::GROUPING, Method::PARRY_BINNED, Method::MEDIAN_SPLIT][which];
         let b = peers::build(m, &scene, &Params::default()).unwrap();
         check_refinement_with(&scene, &b.tree, &treelets(k, 2));
     }
@@ -373,7 +373,7 @@ proptest! {
         every in 1u32..=3,
         after in any::<bool>(),
     ) {
-        let b = peers::build(Method::Grouping, &scene, &Params::default()).unwrap();
+        let b = peers::build(Method::GROUPING, &scene, &Params::default()).unwrap();
         let tuning = Tuning { treelet_min: min, treelet_every: every, treelet_after: after };
         check_refinement_with(&scene, &b.tree, &(RefineParams::default(), tuning));
     }

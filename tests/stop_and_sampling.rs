@@ -18,7 +18,7 @@ use wraptree::wrap::{
 
 fn options(tightness_nodes: usize) -> Options {
     Options {
-        methods: vec![Method::Grouping, Method::MedianSplit],
+        methods: vec![Method::GROUPING, Method::MEDIAN_SPLIT],
         wrappers: vec![Wrapper::Box, Wrapper::Sphere(SphereMethod::AabbCenter)],
         repeat: 1,
         tightness_nodes,
@@ -57,13 +57,13 @@ fn bench_stops_at_the_next_step_and_writes_nothing() {
     // method's tree (both were built first, in rounds).
     assert!(matches!(
         steps.last(),
-        Some(Step::Tightness(Method::Grouping, _))
+        Some(Step::Tightness(Method::GROUPING, _))
     ));
-    assert!(steps.contains(&Step::Build(Method::MedianSplit)));
+    assert!(steps.contains(&Step::Build(Method::MEDIAN_SPLIT)));
     assert!(
         !steps
             .iter()
-            .any(|s| matches!(s, Step::Wrapper(Method::MedianSplit, _)))
+            .any(|s| matches!(s, Step::Wrapper(Method::MEDIAN_SPLIT, _)))
     );
     // The command writes only finished rows: the previous file stays as it was.
     assert_eq!(std::fs::read_to_string(&csv).unwrap(), "previous results\n");

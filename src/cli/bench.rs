@@ -7,6 +7,8 @@ use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use wraptree::grouping::Schedule;
+use wraptree::grouping::partitioned::Chunking;
 use wraptree::metrics::bench::{record_costs, target_rows, target_scenes};
 use wraptree::metrics::compare::{Options, Step, Wrapper, evaluate};
 use wraptree::metrics::report::{
@@ -173,23 +175,24 @@ impl BenchCmd {
             if !opts
                 .methods
                 .iter()
-                .any(|m| m.base() == Method::GroupingPartitioned)
+                .any(|m| m.base() == Method::GROUPING_PARTITIONED)
             {
                 anyhow::bail!(
                     "{flag} sets grouping-partitioned's chunks: name grouping-partitioned \
                      or grouping-partitioned+refine in --methods"
                 );
             }
-            opts.params.mode = self.chunks.apply(opts.params.mode);
+            // Read by grouping-partitioned only (`Method::schedule`).
+            let c = self.chunks.apply(Chunking::DEFAULT);
+            opts.params.mode.schedule = Schedule::Partitioned(c);
             opts.params.check().map_err(anyhow::Error::msg)?;
-            let m = opts.params.mode;
-            let delta = match m.chunk_delta {
+            let delta = match c.delta {
                 0 => "by the scene's size".to_string(),
                 d => d.to_string(),
             };
             eprintln!(
                 "grouping-partitioned: chunks of δ = {delta}, ε = {}, root share {}, SAH cuts up to {}",
-                m.chunk_epsilon, m.chunk_top, m.chunk_sah
+                c.epsilon, c.top, c.sah_below
             );
         }
         let output = output_dir(self.output.as_deref(), "recordings/bench")?;

@@ -18,7 +18,9 @@ use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use wraptree::grouping::partitioned::Chunking;
 use wraptree::grouping::{CostMeasure, Mode, PSet, Params, Pregroup, Schedule, Weights};
+use wraptree::refine::Refinement;
 use wraptree::scene::{LoadOptions, Loaded, Up, UrdfOptions};
 
 /// Build, record and inspect bounding-volume hierarchies with the bottom-up grouping phase of
@@ -179,8 +181,8 @@ pub struct GroupArgs {
     pub seed: Option<u64>,
     /// Schedule: exact (the literal §2.2 run) or partitioned (the same step inside the chunks
     /// of a Morton split, bottom-up, in parallel).
-    #[arg(long, value_enum, default_value_t = Schedule::Exact)]
-    pub schedule: Schedule,
+    #[arg(long, default_value = "exact", value_parser = ["exact", "partitioned"])]
+    pub schedule: String,
     /// The fast path: the partitioned schedule whose split is the tree below a root share of
     /// 16 (chunks of δ = 2; the --chunk-* flags still apply), after merging neighbours with
     /// identical boxes; with `record`, `--refine` adds its refinement (the bench method
@@ -213,11 +215,35 @@ impl GroupArgs {
         build_pool(self.threads)
     }
 
+    /// The refinement `record --refine` starts from: the fast path's with `--fast` (its
+    /// preset's other half, next to [`GroupArgs::params`]' schedule), else the default.
+    pub fn refinement(&self) -> Refinement {
+        if self.fast {
+            Refinement::Fast
+        } else {
+            Refinement::Default
+        }
+    }
+
     /// Checks the values (building the thread pool, see [`GroupArgs::threads`]) and turns them
-    /// into [`Params`].
+    /// into [`Params`]. `--fast` is resolved here, once: the partitioned schedule with
+    /// [`Chunking::FAST`] (the `--chunk-*` flags still apply to it).
     pub fn params(&self) -> Result<Params> {
         self.threads()?;
-        let mut params = Params {
+        let schedule = if self.fast || self.schedule == "partitioned" {
+            let preset = if self.fast {
+                Chunking::FAST
+            } else {
+                Chunking::DEFAULT
+            };
+            Schedule::Partitioned(self.chunks.apply(preset))
+        } else {
+            if let Some(flag) = self.chunks.first_set() {
+                anyhow::bail!("{flag} needs --schedule partitioned or --fast");
+            }
+            Schedule::Exact
+        };
+        let params = Params {
             weights: Weights {
                 a: self.a,
                 b: self.b,
@@ -228,23 +254,13 @@ impl GroupArgs {
             pset: self.pset,
             seed: self.seed,
             mode: Mode {
-                schedule: self.schedule,
+                schedule,
                 pregroup: self.pregroup,
                 instancing: self.instancing,
                 cost: self.cost,
-                ..Mode::default()
             },
         };
-        if self.fast {
-            params.mode = params.mode.fast();
-        }
-        params.mode = self.chunks.apply(params.mode);
-        if let Some(flag) = self.chunks.first_set()
-            && params.mode.schedule != Schedule::Partitioned
-        {
-            anyhow::bail!("{flag} needs --schedule partitioned or --fast");
-        }
-        if params.mode.schedule == Schedule::Partitioned && params.pset == PSet::Hull {
+        if schedule.is_partitioned() && params.pset == PSet::Hull {
             // The library groups hulls with the exact schedule whatever the mode says; a run
             // that reported a partitioned schedule (and its chunks) would not be the run made.
             // Refused here, not in `Mode::check`, which recordings' metadata also passes:
@@ -295,14 +311,15 @@ pub struct ChunkArgs {
 }
 
 impl ChunkArgs {
-    /// `mode` with the flags that are set in place of its chunk settings.
-    pub fn apply(&self, mode: Mode) -> Mode {
-        Mode {
-            chunk_top: self.chunk_top.unwrap_or(mode.chunk_top),
-            chunk_delta: self.chunk_delta.unwrap_or(mode.chunk_delta),
-            chunk_epsilon: self.chunk_epsilon.unwrap_or(mode.chunk_epsilon),
-            chunk_sah: self.chunk_sah.unwrap_or(mode.chunk_sah),
-            ..mode
+    /// `chunking` with the flags that are set in its place: the one conversion from the
+    /// `--chunk-*` flags.
+    pub fn apply(&self, chunking: Chunking) -> Chunking {
+        Chunking {
+            top: self.chunk_top.unwrap_or(chunking.top),
+            delta: self.chunk_delta.unwrap_or(chunking.delta),
+            epsilon: self.chunk_epsilon.unwrap_or(chunking.epsilon),
+            sah_below: self.chunk_sah.unwrap_or(chunking.sah_below),
+            ..chunking
         }
     }
 

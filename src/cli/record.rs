@@ -14,7 +14,7 @@ use wraptree::output::output_prefix;
 use wraptree::record::live::{self, Live, LiveOptions, RerunLive};
 use wraptree::record::mcap::Compression;
 use wraptree::record::{Detail, RecordOptions, Written, record};
-use wraptree::refine::{self, RefineParams};
+use wraptree::refine::RefineParams;
 use wraptree::scene::Scene;
 use wraptree::stop::Stop;
 use wraptree::wrap::WrapperKind;
@@ -252,8 +252,8 @@ impl RecordCmd {
         let live = self.live.start(&stop)?;
         opts.live = live.clone();
         let loaded = self.scene.load()?;
-        if self.group.fast && refine.refine {
-            opts.refine = refine.params(refine::fast_for(loaded.scene.len()));
+        if refine.refine {
+            opts.refine = refine.params(self.group.refinement().params(loaded.scene.len()));
             opts.check()?;
         }
         let params = self.group.params()?.resolve(&loaded.scene);

@@ -35,7 +35,9 @@ pub mod voxel_hash;
 
 pub use crate::events::{Event, EventLog, Merge, Observer, Part, PartKind, Tee};
 pub use limits::{Budget, Limits, StopReason, Stopped};
-pub use params::{CostMeasure, Mode, PSet, Params, Pregroup, ResolvedParams, Schedule, Weights};
+pub use params::{
+    CostMeasure, Exponent, Mode, PSet, Params, Pregroup, ResolvedParams, Schedule, Weights,
+};
 pub use pregroup::Pregrouping;
 pub use subset_tree::{C_PRIM, C_TRAV, NONE, SubsetTree, sah, sah_of_sums};
 
@@ -139,7 +141,7 @@ fn run_boxes<O: Observer>(boxes: Vec<Aabb>, params: &ResolvedParams, observer: O
     let budget = Budget::default();
     match params.mode.schedule {
         Schedule::Exact => cluster::run_boxes(boxes, params, observer, &budget),
-        Schedule::Partitioned => partitioned::run_boxes(boxes, params, observer, &budget),
+        Schedule::Partitioned(c) => partitioned::group_boxes(boxes, params, &c, observer, &budget),
     }
     .expect("an unlimited budget never stops")
 }
@@ -172,6 +174,6 @@ fn run_here<O: Observer>(
     }
     match params.mode.schedule {
         Schedule::Exact => cluster::run(scene, params, observer, budget),
-        Schedule::Partitioned => partitioned::run(scene, params, observer, budget),
+        Schedule::Partitioned(c) => partitioned::group_with(scene, params, &c, observer, budget),
     }
 }

@@ -3,6 +3,7 @@
 //! (schedule, pre-grouping, size measure).
 
 use crate::geom::Aabb;
+use crate::grouping::partitioned::Chunking;
 use crate::scene::Scene;
 use rayon::prelude::*;
 
@@ -43,14 +44,29 @@ impl Weights {
     /// every pair; it is then taken as 1, so the cost is diameter^A.
     #[inline]
     pub fn cost(&self, diameter: f64, fill: f64, balance: f64) -> f64 {
-        let scale = if self.a == 1.0 {
-            diameter
+        self.cost_scaled(self.scale(diameter), fill, balance)
+    }
+
+    /// The form of diameter^A: the one place that tells A = 1, A = 0 and any other A apart.
+    #[inline(always)]
+    pub fn exponent(&self) -> Exponent {
+        if self.a == 1.0 {
+            Exponent::One
         } else if self.a == 0.0 {
-            1.0
+            Exponent::Zero
         } else {
-            diameter.powf(self.a)
-        };
-        self.cost_scaled(scale, fill, balance)
+            Exponent::Other
+        }
+    }
+
+    /// diameter^A, without `powf` for A = 1 and A = 0.
+    #[inline(always)]
+    pub fn scale(&self, diameter: f64) -> f64 {
+        match self.exponent() {
+            Exponent::One => diameter,
+            Exponent::Zero => 1.0,
+            Exponent::Other => diameter.powf(self.a),
+        }
     }
 
     /// Checks that A, B and C are finite and ≥ 0; the error names the weight (`a`, `b`, `c`).
@@ -74,26 +90,68 @@ impl Weights {
     }
 }
 
-/// How the grouping phase is scheduled over the scene.
-#[derive(
-    Clone,
-    Copy,
-    Debug,
-    Default,
-    PartialEq,
-    Eq,
-    serde::Serialize,
-    serde::Deserialize,
-    clap::ValueEnum,
-)]
+/// The form of the Cost's factor diameter^A ([`Weights::exponent`]), chosen once per run: the
+/// grouping's scans are compiled for each ([`Exponent::code`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Exponent {
+    /// A = 1: the diameter itself.
+    One,
+    /// A = 0: every pair's factor is 1.
+    Zero,
+    /// Any other A: `powf`.
+    Other,
+}
+
+impl Exponent {
+    /// The form as the const parameter of the specialised scans: 1, 0, or 2 for any other A.
+    pub const fn code(self) -> u8 {
+        match self {
+            Exponent::One => 1,
+            Exponent::Zero => 0,
+            Exponent::Other => 2,
+        }
+    }
+}
+
+/// How the grouping phase is scheduled over the scene: the schedule carries its chunking.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Schedule {
     /// The literal §2.2 run over all bodies at once (the default; what users debug step by step).
     #[default]
     Exact,
     /// The same grouping step run inside the chunks of a top-down Morton split, bottom-up
-    /// (approximate agglomerative clustering), in parallel.
-    Partitioned,
+    /// (approximate agglomerative clustering), in parallel, split as the [`Chunking`] says.
+    Partitioned(Chunking),
+}
+
+impl Schedule {
+    /// The partitioned schedule with its default chunking ([`Chunking::DEFAULT`]).
+    pub const PARTITIONED: Schedule = Schedule::Partitioned(Chunking::DEFAULT);
+
+    /// The fast path's schedule (`--fast`): the partitioned one with [`Chunking::FAST`].
+    pub const FAST: Schedule = Schedule::Partitioned(Chunking::FAST);
+
+    /// The schedule's name, as `--schedule` and recordings' metadata spell it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Schedule::Exact => "exact",
+            Schedule::Partitioned(_) => "partitioned",
+        }
+    }
+
+    /// The chunking of a partitioned schedule.
+    pub fn chunking(&self) -> Option<&Chunking> {
+        match self {
+            Schedule::Exact => None,
+            Schedule::Partitioned(c) => Some(c),
+        }
+    }
+
+    /// Whether this is the partitioned schedule.
+    pub fn is_partitioned(&self) -> bool {
+        matches!(self, Schedule::Partitioned(_))
+    }
 }
 
 /// Which components are grouped on their own before the top level (the paper's §1.3 speed-up).
@@ -143,10 +201,10 @@ pub enum CostMeasure {
 /// How a grouping run is organised beyond its Cost weights and limits. The default is the
 /// literal §2.2 run; every other setting is recorded in recordings' metadata so that
 /// `replay --verify` re-runs the same mode.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
 pub struct Mode {
-    /// Exact or partitioned schedule.
+    /// Exact or partitioned schedule (with its chunking).
     pub schedule: Schedule,
     /// Components grouped first, if any.
     pub pregroup: Pregroup,
@@ -154,80 +212,13 @@ pub struct Mode {
     pub instancing: bool,
     /// The size measure in the Cost.
     pub cost: CostMeasure,
-    /// The partitioned schedule's root share ([`Chunking::top`](crate::grouping::partitioned::Chunking::top)):
-    /// about how many bodies its root step starts from; scenes of at most 1.5× this are one
-    /// subproblem (the exact schedule's tree); 0 = AAC's reduction alone. The exact schedule
-    /// does not read it.
-    pub chunk_top: u32,
-    /// The partitioned schedule's chunk size δ
-    /// ([`Chunking::delta`](crate::grouping::partitioned::Chunking::delta)), at least 2; 0 (the
-    /// default) = by the scene's size, 4,096 up to 2^18 primitives and 4 above
-    /// ([`Chunking::delta_for`](crate::grouping::partitioned::Chunking::delta_for)). Resolved
-    /// parameters hold the δ the run uses.
-    pub chunk_delta: u32,
-    /// The partitioned schedule's ε in AAC's reduction f(n) = ⌈c·n^(1/2 − ε)⌉
-    /// ([`Chunking::epsilon`](crate::grouping::partitioned::Chunking::epsilon)), in [0, 1/2].
-    pub chunk_epsilon: f64,
-    /// The partitioned schedule's SAH cuts: ranges of at most this many primitives are cut by
-    /// binned SAH instead of at a Morton bit
-    /// ([`Chunking::sah_below`](crate::grouping::partitioned::Chunking::sah_below)); 0 =
-    /// Morton cuts throughout.
-    pub chunk_sah: u32,
-    /// The partitioned schedule's largest chunk
-    /// ([`Chunking::chunk_max`](crate::grouping::partitioned::Chunking::chunk_max)); 0 = δ.
-    pub chunk_max: u32,
-    /// The partitioned schedule's smallest cuts: ranges of 3 up to this many primitives (at
-    /// most 4) that are cut try every partition
-    /// ([`Chunking::few`](crate::grouping::partitioned::Chunking::few)); 0 = the SAH sweep. The
-    /// fast path sets 4.
-    pub chunk_few: u32,
-    /// The partitioned schedule's twins: bodies with identical boxes side by side in the Morton
-    /// order are merged in pairs before the split
-    /// ([`Chunking::twins`](crate::grouping::partitioned::Chunking::twins)). The fast path
-    /// sets it.
-    pub chunk_twins: bool,
-}
-
-impl Default for Mode {
-    /// The literal §2.2 run; the partitioned schedule's default root share, δ by the scene's size.
-    fn default() -> Self {
-        Mode {
-            schedule: Schedule::default(),
-            pregroup: Pregroup::default(),
-            instancing: false,
-            cost: CostMeasure::default(),
-            chunk_top: crate::grouping::partitioned::Chunking::DEFAULT.top,
-            chunk_delta: 0,
-            chunk_epsilon: crate::grouping::partitioned::Chunking::DEFAULT.epsilon,
-            chunk_sah: crate::grouping::partitioned::Chunking::DEFAULT.sah_below,
-            chunk_max: crate::grouping::partitioned::Chunking::DEFAULT.chunk_max,
-            chunk_few: crate::grouping::partitioned::Chunking::DEFAULT.few,
-            chunk_twins: crate::grouping::partitioned::Chunking::DEFAULT.twins,
-        }
-    }
 }
 
 impl Mode {
-    /// This mode on the fast path: the partitioned schedule with the split of
-    /// [`Chunking::FAST`](crate::grouping::partitioned::Chunking::FAST) (its root share, δ, ε
-    /// and SAH cuts), pre-grouping and the Cost measure kept.
-    pub fn fast(self) -> Mode {
-        let ch = crate::grouping::partitioned::Chunking::FAST;
-        Mode {
-            schedule: Schedule::Partitioned,
-            chunk_top: ch.top,
-            chunk_delta: ch.delta,
-            chunk_epsilon: ch.epsilon,
-            chunk_sah: ch.sah_below,
-            chunk_few: ch.few,
-            chunk_twins: ch.twins,
-            ..self
-        }
-    }
-
     /// Checks that the settings fit together with the p-set `pset`: instancing needs
-    /// pre-grouping (copies are found among components), and pre-grouping needs the AABB p-set.
-    /// The errors name the CLI flags.
+    /// pre-grouping (copies are found among components), pre-grouping needs the AABB p-set,
+    /// and a partitioned schedule's chunking is valid ([`Chunking::check`]). The errors name
+    /// the CLI flags.
     pub fn check(&self, pset: PSet) -> Result<(), String> {
         if self.instancing && self.pregroup == Pregroup::None {
             return Err(
@@ -239,26 +230,10 @@ impl Mode {
         if self.pregroup != Pregroup::None && pset != PSet::Aabb {
             return Err("--pregroup needs --pset aabb (parts are grouped as boxes)".to_string());
         }
-        if self.chunk_delta == 1 {
-            return Err(
-                "--chunk-delta (δ) must be at least 2 (or 0: by the scene's size), got 1"
-                    .to_string(),
-            );
+        match &self.schedule {
+            Schedule::Partitioned(c) => c.check(),
+            Schedule::Exact => Ok(()),
         }
-        let few_max = crate::grouping::partitioned::Chunking::FEW_MAX;
-        if self.chunk_few > few_max {
-            return Err(format!(
-                "chunk_few must be at most {few_max}, got {}",
-                self.chunk_few
-            ));
-        }
-        if !(0.0..=0.5).contains(&self.chunk_epsilon) {
-            return Err(format!(
-                "--chunk-epsilon must be in [0, 0.5], got {}",
-                self.chunk_epsilon
-            ));
-        }
-        Ok(())
     }
 }
 
@@ -354,7 +329,7 @@ impl Params {
     /// to 1e-6 × the scene diagonal, and to 1 for a scene that is a single point. A given
     /// DLimit ≤ 0 (or not finite) becomes 1; a given GLimit ≤ 0 becomes 1e-9 × DLimit0, since
     /// the paper's GLimit must be positive for scenes of several connected components. The
-    /// partitioned schedule's δ of 0 becomes the one for the scene's size.
+    /// partitioned schedule's δ of 0 becomes the one for the scene's size ([`Chunking::for_size`]).
     pub fn resolve(&self, scene: &Scene) -> ResolvedParams {
         self.resolve_with(
             scene.len(),
@@ -432,11 +407,8 @@ impl Params {
             pset: self.pset,
             seed: self.seed,
             mode: match self.mode.schedule {
-                Schedule::Partitioned => Mode {
-                    chunk_delta: crate::grouping::partitioned::Chunking::delta_for(
-                        self.mode.chunk_delta,
-                        n,
-                    ),
+                Schedule::Partitioned(c) => Mode {
+                    schedule: Schedule::Partitioned(c.for_size(n)),
                     ..self.mode
                 },
                 Schedule::Exact => self.mode,

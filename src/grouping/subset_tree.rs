@@ -172,6 +172,49 @@ impl SubsetTree {
             .collect()
     }
 
+    /// Checks the tree over `scene`, the one validator of Subset Trees: 2N − 1 nodes, each
+    /// leaf exactly once under the root, each leaf's box holding its primitive's vertices,
+    /// each interior node with two children whose boxes it holds, whose parent it is and one
+    /// level above them, and a diameter at least theirs (within 1e-12, relative). Err: the
+    /// first violation.
+    pub fn validate(&self, scene: &crate::scene::Scene) -> Result<(), String> {
+        let n = scene.len();
+        if self.len() != 2 * n - 1 || self.leaves() != n {
+            return Err(format!("{} nodes for {n} leaves", self.len()));
+        }
+        let mut leaves = self.leaves_under(self.root());
+        leaves.sort_unstable();
+        if leaves.len() != n || leaves.iter().enumerate().any(|(i, &l)| l as usize != i) {
+            return Err("not every leaf exactly once under the root".into());
+        }
+        for leaf in 0..n {
+            if !scene
+                .prim_vertices(leaf)
+                .all(|p| self.aabb[leaf].contains_point(p, 0.0))
+            {
+                return Err(format!("leaf {leaf}'s box misses a vertex"));
+            }
+        }
+        for x in n as u32..self.len() as u32 {
+            let [a, b] = self
+                .children_of(x)
+                .ok_or(format!("node {x} has no children"))?;
+            for c in [a, b] {
+                let (xi, ci) = (x as usize, c as usize);
+                if !self.aabb[xi].contains_aabb(&self.aabb[ci], 0.0) {
+                    return Err(format!("node {c}'s box is not inside its parent {x}'s"));
+                }
+                if self.depth[ci] != self.depth[xi] + 1 || self.parent[ci] != x {
+                    return Err(format!("node {c}: parent or depth inconsistent"));
+                }
+                if self.diameter[xi] < self.diameter[ci] * (1.0 - 1e-12) - 1e-12 {
+                    return Err(format!("node {x}'s diameter is below its child {c}'s"));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Parents as `i64` with −1 for the root (the `--json` form).
     pub fn parent_i64(&self) -> Vec<i64> {
         self.parent

@@ -193,12 +193,12 @@ pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, 
     let workload = Workload::standard(scene, 1);
     let [plain, ploc, binned, refined, reinserted, part_refined] = measure(
         [
-            Method::Grouping,
-            Method::ObvhsPloc,
-            Method::ParryBinned,
-            Method::GroupingRefine,
-            Method::ObvhsPlocReinsert,
-            Method::GroupingPartitionedRefine,
+            Method::GROUPING,
+            Method::OBVHS_PLOC,
+            Method::PARRY_BINNED,
+            Method::GROUPING_REFINE,
+            Method::OBVHS_PLOC_REINSERT,
+            Method::GROUPING_PARTITIONED_REFINE,
         ],
         scene,
         repeat,
@@ -232,9 +232,9 @@ pub fn target_rows(scene: &Scene, repeat: u32) -> Result<(TargetRow, RefineRow, 
         (1.0, 1.0)
     };
     let sped = [
-        Method::GroupingPregroup,
-        Method::GroupingInstanced,
-        Method::GroupingObjects,
+        Method::GROUPING_PREGROUP,
+        Method::GROUPING_INSTANCED,
+        Method::GROUPING_OBJECTS,
     ];
     let mut on_threads = Vec::new();
     for threads in [1, 2] {

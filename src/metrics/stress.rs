@@ -109,39 +109,10 @@ fn on_thread<T: Send + 'static>(
     }
 }
 
-/// Checks a Subset Tree over `scene`; returns its depth or the first violation.
+/// Checks a Subset Tree over `scene` ([`SubsetTree::validate`]); returns its depth or the
+/// first violation.
 fn check_tree(scene: &Scene, t: &SubsetTree) -> Result<u32, String> {
-    let n = scene.len();
-    if t.len() != 2 * n - 1 || t.leaves() != n {
-        return Err(format!("{} nodes for {n} leaves", t.len()));
-    }
-    let mut leaves = t.leaves_under(t.root());
-    leaves.sort_unstable();
-    if leaves.len() != n || leaves.iter().enumerate().any(|(i, &l)| l as usize != i) {
-        return Err("not every leaf exactly once under the root".into());
-    }
-    for leaf in 0..n {
-        if !scene
-            .prim_vertices(leaf)
-            .all(|p| t.aabb[leaf].contains_point(p, 0.0))
-        {
-            return Err(format!("leaf {leaf}'s box misses a vertex"));
-        }
-    }
-    for x in n as u32..t.len() as u32 {
-        let [a, b] = t
-            .children_of(x)
-            .ok_or(format!("node {x} has no children"))?;
-        for c in [a, b] {
-            if !t.aabb[x as usize].contains_aabb(&t.aabb[c as usize], 0.0) {
-                return Err(format!("node {c}'s box is not inside its parent {x}'s"));
-            }
-            if t.depth[c as usize] != t.depth[x as usize] + 1 || t.parent[c as usize] != x {
-                return Err(format!("node {c}: parent or depth inconsistent"));
-            }
-        }
-    }
-    Ok(t.depth_max())
+    t.validate(scene).map(|()| t.depth_max())
 }
 
 /// A row for a grouping of `scene` with `pset`, and the grouping if it finished.

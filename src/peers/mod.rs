@@ -3,11 +3,13 @@
 //! ([`crate::query`]) measure every hierarchy the same way (`docs/benchmarks.md`, "How it is
 //! measured").
 //!
-//! - [`Method::Grouping`], [`Method::GroupingHull`], [`Method::GroupingPartitioned`]: the
+//! A [`Method`] is a [`Builder`] and optionally a [`Refinement`] of its tree.
+//!
+//! - [`Builder::Grouping`], [`Builder::GroupingHull`], [`Builder::GroupingPartitioned`]: the
 //!   paper's grouping phase (§2.2) with AABB or hull p-sets, and in the partitioned schedule;
-//! - [`Method::Fast`]: the fast path, the partitioned schedule with small subproblems
-//!   ([`Method::GroupingFast`]) then a bounded refinement ([`crate::refine::refine_fast`]);
-//! - [`Method::GroupingPregroup`], [`Method::GroupingInstanced`], [`Method::GroupingObjects`]:
+//! - [`Method::FAST`]: the fast path, the partitioned schedule with small subproblems
+//!   ([`Builder::GroupingFast`]) then a bounded refinement ([`Refinement::Fast`]);
+//! - [`Builder::GroupingPregroup`], [`Builder::GroupingInstanced`], [`Builder::GroupingObjects`]:
 //!   the same with the paper's §1.3 speed-ups ([`crate::grouping::pregroup`]);
 //! - [`parry_bvh`]: parry3d's `Bvh`, binned SAH or PLOC, as published;
 //! - [`obvhs_ploc`]: obvhs's PLOC, with or without its reinsertion optimiser, as published;
@@ -22,116 +24,202 @@ pub mod obvhs_ploc;
 pub mod parry_bvh;
 pub mod topology;
 
+#[cfg(doc)]
+use crate::grouping::partitioned::Chunking;
 use crate::grouping::{self, PSet, Params, Pregroup, Schedule, Stats, SubsetTree};
-use crate::refine::{self, RefineParams};
+use crate::refine::{self, Refinement};
 use crate::scene::Scene;
 use parry3d::partitioning::BvhBuildStrategy;
 use std::time::Instant;
 
-/// A hierarchy builder.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
-pub enum Method {
+/// Declares [`Builder`] with each builder's name and its refined form's name.
+macro_rules! builders {
+    ($($(#[$doc:meta])* $variant:ident = $name:literal,)*) => {
+        /// A hierarchy builder, without refinement.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+        pub enum Builder {
+            $($(#[$doc])* $variant,)*
+        }
+
+        impl Builder {
+            /// The builder's name in tables, CSV and on the command line.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(Builder::$variant => $name,)*
+                }
+            }
+
+            /// The name of the builder followed by the default refinement (`NAME+refine`).
+            fn refined_name(self) -> &'static str {
+                match self {
+                    $(Builder::$variant => concat!($name, "+refine"),)*
+                }
+            }
+        }
+    };
+}
+
+builders! {
     /// The grouping phase with AABB p-sets and the given parameters.
-    Grouping,
+    Grouping = "grouping",
     /// The grouping phase with convex-hull p-sets.
-    GroupingHull,
+    GroupingHull = "grouping-hull",
     /// The grouping phase in the partitioned schedule (AABB p-sets).
-    GroupingPartitioned,
+    GroupingPartitioned = "grouping-partitioned",
     /// The grouping phase with connected components pre-grouped (AABB p-set).
-    GroupingPregroup,
+    GroupingPregroup = "grouping-pregroup",
     /// The grouping phase with connected components pre-grouped and rigid copies copy-moved.
-    GroupingInstanced,
+    GroupingInstanced = "grouping-instanced",
     /// The grouping phase with the scene's objects pre-grouped and rigid copies copy-moved.
-    GroupingObjects,
+    GroupingObjects = "grouping-objects",
+    /// The partitioned schedule with the fast path's split ([`Schedule::FAST`]).
+    GroupingFast = "grouping-fast",
     /// parry3d `Bvh`, binned SAH strategy.
-    ParryBinned,
+    ParryBinned = "parry-binned",
     /// parry3d `Bvh`, PLOC strategy.
-    ParryPloc,
+    ParryPloc = "parry-ploc",
     /// obvhs PLOC.
-    ObvhsPloc,
+    ObvhsPloc = "obvhs-ploc",
     /// obvhs PLOC followed by reinsertion.
-    ObvhsPlocReinsert,
+    ObvhsPlocReinsert = "obvhs-ploc-reinsert",
     /// Top-down median split.
-    MedianSplit,
+    MedianSplit = "median-split",
     /// Goldsmith–Salmon incremental insertion.
-    GoldsmithSalmon,
-    /// [`Method::Grouping`] then the refinement pass.
-    GroupingRefine,
-    /// [`Method::ParryBinned`] then the refinement pass.
-    ParryBinnedRefine,
-    /// [`Method::ObvhsPloc`] then the refinement pass.
-    ObvhsPlocRefine,
-    /// [`Method::GroupingPartitioned`] then the refinement pass.
-    GroupingPartitionedRefine,
-    /// The partitioned schedule with the fast path's split
-    /// ([`Chunking::FAST`](crate::grouping::partitioned::Chunking::FAST)).
-    GroupingFast,
-    /// The fast path: [`Method::GroupingFast`] then [`crate::refine::refine_fast`].
-    Fast,
+    GoldsmithSalmon = "goldsmith-salmon",
+}
+
+impl Builder {
+    /// Whether this is the paper's grouping phase.
+    pub fn is_grouping(self) -> bool {
+        matches!(
+            self,
+            Builder::Grouping
+                | Builder::GroupingHull
+                | Builder::GroupingPregroup
+                | Builder::GroupingInstanced
+                | Builder::GroupingObjects
+                | Builder::GroupingPartitioned
+                | Builder::GroupingFast
+        )
+    }
+}
+
+/// A hierarchy method: a builder, then optionally a refinement of its tree. Serialised as its
+/// name ([`Method::name`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Method {
+    /// The builder.
+    pub builder: Builder,
+    /// The refinement of the builder's tree ([`crate::refine`]), if any.
+    pub refinement: Option<Refinement>,
 }
 
 impl Method {
+    /// `builder` alone.
+    pub const fn of(builder: Builder) -> Method {
+        Method {
+            builder,
+            refinement: None,
+        }
+    }
+
+    /// `builder` then the default refinement.
+    pub const fn refined(builder: Builder) -> Method {
+        Method {
+            builder,
+            refinement: Some(Refinement::Default),
+        }
+    }
+
+    /// The grouping phase with AABB p-sets and the given parameters.
+    pub const GROUPING: Method = Method::of(Builder::Grouping);
+    /// The grouping phase with convex-hull p-sets.
+    pub const GROUPING_HULL: Method = Method::of(Builder::GroupingHull);
+    /// The grouping phase in the partitioned schedule.
+    pub const GROUPING_PARTITIONED: Method = Method::of(Builder::GroupingPartitioned);
+    /// The grouping phase with connected components pre-grouped.
+    pub const GROUPING_PREGROUP: Method = Method::of(Builder::GroupingPregroup);
+    /// The grouping phase with connected components pre-grouped and copies copy-moved.
+    pub const GROUPING_INSTANCED: Method = Method::of(Builder::GroupingInstanced);
+    /// The grouping phase with the scene's objects pre-grouped and copies copy-moved.
+    pub const GROUPING_OBJECTS: Method = Method::of(Builder::GroupingObjects);
+    /// The fast path's split, unrefined.
+    pub const GROUPING_FAST: Method = Method::of(Builder::GroupingFast);
+    /// parry3d `Bvh`, binned SAH.
+    pub const PARRY_BINNED: Method = Method::of(Builder::ParryBinned);
+    /// parry3d `Bvh`, PLOC.
+    pub const PARRY_PLOC: Method = Method::of(Builder::ParryPloc);
+    /// obvhs PLOC.
+    pub const OBVHS_PLOC: Method = Method::of(Builder::ObvhsPloc);
+    /// obvhs PLOC then its reinsertion.
+    pub const OBVHS_PLOC_REINSERT: Method = Method::of(Builder::ObvhsPlocReinsert);
+    /// Top-down median split.
+    pub const MEDIAN_SPLIT: Method = Method::of(Builder::MedianSplit);
+    /// Goldsmith–Salmon incremental insertion.
+    pub const GOLDSMITH_SALMON: Method = Method::of(Builder::GoldsmithSalmon);
+    /// The exact grouping refined.
+    pub const GROUPING_REFINE: Method = Method::refined(Builder::Grouping);
+    /// parry Binned refined.
+    pub const PARRY_BINNED_REFINE: Method = Method::refined(Builder::ParryBinned);
+    /// obvhs PLOC refined.
+    pub const OBVHS_PLOC_REFINE: Method = Method::refined(Builder::ObvhsPloc);
+    /// The partitioned grouping refined.
+    pub const GROUPING_PARTITIONED_REFINE: Method = Method::refined(Builder::GroupingPartitioned);
+    /// The fast path: the fast path's split, then its refinement ([`Refinement::Fast`]).
+    pub const FAST: Method = Method {
+        builder: Builder::GroupingFast,
+        refinement: Some(Refinement::Fast),
+    };
+
     /// What a bench compares by default: the paper's exact run, the fast path, the exact run
     /// refined, the partitioned schedule, and the peers users choose between (parry Binned,
     /// obvhs PLOC with and without reinsertion). The others (the hull p-set, pre-grouping,
     /// the peers refined, median split, Goldsmith–Salmon) on request.
     pub const DEFAULT: [Method; 7] = [
-        Method::Grouping,
-        Method::Fast,
-        Method::GroupingRefine,
-        Method::GroupingPartitioned,
-        Method::ParryBinned,
-        Method::ObvhsPloc,
-        Method::ObvhsPlocReinsert,
+        Method::GROUPING,
+        Method::FAST,
+        Method::GROUPING_REFINE,
+        Method::GROUPING_PARTITIONED,
+        Method::PARRY_BINNED,
+        Method::OBVHS_PLOC,
+        Method::OBVHS_PLOC_REINSERT,
     ];
 
-    /// Every method, ours first (`--methods all`).
+    /// Every named method, ours first (`--methods all`).
     pub const ALL: [Method; 18] = [
-        Method::Grouping,
-        Method::Fast,
-        Method::GroupingFast,
-        Method::GroupingRefine,
-        Method::GroupingHull,
-        Method::GroupingPartitioned,
-        Method::GroupingPartitionedRefine,
-        Method::GroupingPregroup,
-        Method::GroupingInstanced,
-        Method::GroupingObjects,
-        Method::ParryBinned,
-        Method::ParryPloc,
-        Method::ObvhsPloc,
-        Method::ObvhsPlocReinsert,
-        Method::MedianSplit,
-        Method::GoldsmithSalmon,
-        Method::ParryBinnedRefine,
-        Method::ObvhsPlocRefine,
+        Method::GROUPING,
+        Method::FAST,
+        Method::GROUPING_FAST,
+        Method::GROUPING_REFINE,
+        Method::GROUPING_HULL,
+        Method::GROUPING_PARTITIONED,
+        Method::GROUPING_PARTITIONED_REFINE,
+        Method::GROUPING_PREGROUP,
+        Method::GROUPING_INSTANCED,
+        Method::GROUPING_OBJECTS,
+        Method::PARRY_BINNED,
+        Method::PARRY_PLOC,
+        Method::OBVHS_PLOC,
+        Method::OBVHS_PLOC_REINSERT,
+        Method::MEDIAN_SPLIT,
+        Method::GOLDSMITH_SALMON,
+        Method::PARRY_BINNED_REFINE,
+        Method::OBVHS_PLOC_REFINE,
     ];
 
-    /// Short name used in tables, CSV and on the command line.
+    /// Short name used in tables, CSV and on the command line: the builder's, `NAME+refine`
+    /// with the default refinement, and `fast` for the fast path ([`Method::FAST`]); another
+    /// builder with the fast path's refinement is `NAME+refine-fast`.
     pub fn name(self) -> &'static str {
-        match self {
-            Method::Grouping => "grouping",
-            Method::GroupingHull => "grouping-hull",
-            Method::GroupingPartitioned => "grouping-partitioned",
-            Method::GroupingPregroup => "grouping-pregroup",
-            Method::GroupingInstanced => "grouping-instanced",
-            Method::GroupingObjects => "grouping-objects",
-            Method::ParryBinned => "parry-binned",
-            Method::ParryPloc => "parry-ploc",
-            Method::ObvhsPloc => "obvhs-ploc",
-            Method::ObvhsPlocReinsert => "obvhs-ploc-reinsert",
-            Method::MedianSplit => "median-split",
-            Method::GoldsmithSalmon => "goldsmith-salmon",
-            Method::GroupingRefine => "grouping+refine",
-            Method::ParryBinnedRefine => "parry-binned+refine",
-            Method::ObvhsPlocRefine => "obvhs-ploc+refine",
-            Method::GroupingPartitionedRefine => "grouping-partitioned+refine",
-            Method::GroupingFast => "grouping-fast",
-            Method::Fast => "fast",
+        match self.refinement {
+            None => self.builder.name(),
+            Some(Refinement::Default) => self.builder.refined_name(),
+            Some(Refinement::Fast) if self.builder == Builder::GroupingFast => "fast",
+            Some(Refinement::Fast) => "+refine-fast",
         }
     }
 
-    /// Parses a name as printed by [`Method::name`].
+    /// Parses a name of [`Method::ALL`] as printed by [`Method::name`].
     pub fn parse(s: &str) -> Result<Method, String> {
         Method::ALL
             .into_iter()
@@ -144,55 +232,50 @@ impl Method {
 
     /// Whether this is the paper's grouping phase (refined or not).
     pub fn is_grouping(self) -> bool {
-        matches!(
-            self,
-            Method::Grouping
-                | Method::GroupingHull
-                | Method::GroupingRefine
-                | Method::GroupingPregroup
-                | Method::GroupingInstanced
-                | Method::GroupingObjects
-                | Method::GroupingPartitioned
-                | Method::GroupingPartitionedRefine
-                | Method::GroupingFast
-                | Method::Fast
-        )
+        self.builder.is_grouping()
     }
 
     /// Whether the builder's tree goes through [`crate::refine`].
     pub fn is_refined(self) -> bool {
-        self.base() != self
+        self.refinement.is_some()
     }
 
     /// The builder without refinement.
     pub fn base(self) -> Method {
-        match self {
-            Method::GroupingRefine => Method::Grouping,
-            Method::ParryBinnedRefine => Method::ParryBinned,
-            Method::ObvhsPlocRefine => Method::ObvhsPloc,
-            Method::GroupingPartitionedRefine => Method::GroupingPartitioned,
-            Method::Fast => Method::GroupingFast,
-            m => m,
+        Method::of(self.builder)
+    }
+
+    /// The schedule this method groups with under `params`, for the grouping builders:
+    /// `grouping-partitioned` takes `params`' schedule when it is partitioned (else the default
+    /// chunking), `grouping-fast` [`Schedule::FAST`] whatever `params` say, the others the
+    /// exact schedule.
+    pub fn schedule(self, params: &Params) -> Option<Schedule> {
+        match self.builder {
+            Builder::GroupingPartitioned => Some(match params.mode.schedule {
+                s @ Schedule::Partitioned(_) => s,
+                Schedule::Exact => Schedule::PARTITIONED,
+            }),
+            Builder::GroupingFast => Some(Schedule::FAST),
+            b if b.is_grouping() => Some(Schedule::Exact),
+            _ => None,
         }
     }
 
     /// The partitioned schedule's settings this method groups a scene of `n` primitives with
-    /// under `params`, for the methods that run it (`grouping-partitioned` with `params`'
-    /// chunks, `fast` with its own): `delta=… epsilon=… top=… sah=…`, as the `--chunk-*` flags
-    /// name them, with δ as the run uses it ([`Chunking::delta_for`](crate::grouping::partitioned::Chunking::delta_for)).
+    /// under `params` ([`Method::schedule`]): `delta=… epsilon=… top=… sah=…`, as the
+    /// `--chunk-*` flags name them, with δ as the run uses it ([`Chunking::for_size`]).
     pub fn chunking(self, params: &Params, n: usize) -> Option<String> {
-        let mode = match self.base() {
-            Method::GroupingPartitioned => params.mode,
-            Method::GroupingFast => params.mode.fast(),
-            _ => return None,
-        };
+        let c = self.schedule(params)?.chunking()?.for_size(n);
         Some(format!(
             "delta={} epsilon={} top={} sah={}",
-            crate::grouping::partitioned::Chunking::delta_for(mode.chunk_delta, n),
-            mode.chunk_epsilon,
-            mode.chunk_top,
-            mode.chunk_sah
+            c.delta, c.epsilon, c.top, c.sah_below
         ))
+    }
+}
+
+impl serde::Serialize for Method {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
     }
 }
 
@@ -234,9 +317,8 @@ pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, St
 
 /// [`build`] on the caller's thread.
 fn build_here(method: Method, scene: &Scene, params: &Params) -> Result<Built, String> {
-    let base = method.base();
-    let mut built = build_base(base, scene, params)?;
-    if method.is_refined() {
+    let mut built = build_base(method.builder, scene, params)?;
+    if let Some(refinement) = method.refinement {
         let t = Instant::now();
         let Built {
             tree,
@@ -244,11 +326,8 @@ fn build_here(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
             stats,
             ..
         } = built;
-        let tree = if method == Method::Fast {
-            refine::refine_fast(tree).tree
-        } else {
-            refine::refine_owned(tree, &RefineParams::default(), ()).tree
-        };
+        let params = refinement.params(tree.leaves());
+        let tree = refine::refine_owned(tree, &params, ()).tree;
         let refine_seconds = t.elapsed().as_secs_f64();
         built = Built {
             method,
@@ -261,9 +340,10 @@ fn build_here(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
     Ok(built)
 }
 
-/// Builds an unrefined method's hierarchy (see [`build`]).
-fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, String> {
+/// Builds `builder`'s hierarchy (see [`build`]).
+fn build_base(builder: Builder, scene: &Scene, params: &Params) -> Result<Built, String> {
     let t = Instant::now();
+    let method = Method::of(builder);
     let done = |tree: SubsetTree, stats: Option<Stats>, seconds: f64| Built {
         method,
         tree,
@@ -271,19 +351,19 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
         stats,
         refine_seconds: 0.0,
     };
-    if method.is_grouping() {
+    if builder.is_grouping() {
         let mut p = Params {
-            pset: if method == Method::GroupingHull {
+            pset: if builder == Builder::GroupingHull {
                 PSet::Hull
             } else {
                 params.pset
             },
             ..params.clone()
         };
-        let (pregroup, instancing) = match method {
-            Method::GroupingPregroup => (Pregroup::Connected, false),
-            Method::GroupingInstanced => (Pregroup::Connected, true),
-            Method::GroupingObjects => (Pregroup::Objects, true),
+        let (pregroup, instancing) = match builder {
+            Builder::GroupingPregroup => (Pregroup::Connected, false),
+            Builder::GroupingInstanced => (Pregroup::Connected, true),
+            Builder::GroupingObjects => (Pregroup::Objects, true),
             _ => (p.mode.pregroup, p.mode.instancing),
         };
         if pregroup != Pregroup::None {
@@ -291,13 +371,11 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
         }
         p.mode.pregroup = pregroup;
         p.mode.instancing = instancing;
-        if method == Method::GroupingPartitioned {
+        if let Some(schedule @ Schedule::Partitioned(_)) = method.schedule(params) {
             p.pset = PSet::Aabb;
-            p.mode.schedule = Schedule::Partitioned;
-        }
-        if method == Method::GroupingFast {
-            p.pset = PSet::Aabb;
-            p.mode = p.mode.fast();
+            p.mode.schedule = schedule;
+        } else {
+            p.mode.schedule = Schedule::Exact;
         }
         if p.pset == PSet::Aabb && pregroup == Pregroup::None {
             // Like the peers', from the primitives' boxes, computed untimed (with room for
@@ -315,10 +393,10 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
         let seconds = t.elapsed().as_secs_f64();
         return Ok(done(g.tree, Some(g.stats), seconds));
     }
-    let (nodes, root, seconds) = match method {
-        Method::ParryBinned | Method::ParryPloc => {
+    let (nodes, root, seconds) = match builder {
+        Builder::ParryBinned | Builder::ParryPloc => {
             let boxes = topology::local_boxes(scene);
-            let strategy = if method == Method::ParryBinned {
+            let strategy = if builder == Builder::ParryBinned {
                 BvhBuildStrategy::Binned
             } else {
                 BvhBuildStrategy::Ploc
@@ -329,15 +407,15 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
             let (nodes, root) = parry_bvh::topology(&bvh);
             (nodes, root, s)
         }
-        Method::ObvhsPloc | Method::ObvhsPlocReinsert => {
+        Builder::ObvhsPloc | Builder::ObvhsPlocReinsert => {
             let boxes = topology::local_boxes(scene);
             let t = Instant::now();
-            let bvh = obvhs_ploc::build(&boxes, method == Method::ObvhsPlocReinsert);
+            let bvh = obvhs_ploc::build(&boxes, builder == Builder::ObvhsPlocReinsert);
             let s = t.elapsed().as_secs_f64();
             let (nodes, root) = obvhs_ploc::topology(&bvh);
             (nodes, root, s)
         }
-        Method::MedianSplit => {
+        Builder::MedianSplit => {
             let centres: Vec<_> = (0..scene.len())
                 .map(|i| scene.prim_aabb(i).center())
                 .collect();
@@ -345,26 +423,19 @@ fn build_base(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
             let (nodes, root) = median_split::build(&centres);
             (nodes, root, t.elapsed().as_secs_f64())
         }
-        Method::GoldsmithSalmon => {
+        Builder::GoldsmithSalmon => {
             let boxes: Vec<_> = (0..scene.len()).map(|i| scene.prim_aabb(i)).collect();
             let t = Instant::now();
             let (nodes, root) = goldsmith_salmon::build(&boxes);
             (nodes, root, t.elapsed().as_secs_f64())
         }
-        Method::Grouping
-        | Method::GroupingHull
-        | Method::GroupingPregroup
-        | Method::GroupingInstanced
-        | Method::GroupingObjects
-        | Method::GroupingPartitioned
-        | Method::GroupingFast => unreachable!("handled above"),
-        Method::GroupingRefine
-        | Method::ParryBinnedRefine
-        | Method::ObvhsPlocRefine
-        | Method::GroupingPartitionedRefine
-        | Method::Fast => {
-            unreachable!("refined methods are built from their base")
-        }
+        Builder::Grouping
+        | Builder::GroupingHull
+        | Builder::GroupingPregroup
+        | Builder::GroupingInstanced
+        | Builder::GroupingObjects
+        | Builder::GroupingPartitioned
+        | Builder::GroupingFast => unreachable!("handled above"),
     };
     let tree = topology::subset_tree(scene, &nodes, root)
         .map_err(|e| format!("{}: malformed tree: {e}", method.name()))?;
@@ -380,31 +451,42 @@ mod tests {
     fn the_partitioned_methods_name_their_chunks_and_the_others_none() {
         let mut p = Params::default();
         // δ by the scene's size by default: 4,096 up to 2^18 primitives, 4 above.
-        let by_size = |n| Method::GroupingPartitioned.chunking(&p, n);
+        let by_size = |n| Method::GROUPING_PARTITIONED.chunking(&p, n);
         let d = "delta=4096 epsilon=0.5 top=8192 sah=256";
         assert_eq!(by_size(1 << 18).as_deref(), Some(d));
         let above = "delta=4 epsilon=0.5 top=8192 sah=256";
         assert_eq!(by_size((1 << 18) + 1).as_deref(), Some(above));
-        p.mode.chunk_delta = 16;
+        p.mode.schedule = Schedule::Partitioned(crate::grouping::partitioned::Chunking {
+            delta: 16,
+            ..crate::grouping::partitioned::Chunking::DEFAULT
+        });
         let d = "delta=16 epsilon=0.5 top=8192 sah=256";
         assert_eq!(
-            Method::GroupingPartitioned.chunking(&p, 10).as_deref(),
+            Method::GROUPING_PARTITIONED.chunking(&p, 10).as_deref(),
             Some(d)
         );
         assert_eq!(
-            Method::GroupingPartitionedRefine
+            Method::GROUPING_PARTITIONED_REFINE
                 .chunking(&p, 1 << 20)
                 .as_deref(),
             Some(d)
         );
         // The fast path keeps its own chunks whatever `params` say.
         let f = "delta=2 epsilon=0.5 top=16 sah=256";
-        assert_eq!(Method::Fast.chunking(&p, 10).as_deref(), Some(f));
+        assert_eq!(Method::FAST.chunking(&p, 10).as_deref(), Some(f));
         assert_eq!(
-            Method::GroupingFast.chunking(&p, 1 << 20).as_deref(),
+            Method::GROUPING_FAST.chunking(&p, 1 << 20).as_deref(),
             Some(f)
         );
-        for m in [Method::Grouping, Method::GroupingRefine, Method::ObvhsPloc] {
+        // Every name of `ALL` parses back to its method.
+        for m in Method::ALL {
+            assert_eq!(Method::parse(m.name()), Ok(m));
+        }
+        for m in [
+            Method::GROUPING,
+            Method::GROUPING_REFINE,
+            Method::OBVHS_PLOC,
+        ] {
             assert_eq!(m.chunking(&p, 10), None, "{}", m.name());
         }
     }
@@ -432,7 +514,7 @@ mod tests {
     #[test]
     fn median_split_depth_is_logarithmic() {
         let scene = generate::soup(1000, 2);
-        let b = build(Method::MedianSplit, &scene, &Params::default()).unwrap();
+        let b = build(Method::MEDIAN_SPLIT, &scene, &Params::default()).unwrap();
         assert_eq!(b.tree.depth_max(), 10);
     }
 }

@@ -17,6 +17,12 @@ mod summary;
 
 pub use run::{RecordOptions, Written, record};
 
+/// The form of the recordings this build writes, in the `.mcap`'s `wraptree` metadata and the
+/// `.rrd`'s `wraptree` property (`format_version`). Readers take this version and files without
+/// one (older recordings, through one table of the settings they were made with:
+/// [`mcap::metadata::current_form`]); a newer one is an error.
+pub const FORMAT_VERSION: u32 = 1;
+
 use crate::grouping::{Grouping, ResolvedParams, Stopped};
 use crate::scene::{Scene, SceneSource};
 use crate::wrap::cover::Cover;

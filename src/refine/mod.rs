@@ -65,6 +65,26 @@ pub const FAST_SMALL_PARAMS: RefineParams = RefineParams {
     ..FAST
 };
 
+/// Which parameters a refinement starts from: the default ones, or the fast path's for the
+/// tree's size ([`fast_for`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+pub enum Refinement {
+    /// [`RefineParams::default`].
+    Default,
+    /// The fast path's: [`fast_for`] the tree's size.
+    Fast,
+}
+
+impl Refinement {
+    /// The parameters for a tree of `n` leaves.
+    pub fn params(self, n: usize) -> RefineParams {
+        match self {
+            Refinement::Default => RefineParams::default(),
+            Refinement::Fast => fast_for(n),
+        }
+    }
+}
+
 /// The fast path's refinement for a tree of `n` leaves: [`FAST`], with a first batch of
 /// [`FAST_LARGE_BATCH`] from [`FAST_LARGE`] leaves up, or [`FAST_SMALL_PARAMS`] below
 /// [`FAST_SMALL`] ([`refine_fast`]).

@@ -9,24 +9,19 @@
 //! embeds is exactly what was grouped.
 
 use super::load::{LoadError, LoadOptions, Loaded};
+use super::obj_writer::{ObjWriter, write_scene};
 use super::{PrimitiveKind, Scene, obj};
+use crate::geom::P3;
 
 /// The OBJ text of `scene`, whose object `k` is named `names[k]` (`object<k>` past the end).
 /// `what` is written in the first comment line.
 pub fn obj_text(scene: &Scene, names: &[String], what: &str) -> Vec<u8> {
-    use std::io::Write;
-    let mut out = Vec::with_capacity(scene.points.len() * 40 + scene.prim_points.len() * 8);
-    // Writing to a Vec cannot fail.
-    let _ = writeln!(
-        out,
-        "# {what}: {} primitives, written by wraptree {}",
+    let out = Vec::with_capacity(scene.points.len() * 40 + scene.prim_points.len() * 8);
+    let comment = format!(
+        "{what}: {} primitives, written by wraptree {}",
         scene.len(),
         env!("CARGO_PKG_VERSION")
     );
-    for p in &scene.points {
-        // `+ 0.0`: -0 is written as 0 (the loader merges them anyway).
-        let _ = writeln!(out, "v {} {} {}", p.x + 0.0, p.y + 0.0, p.z + 0.0);
-    }
     let name = |k: u32| {
         names
             .get(k as usize)
@@ -34,23 +29,20 @@ pub fn obj_text(scene: &Scene, names: &[String], what: &str) -> Vec<u8> {
             .unwrap_or_else(|| format!("object{k}"))
     };
     let poly = scene.kind == Some(PrimitiveKind::Polyhedron);
-    for i in 0..scene.len() {
-        if poly || i == 0 || scene.object(i) != scene.object(i - 1) {
-            let _ = writeln!(out, "o {}", name(scene.object(i)));
-        }
-        if poly {
-            for t in scene.prim_tris(i) {
-                let _ = writeln!(out, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
-            }
-        } else {
-            out.push(b'f');
-            for v in scene.prim(i) {
-                let _ = write!(out, " {}", v + 1);
-            }
-            out.push(b'\n');
-        }
-    }
-    out
+    // Writing to a Vec cannot fail.
+    let mut w = ObjWriter::new(out, &comment).expect("writing to memory");
+    write_scene(
+        &mut w,
+        scene,
+        // `+ 0.0`: -0 is written as 0 (the loader merges them anyway).
+        |p| P3::new(p.x + 0.0, p.y + 0.0, p.z + 0.0),
+        |i| {
+            (poly || i == 0 || scene.object(i) != scene.object(i - 1))
+                .then(|| name(scene.object(i)))
+        },
+    )
+    .expect("writing to memory");
+    w.into_inner()
 }
 
 /// The scene of the multi-file input `file_name` as a [`Loaded`] whose source is its OBJ text

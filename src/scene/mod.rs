@@ -24,6 +24,7 @@ pub mod generate;
 pub mod gltf;
 pub mod load;
 pub mod obj;
+pub mod obj_writer;
 pub mod off;
 pub mod pathological;
 pub mod ply;
@@ -165,41 +166,29 @@ impl Scene {
     /// line wherever the object changes. Loading the output gives the same primitives and, when
     /// the ids are in order of first appearance (as loaders and generators make them), the same
     /// object ids.
-    pub fn write_obj(&self, mut out: impl std::io::Write) -> std::io::Result<()> {
-        writeln!(
-            out,
-            "# wraptree scene '{}', {} primitives",
-            self.name,
-            self.len()
-        )?;
-        for p in &self.points {
-            writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
-        }
+    pub fn write_obj(&self, out: impl std::io::Write) -> std::io::Result<()> {
+        let comment = format!("wraptree scene '{}', {} primitives", self.name, self.len());
+        let mut w = obj_writer::ObjWriter::new(out, &comment)?;
         let poly = self.kind == Some(PrimitiveKind::Polyhedron);
-        for i in 0..self.len() {
-            if !poly && !self.objects.is_empty() && (i == 0 || self.object(i) != self.object(i - 1))
-            {
-                writeln!(out, "o obj{}", self.object(i))?;
-            }
-            if poly {
-                let label = self.labels.get(i).map(String::as_str).unwrap_or("");
-                if label.is_empty() {
-                    writeln!(out, "o part{i}")?;
+        obj_writer::write_scene(
+            &mut w,
+            self,
+            |p| *p,
+            |i| {
+                if poly {
+                    Some(match self.labels.get(i).map(String::as_str).unwrap_or("") {
+                        "" => format!("part{i}"),
+                        label => label.to_string(),
+                    })
+                } else if !self.objects.is_empty()
+                    && (i == 0 || self.object(i) != self.object(i - 1))
+                {
+                    Some(format!("obj{}", self.object(i)))
                 } else {
-                    writeln!(out, "o {label}")?;
+                    None
                 }
-                for t in self.prim_tris(i) {
-                    writeln!(out, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
-                }
-            } else {
-                write!(out, "f")?;
-                for v in self.prim(i) {
-                    write!(out, " {}", v + 1)?;
-                }
-                writeln!(out)?;
-            }
-        }
-        Ok(())
+            },
+        )
     }
 }
 

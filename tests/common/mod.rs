@@ -147,7 +147,8 @@ pub fn run(scene: &Scene, params: &Params) -> (Grouping, EventLog) {
     (g, log)
 }
 
-/// Checks the Subset Tree invariants; panics with a message on the first violation.
+/// Checks the merge events against the tree, and the tree by [`SubsetTree::validate`]; panics
+/// with a message on the first violation.
 pub fn check_tree(scene: &Scene, g: &Grouping, log: &EventLog) {
     let n = scene.len();
     let t: &SubsetTree = &g.tree;
@@ -166,31 +167,9 @@ pub fn check_tree(scene: &Scene, g: &Grouping, log: &EventLog) {
         let want = if x == 2 * n - 2 { 0 } else { 1 };
         assert_eq!(*c, want, "node {x} is a child {c} times");
     }
-    let mut leaves = t.leaves_under(t.root());
-    leaves.sort();
-    assert_eq!(
-        leaves,
-        (0..n as u32).collect::<Vec<_>>(),
-        "each leaf once under the root"
-    );
-    for leaf in 0..n {
-        for p in scene.prim_vertices(leaf) {
-            assert!(t.aabb[leaf].contains_point(p, 0.0));
-        }
-    }
-    for x in n as u32..t.len() as u32 {
-        let [a, b] = t.children_of(x).unwrap();
-        for c in [a, b] {
-            assert!(
-                t.aabb[x as usize].contains_aabb(&t.aabb[c as usize], 0.0),
-                "parent {x} box holds child {c}"
-            );
-            assert!(
-                t.diameter[x as usize] + 1e-12 >= t.diameter[c as usize],
-                "diameter grows"
-            );
-            assert_eq!(t.depth[c as usize], t.depth[x as usize] + 1);
-        }
+    // The tree itself, by the library's validator.
+    if let Err(e) = t.validate(scene) {
+        panic!("invalid Subset Tree: {e}");
     }
 }
 

@@ -27,7 +27,7 @@ use crate::geom::surface_area;
 use crate::geom::{Aabb, P3, V3};
 use crate::grouping::mpairs::{K_MAX, Top};
 use crate::grouping::voxel_hash::{BLOCK, CellBounds, DEAD, Rec, VoxelHash};
-use crate::grouping::{CostMeasure, Weights};
+use crate::grouping::{CostMeasure, Exponent, Weights};
 
 /// The last search after a merge: its searcher, the bits of the searcher's box and diameter
 /// and the voxel hash version, and the first `K_MAX + 1` partners in key order of all stored
@@ -55,6 +55,27 @@ fn memo_key(xa: &Aabb, dx: f64, version: u64) -> MemoKey {
     ([l[0], l[1], l[2], h[0], h[1], h[2]], dx.to_bits(), version)
 }
 
+/// Runs `$body` with the const `$A` set to the code of the Cost form `$exponent`
+/// ([`Exponent::code`]): the one dispatch from a run's form to its specialised scan.
+macro_rules! by_exponent {
+    ($exponent:expr, $A:ident => $body:expr) => {
+        match $exponent {
+            Exponent::One => {
+                const $A: u8 = Exponent::One.code();
+                $body
+            }
+            Exponent::Zero => {
+                const $A: u8 = Exponent::Zero.code();
+                $body
+            }
+            Exponent::Other => {
+                const $A: u8 = Exponent::Other.code();
+                $body
+            }
+        }
+    };
+}
+
 /// Cost of a pair of AABB bodies whose merged box has diagonal `d`; `A` = 1 or 0 selects the
 /// exponent without `powf` (any other value uses `w.a`).
 #[inline(always)]
@@ -79,13 +100,7 @@ fn pair_cost<const A: u8>(w: &Weights, d: f64, dx: f64, dy: f64) -> f64 {
 /// bit for bit the exact schedule's.
 #[inline(always)]
 pub(in crate::grouping) fn pair_cost_any(w: &Weights, d: f64, dx: f64, dy: f64) -> f64 {
-    if w.a == 1.0 {
-        pair_cost::<1>(w, d, dx, dy)
-    } else if w.a == 0.0 {
-        pair_cost::<0>(w, d, dx, dy)
-    } else {
-        pair_cost::<2>(w, d, dx, dy)
-    }
+    by_exponent!(w.exponent(), A => pair_cost::<A>(w, d, dx, dy))
 }
 
 /// The Cost's size measures of a pair whose merged box has extents `e`: its diagonal and the
@@ -160,7 +175,7 @@ struct Quick {
 
 impl Quick {
     fn new(w: &Weights, small: bool) -> Option<Quick> {
-        (small && w.a == 1.0 && w.c == 0.0 && (1e-40..=1e40).contains(&w.b))
+        (small && w.exponent() == Exponent::One && w.c == 0.0 && (1e-40..=1e40).contains(&w.b))
             .then_some(Quick { b: w.b })
     }
 
@@ -609,14 +624,14 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
         limit: &mut ScanLimit<'_>,
     ) -> u64 {
         if P::AABB {
-            let a = self.params.weights.a;
+            let exponent = self.params.weights.exponent();
             // The parallel scan computes the diameter Cost only; the area Cost scans in order.
             let area = self.params.mode.cost == CostMeasure::Area;
             let quick = Quick::new(&self.params.weights, self.quick && !area).is_some();
             if quick && glimit >= 0.0 && limit.budget.max_pairs.is_none() && self.crowded() {
                 if par::worth_it(par::CROWDED_MIN_BODIES, order.len(), limit) {
                     // The sqrt-free filter holds for A = 1 only.
-                    debug_assert!(a == 1.0);
+                    debug_assert!(exponent == Exponent::One);
                     return self.crowded_par(order, glimit, limit);
                 }
                 let pairs = self.count_pairs(glimit);
@@ -629,19 +644,9 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
                 return pairs;
             }
             if !area && par::worth_it(par::MIN_BODIES, order.len(), limit) {
-                if a == 1.0 {
-                    self.pairs_once_par::<1>(glimit, limit)
-                } else if a == 0.0 {
-                    self.pairs_once_par::<0>(glimit, limit)
-                } else {
-                    self.pairs_once_par::<2>(glimit, limit)
-                }
-            } else if a == 1.0 {
-                self.pairs_once::<1>(glimit, limit)
-            } else if a == 0.0 {
-                self.pairs_once::<0>(glimit, limit)
+                by_exponent!(exponent, A => self.pairs_once_par::<A>(glimit, limit))
             } else {
-                self.pairs_once::<2>(glimit, limit)
+                by_exponent!(exponent, A => self.pairs_once::<A>(glimit, limit))
             }
         } else {
             // Each pair is found from both of its bodies.
@@ -685,14 +690,7 @@ impl<P: PSetBodies, O: Observer> Clusterer<P, O> {
     /// Step 4(b) (and a used-up list): refills `x`'s partner list.
     pub(super) fn search(&mut self, x: u32, glimit: f64) {
         if P::AABB {
-            let a = self.params.weights.a;
-            if a == 1.0 {
-                self.scan_pruned::<1>(x, glimit)
-            } else if a == 0.0 {
-                self.scan_pruned::<0>(x, glimit)
-            } else {
-                self.scan_pruned::<2>(x, glimit)
-            }
+            by_exponent!(self.params.weights.exponent(), A => self.scan_pruned::<A>(x, glimit))
         } else {
             self.search_any(x, glimit);
         }

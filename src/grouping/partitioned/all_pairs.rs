@@ -1,35 +1,37 @@
-//! The brute-force step of [`brute_force`](super::brute_force) for subproblems of at most [`TINY`] bodies,
+//! The brute-force step (`brute_force`) for subproblems of at most
+//! [`MAX_BODIES`] bodies,
 //! most of the partitioned schedule's subproblems (AAC's chunks and the levels just above).
 //!
 //! With so few bodies, keeping each body's cheapest partner costs more than it saves: every
 //! step looks at all pairs of the bodies left. The pair merged next is the least by (its
 //! round, clamped to the current round; Cost; smaller tie tag; larger tie tag), which is the
-//! pair `brute_force` merges: the cheapest pair eligible in the current round, or, when none is,
+//! pair `partner_table` merges: the cheapest pair eligible in the current round, or, when none is,
 //! the cheapest of those eligible first in a later round, which becomes the current one. The
 //! counters (eligible pairs at each round start, candidates, pops, rounds) and the events'
 //! queue length (bodies with an eligible partner after the merge) are those of `brute_force`.
 
-use super::brute_force::{NEVER, eval, leave, merged, pairs_of, put_merge};
+use super::pairs::{eval, leave, merged, pairs_of, put_merge};
+use super::round_limits::NO_ROUND;
 use super::subproblem::{Body, Counters, Leftover, MergeSlots, RunInputs};
 use crate::grouping::cluster::tie_tag;
 
 /// The most bodies a subproblem may have to be solved here.
-pub(super) const TINY: usize = 8;
+pub(super) const MAX_BODIES: usize = 8;
 
 /// The pairs of the bodies in the slots `0..m`: Cost bits and first eligible round (`[i][j]`,
 /// `i < j`), the slots' tie tags and which slots hold a body.
 struct Pairs {
-    cost: [[u64; TINY]; TINY],
-    round: [[u32; TINY]; TINY],
-    tag: [u64; TINY],
-    live: [bool; TINY],
+    cost: [[u64; MAX_BODIES]; MAX_BODIES],
+    round: [[u32; MAX_BODIES]; MAX_BODIES],
+    tag: [u64; MAX_BODIES],
+    live: [bool; MAX_BODIES],
     m: usize,
 }
 
 impl Pairs {
     /// The number of pairs eligible in round `r`, and of bodies with an eligible partner.
     fn eligible(&self, r: u32) -> (u64, u32) {
-        let (mut pairs, mut with) = (0u64, [false; TINY]);
+        let (mut pairs, mut with) = (0u64, [false; MAX_BODIES]);
         for i in (0..self.m).filter(|&i| self.live[i]) {
             for j in (i + 1..self.m).filter(|&j| self.live[j]) {
                 if self.round[i][j] <= r {
@@ -86,7 +88,7 @@ impl Pairs {
 /// [`run`] for two bodies `x` and `y` (in slot order) that become one, without the table of
 /// pairs: the same merge (slot 0 of `out`), event and counters (added to `stats`); returns the
 /// new body. Below the root's share of the fast path's split every node does this
-/// ([`Executor::merge_down`](super::executor::Executor::merge_down)).
+/// (`Executor::merge_down`).
 pub(super) fn pair(
     ctx: &RunInputs,
     x: &Body,
@@ -95,7 +97,10 @@ pub(super) fn pair(
     stats: &mut Counters,
 ) -> Body {
     let (_, round) = eval(ctx, x, y);
-    assert!(round != NEVER, "bodies of NaN size never become eligible");
+    assert!(
+        round != NO_ROUND,
+        "bodies of NaN size never become eligible"
+    );
     let body = merged(ctx, x, y, out.first_new);
     // No body is left with a partner.
     put_merge(ctx, out, 0, [x, y], &body, round, || 0);
@@ -107,8 +112,9 @@ pub(super) fn pair(
     body
 }
 
-/// [`brute_force::combine`](super::brute_force::combine) for at most [`TINY`] bodies (more than `keep`).
-pub(super) fn run(
+/// `brute_force::combine` for at most [`MAX_BODIES`] bodies (more
+/// than `keep`).
+pub(super) fn combine_few(
     ctx: &RunInputs,
     body: &mut [Body],
     parts: [Leftover; 2],
@@ -117,14 +123,14 @@ pub(super) fn run(
     export: bool,
 ) -> Leftover {
     let m = body.len();
-    debug_assert!(m <= TINY && keep >= 1 && keep < m && parts[0].n + parts[1].n == m);
+    debug_assert!(m <= MAX_BODIES && keep >= 1 && keep < m && parts[0].n + parts[1].n == m);
     let seed = ctx.params.seed;
     let mut st = Counters::default();
     let mut p = Pairs {
-        cost: [[0; TINY]; TINY],
-        round: [[NEVER; TINY]; TINY],
-        tag: [0; TINY],
-        live: [false; TINY],
+        cost: [[0; MAX_BODIES]; MAX_BODIES],
+        round: [[NO_ROUND; MAX_BODIES]; MAX_BODIES],
+        tag: [0; MAX_BODIES],
+        live: [false; MAX_BODIES],
         m,
     };
     for (k, b) in body.iter().enumerate() {
@@ -142,7 +148,7 @@ pub(super) fn run(
         };
         st.eligible_pairs += eligible;
         let (i, j, r) = pair.expect("more than one body is left");
-        assert!(r != NEVER, "bodies of NaN size never become eligible");
+        assert!(r != NO_ROUND, "bodies of NaN size never become eligible");
         if r > round {
             // Step 5 until this pair is eligible: a round start.
             round = r;
@@ -168,7 +174,7 @@ pub(super) fn run(
     st.rounds = round + 1;
     out.stats.add(&st);
     // Keep the live slots' bodies, in slot order, and their pairs.
-    let mut slots = [0usize; TINY];
+    let mut slots = [0usize; MAX_BODIES];
     let mut n = 0;
     for k in (0..m).filter(|&k| p.live[k]) {
         slots[n] = k;

@@ -60,7 +60,8 @@ impl Executor<'_> {
                 let (lout, rest) = out.split(lm);
                 let (rout, own) = rest.split(rm);
                 // The children's pairs serve this node's brute-force step.
-                let want = node.inputs as usize <= brute_force::SMALL && node.inputs > node.keep;
+                let want =
+                    node.inputs as usize <= brute_force::MAX_BODIES && node.inputs > node.keep;
                 let mid = (ln.hi - ln.lo) as usize;
                 let (la, ra) = arena.split_at_mut(mid);
                 let ((lb, ls), (rb, rs)) = if node.hi - node.lo >= self.grain {
@@ -120,7 +121,7 @@ impl Executor<'_> {
         export: bool,
     ) -> Option<Leftover> {
         let m = parts[0].n + parts[1].n;
-        if m <= brute_force::SMALL {
+        if m <= brute_force::MAX_BODIES {
             return Some(brute_force::combine(
                 self.ctx,
                 &mut arena[..m],
@@ -130,7 +131,7 @@ impl Executor<'_> {
                 export,
             ));
         }
-        voxel_step::combine(self.ctx, arena[..m].to_vec(), keep, own).map(|bodies| {
+        voxel_step::combine_by_voxels(self.ctx, arena[..m].to_vec(), keep, own).map(|bodies| {
             arena[..bodies.len()].copy_from_slice(&bodies);
             Leftover {
                 n: bodies.len(),
@@ -184,7 +185,7 @@ impl Executor<'_> {
             None => {
                 self.first_rounds(arena);
                 if arena.len() != 2 {
-                    // One primitive, or a chunk of more that keeps one (`chunk_max` above 2):
+                    // One primitive, or a chunk of more that keeps one:
                     // its own subproblem.
                     let mut out = out;
                     let part = Leftover {

@@ -2,9 +2,10 @@
 //! executor run over it, the events announced and the Subset Tree assembled.
 
 use super::announce::{Built, announce};
-use super::brute_force::merge_info;
+use super::chunking::Chunking;
 use super::executor::Executor;
-use super::plan::{Chunking, Node, plan};
+use super::pairs::merge_info;
+use super::plan::{Node, plan};
 use super::split::morton_order;
 use super::subproblem::{Body, Counters, Leftover, MergeInfo, MergeSlots, RunInputs};
 use super::twins::{self, Twins};
@@ -24,50 +25,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// How many leaves ahead the gather asks for the box it will read (its reads are random).
 const GATHER_AHEAD: usize = 16;
 
-/// The [`Chunking`] `params.mode` names for a scene of `n` primitives (δ by
-/// [`Chunking::delta_for`]).
-pub(crate) fn chunking_of(params: &ResolvedParams, n: usize) -> Chunking {
-    Chunking {
-        top: params.mode.chunk_top,
-        epsilon: params.mode.chunk_epsilon,
-        sah_below: params.mode.chunk_sah,
-        chunk_max: params.mode.chunk_max,
-        delta: Chunking::delta_for(params.mode.chunk_delta, n),
-        few: params.mode.chunk_few,
-        twins: params.mode.chunk_twins,
-    }
-}
-
-/// Runs the partitioned schedule with the default [`Chunking`].
-pub(crate) fn run<O: Observer>(
-    scene: &Scene,
-    params: &ResolvedParams,
-    observer: O,
-    budget: &Budget<'_>,
-) -> Result<Grouping, Stopped> {
-    group_with(
-        scene,
-        params,
-        &chunking_of(params, scene.len()),
-        observer,
-        budget,
-    )
-}
-
-/// Runs the partitioned schedule on primitive boxes (see [`group_boxes`]) with the default
-/// [`Chunking`].
-pub(crate) fn run_boxes<O: Observer>(
-    aabb: Vec<Aabb>,
-    params: &ResolvedParams,
-    observer: O,
-    budget: &Budget<'_>,
-) -> Result<Grouping, Stopped> {
-    let chunking = chunking_of(params, aabb.len());
-    group_boxes(aabb, params, &chunking, observer, budget)
-}
-
-/// Runs the partitioned schedule with `chunking` instead of [`Chunking::DEFAULT`] (see the module
-/// doc); `params.mode` is not read. Panics only if the scene is empty.
+/// Runs the partitioned schedule split as `chunking` says (see the module doc; δ = 0 is taken
+/// by the scene's size, [`Chunking::for_size`]); `params.mode.schedule` is not read. With the
+/// hull p-set, which has no partitioned form, the exact schedule runs. Panics only if the
+/// scene is empty.
 pub fn group_with<O: Observer>(
     scene: &Scene,
     params: &ResolvedParams,
@@ -106,6 +67,7 @@ pub fn group_boxes<O: Observer>(
 ) -> Result<Grouping, Stopped> {
     assert!(!aabb.is_empty(), "grouping needs at least one primitive");
     let n = aabb.len();
+    let chunking = &chunking.for_size(n);
     let ctx = RunInputs::new(*params, budget);
     let listens = !observer.is_silent();
     let g = on_pool(n >= POOL_MIN, || {

@@ -1,7 +1,7 @@
 //! What a node of the split keeps for the level above: AAC's reduction function and the root's
 //! share.
 
-use super::plan::Chunking;
+use super::chunking::Chunking;
 
 /// Below this many primitives f(n) comes from a table (most nodes are small).
 const TABLED: usize = 4096;
@@ -11,7 +11,7 @@ const TABLED: usize = 4096;
 ///
 /// Two halves' shares, rounded up, can exceed their parent's by one, so a node above the share's
 /// size would make a merge or two, each a voxel-hash round over thousands of bodies when it
-/// has more than [`SMALL`](super::brute_force::SMALL) of them. Such a node passes its bodies
+/// has more than [`brute_force::MAX_BODIES`](super::brute_force::MAX_BODIES) of them. Such a node passes its bodies
 /// up, and the root makes those merges. (Shares that add up exactly, as differences of one
 /// rounded-down prefix, push merges into the smallest nodes above f and cost tree quality.)
 pub(super) struct Keep {
@@ -56,8 +56,8 @@ impl Keep {
     }
 
     /// Whether a node of `size` primitives and `inputs` bodies passes them all up: more than
-    /// [`SMALL`](super::brute_force::SMALL) bodies, and a share above f(`size`).
+    /// [`brute_force::MAX_BODIES`](super::brute_force::MAX_BODIES) bodies, and a share above f(`size`).
     pub(super) fn passes(&self, size: u32, inputs: u32) -> bool {
-        inputs as usize > super::brute_force::SMALL && self.share(size) > self.f(size)
+        inputs as usize > super::brute_force::MAX_BODIES && self.share(size) > self.f(size)
     }
 }

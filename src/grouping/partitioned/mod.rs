@@ -15,10 +15,14 @@
 mod all_pairs;
 mod announce;
 mod brute_force;
+mod chunking;
 mod executor;
 mod group;
 mod keep;
+mod pairs;
+mod partner_table;
 mod plan;
+mod round_limits;
 mod sort;
 mod split;
 mod subproblem;
@@ -27,6 +31,5 @@ mod tests;
 mod twins;
 mod voxel_step;
 
-pub(crate) use group::{chunking_of, run, run_boxes};
+pub use chunking::Chunking;
 pub use group::{group_boxes, group_with};
-pub use plan::Chunking;

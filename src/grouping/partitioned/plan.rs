@@ -1,6 +1,7 @@
-//! The top-down split: its parameters ([`Chunking`]), the Morton order of the primitives and the
-//! tree of chunks over it.
+//! The top-down split: the tree of chunks over the Morton order of the primitives, cut as its
+//! [`Chunking`] asks.
 
+use super::chunking::Chunking;
 use super::keep::Keep;
 use super::split::{Zone, morton_cut};
 use super::subproblem::Body;
@@ -8,130 +9,6 @@ use super::subproblem::Body;
 use crate::geom::Aabb;
 use crate::par;
 use rayon::prelude::*;
-
-/// The split's parameters: chunk size δ, the reduction function's ε (AAC §3) and the root's share.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Chunking {
-    /// AAC's δ: chunks keep f(δ) bodies, and f is scaled by it.
-    pub delta: u32,
-    /// f(n) = ⌈c·n^(1/2 − ε)⌉ with c = δ^(1/2 + ε)/2.
-    pub epsilon: f64,
-    /// A node of n of the N primitives keeps at least ⌈top·n/N⌉ bodies, so the root's
-    /// subproblem (the exact schedule's step) starts from about `top` bodies; 0 = AAC's f alone.
-    /// A scene of at most 1.5 × `top` primitives is one subproblem (see [`Chunking::whole`]).
-    pub top: u32,
-    /// Ranges of at most this many primitives are cut by binned SAH on the best axis of
-    /// their centres instead of at their highest differing Morton bit (`split`); 0 = Morton
-    /// cuts throughout.
-    pub sah_below: u32,
-    /// Ranges of at most this many primitives are chunks; 0 = δ. AAC's chunks have fewer than
-    /// δ (δ − 1 here); a range of exactly δ cut in two halves that keep all their bodies gives
-    /// its node the same δ bodies (but for a 1 + 3 cut), so by default it is one chunk and its
-    /// cut is saved (time saved, the trees as good).
-    pub chunk_max: u32,
-    /// Ranges of 3 up to this many primitives (at most [`Chunking::FEW_MAX`]) that are cut, not
-    /// chunks, try every partition for the best binary tree over their leaves instead of the
-    /// SAH sweep (`split`); 0 = the sweep. Only δ = 2 (or `chunk_max` below 4) leaves such ranges to be cut.
-    pub few: u32,
-    /// Whether bodies with identical boxes that the Morton order puts side by side are merged
-    /// in pairs before the split, and again while such pairs remain (`twins`): a mesh of
-    /// double-sided faces is then split as one of half the size. The fast path sets it.
-    pub twins: bool,
-}
-
-impl Chunking {
-    /// The largest [`Chunking::few`]: the split tries every partition only in ranges of 3 or 4
-    /// primitives (at most 7 partitions).
-    pub const FEW_MAX: u32 = 4;
-
-    /// δ = 4 and ε = 1/2, so that f(n) = δ/2 = 2: every node below the root share leaves two
-    /// bodies, and the nodes above it leave ⌈top·n/N⌉, with a root step of about 8,192 bodies;
-    /// ranges of up to 256 primitives are cut by SAH. Faster than AAC's ε = 0.2 for trees as
-    /// close to the exact schedule's (the measurements: docs/benchmarks.md). The partitioned
-    /// schedule's default for scenes of more than [`Chunking::BY_SIZE_UP_TO`] primitives;
-    /// smaller ones take [`Chunking::FAITHFUL_DELTA`] ([`Chunking::delta_for`]).
-    pub const DEFAULT: Chunking = Chunking {
-        delta: 4,
-        epsilon: 0.5,
-        top: 8192,
-        sah_below: 256,
-        chunk_max: 0,
-        few: 0,
-        twins: false,
-    };
-
-    /// δ for scenes of up to [`Chunking::BY_SIZE_UP_TO`] primitives when none is given:
-    /// chunks of 4,096 primitives make most merges the exact run's own, so the tree stays
-    /// close to the exact one's, closer than with δ = 4. It costs about the exact run's work,
-    /// spread over the threads (docs/benchmarks.md).
-    pub const FAITHFUL_DELTA: u32 = 4096;
-
-    /// The most primitives that [`Chunking::FAITHFUL_DELTA`] applies to when δ is not given
-    /// (2^18); larger scenes take [`Chunking::DEFAULT`]'s δ = 4. On large scenes chunks of
-    /// 4,096 take several times the time of chunks of 4 for no better a tree (the exact Cost's
-    /// own tree is further from PLOC's there).
-    pub const BY_SIZE_UP_TO: usize = 1 << 18;
-
-    /// The δ a run on `n` primitives uses for the setting `delta`: `delta` itself, or for 0 (by
-    /// the scene's size) [`Chunking::FAITHFUL_DELTA`] up to [`Chunking::BY_SIZE_UP_TO`]
-    /// primitives and [`Chunking::DEFAULT`]'s δ above.
-    pub fn delta_for(delta: u32, n: usize) -> u32 {
-        match delta {
-            0 if n <= Self::BY_SIZE_UP_TO => Self::FAITHFUL_DELTA,
-            0 => Self::DEFAULT.delta,
-            d => d,
-        }
-    }
-
-    /// The fast path's split (`--fast`, bench method `fast`): the default's with a root share
-    /// of 16 bodies and δ = 2, so that f(n) = 1: below the root share every node merges its two
-    /// halves, and the tree there is the split's own (SAH cuts in ranges of up to 256
-    /// primitives, Morton cuts above), under a root step of about 16 bodies; only scenes of at
-    /// most 24 primitives are grouped whole. Its trees are further from the exact schedule's
-    /// than the default's; the fast path's refinement (`refine::fast_for`) takes their SAH back
-    /// down. Larger root shares gave the same trees after the refinement in more time on small
-    /// scenes (the root step's Cost table grows with the square of the share); δ = 2 against 4
-    /// (with the executor's lean recursion for such subtrees) saves time for as good trees.
-    pub const FAST: Chunking = Chunking {
-        top: 16,
-        delta: 2,
-        few: 4,
-        twins: true,
-        ..Chunking::DEFAULT
-    };
-
-    /// Whether a range of `size` primitives is a chunk: at most [`Chunking::chunk_max`] (δ
-    /// when 0), and at least one.
-    pub fn is_chunk(&self, size: u32) -> bool {
-        let max = if self.chunk_max == 0 {
-            self.delta
-        } else {
-            self.chunk_max
-        };
-        size <= max.max(1)
-    }
-
-    /// Whether a scene of `n` primitives is grouped as one subproblem, the exact schedule's
-    /// step: when `n` ≤ 1.5 × `top`. The root step alone on about `top` bodies costs about what
-    /// the exact schedule costs on all of them, so below this size the split would only
-    /// approximate the tree for no gain.
-    pub fn whole(&self, n: usize) -> bool {
-        2 * n as u64 <= 3 * u64::from(self.top)
-    }
-
-    /// The bodies a node of `n` primitives leaves for the level above: f(n), at least 1.
-    pub fn keep(&self, n: u32) -> u32 {
-        let d = self.delta as f64;
-        let c = d.powf(0.5 + self.epsilon) / 2.0;
-        ((c * (n as f64).powf(0.5 - self.epsilon)).ceil() as u32).max(1)
-    }
-}
-
-impl Default for Chunking {
-    fn default() -> Self {
-        Chunking::DEFAULT
-    }
-}
 
 /// A node of the split, in pre-order (a node, its left half's subtree, then its right half's),
 /// so that the grouping, which descends the split depth first, reads the nodes in order.
@@ -190,13 +67,13 @@ pub(super) fn post_order(nodes: &[Node]) -> Vec<u32> {
 }
 
 /// Ranges of at least this many primitives plan their halves in parallel (a finer grain than
-/// 1,024, with [`executor`](super::executor)'s grain and the refinement's search threshold
-/// lowered alike, made the fast path faster on 4 and 16 threads: `docs/benchmarks.md`).
+/// 1,024, with `executor`'s grain and the refinement's search threshold lowered alike, made the
+/// fast path faster on 4 and 16 threads: `docs/benchmarks.md`).
 const PLAN_GRAIN: u32 = 1 << 8;
 
 /// The split of the primitives into chunks, nodes in pre-order (the root first): `codes`
 /// sorted, `leaves` the primitives in the same order. Ranges of at most
-/// [`Chunking::sah_below`] primitives are cut by binned SAH ([`split`](super::split)), which
+/// [`Chunking::sah_below`] primitives are cut by binned SAH (`split`), which
 /// reorders `codes` and `leaves` alike within them; the nodes' ranges index the new order.
 /// Halves of large ranges are planned in parallel into blocks of nodes, laid end to end at the
 /// end (the same nodes and order as one sequential pass, whatever the number of threads).
@@ -427,25 +304,10 @@ const PLACEHOLDER: Node = Node {
 };
 
 #[cfg(test)]
-pub(super) mod tests {
+mod tests {
+    use super::super::sort::tests::codes;
     use super::*;
     use rand::{Rng, SeedableRng};
-
-    /// `n` pairs in id order with codes from a few clustered values (many ties) and random
-    /// ones.
-    pub(in crate::grouping::partitioned) fn codes(n: usize, seed: u64) -> Vec<(u64, u32)> {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        (0..n as u32)
-            .map(|i| {
-                let code = if rng.random_bool(0.3) {
-                    rng.random_range(0..4u64) << 40
-                } else {
-                    rng.random::<u64>() >> 1
-                };
-                (code, i)
-            })
-            .collect()
-    }
 
     /// A leaf for each of `codes`: a small box at a random place (not its code's).
     fn leaves(codes: &[(u64, u32)], seed: u64) -> Vec<Body> {
@@ -474,18 +336,19 @@ pub(super) mod tests {
     #[test]
     fn parallel_plan_equals_one_sequential_pass() {
         // Above the size the default chunking groups whole, and several plan grains.
-        let len = (5 * PLAN_GRAIN).max(2 * Chunking::DEFAULT.top) as usize + 17;
+        // The default's split for large scenes (δ = 4).
+        let default = Chunking::DEFAULT.for_size(usize::MAX);
+        let len = (5 * PLAN_GRAIN).max(2 * default.top) as usize + 17;
         let mut items = codes(len, 5);
         items.sort_unstable();
         let bodies = leaves(&items, 6);
         for chunking in [
-            Chunking::DEFAULT,
+            default,
             Chunking {
                 delta: 8,
                 epsilon: 0.1,
                 top: 0,
                 sah_below: 0,
-                chunk_max: 7,
                 few: 0,
                 twins: false,
             },
@@ -494,7 +357,7 @@ pub(super) mod tests {
             // SAH cuts in the parallel part of the plan too.
             Chunking {
                 sah_below: 4 * PLAN_GRAIN,
-                ..Chunking::DEFAULT
+                ..default
             },
         ] {
             let keep = Keep::new(&chunking, items.len());
@@ -560,7 +423,7 @@ pub(super) mod tests {
         let mut bodies = leaves(&items, 8);
         let chunking = Chunking {
             top: 2048,
-            ..Chunking::DEFAULT
+            ..Chunking::DEFAULT.for_size(usize::MAX)
         };
         let nodes = plan(&mut items, &mut bodies, &chunking);
         let share = |node: &Node| {
@@ -569,7 +432,7 @@ pub(super) mod tests {
         let mut passed = 0;
         for (k, node) in nodes.iter().enumerate().skip(1) {
             assert!(node.keep >= share(node).min(node.inputs), "node {k}");
-            if node.inputs as usize > super::super::brute_force::SMALL && share(node) > 2 {
+            if node.inputs as usize > super::super::brute_force::MAX_BODIES && share(node) > 2 {
                 assert_eq!(node.keep, node.inputs, "node {k}");
                 passed += 1;
             }

@@ -230,13 +230,30 @@ fn insertion_sort(s: &mut [(u64, u32)]) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
+    use rand::{Rng, SeedableRng};
+
+    /// `n` pairs in id order with codes from a few clustered values (many ties) and random
+    /// ones.
+    pub(in crate::grouping::partitioned) fn codes(n: usize, seed: u64) -> Vec<(u64, u32)> {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        (0..n as u32)
+            .map(|i| {
+                let code = if rng.random_bool(0.3) {
+                    rng.random_range(0..4u64) << 40
+                } else {
+                    rng.random::<u64>() >> 1
+                };
+                (code, i)
+            })
+            .collect()
+    }
 
     #[test]
     fn the_bucket_sort_gives_the_comparison_sorts_order_on_any_thread_count() {
         // Clustered codes (many in one bucket, ties broken by id) and spread ones.
-        let mut codes = super::super::plan::tests::codes(3 * MIN_LEN + 5, 11);
+        let mut codes = codes(3 * MIN_LEN + 5, 11);
         // A dense spot: a fifth of the pairs share their top 18 bits, in falling order; and
         // the next two fifths one bucket.
         let dense = codes.len() / 5;

@@ -1,7 +1,7 @@
 //! What every subproblem of the partitioned schedule shares: its bodies, the run-wide inputs,
 //! the slots its merges go to and its counters.
 
-use super::brute_force::RoundLimits;
+use super::round_limits::RoundLimits;
 use crate::geom::Aabb;
 use crate::grouping::{Budget, ResolvedParams, StopReason};
 use std::sync::Mutex;

@@ -1,11 +1,11 @@
-//! The brute-force subproblems (`all_pairs`, `brute_force`) against the voxel-hash one on the same bodies.
+//! The brute-force subproblems (`all_pairs`, `partner_table`, through `brute_force`) against the voxel-hash one on the same bodies.
 
+use super::round_limits::RoundLimits;
 use super::subproblem::{Body, Counters, Leftover, MergeInfo, MergeSlots, PairList, RunInputs};
 use super::{all_pairs, brute_force, voxel_step};
 use crate::geom::Aabb;
 use crate::grouping::{Budget, Params, Weights};
 use crate::scene::generate;
-use brute_force::RoundLimits;
 
 /// Children, Cost bits and round of each merge, and the ids of the bodies left.
 type Solved = (Vec<([u32; 2], u64, u32)>, Vec<u32>);
@@ -83,7 +83,7 @@ fn solve_parts(
         None => {
             let [a, b] = parts;
             let bodies = [a.bodies, b.bodies].concat();
-            part(&voxel_step::combine(ctx, bodies, keep, &mut out).unwrap())
+            part(&voxel_step::combine_by_voxels(ctx, bodies, keep, &mut out).unwrap())
         }
     };
     let merges = (0..m)
@@ -226,7 +226,7 @@ fn two_bodies_merge_as_the_table_of_pairs_merges_them() {
                     };
                     (left, stats)
                 } else {
-                    let left = all_pairs::run(&ctx, &mut arena, parts, 1, &mut out, true);
+                    let left = all_pairs::combine_few(&ctx, &mut arena, parts, 1, &mut out, true);
                     (left, out.stats)
                 };
                 let stats = format!("{stats:?}");

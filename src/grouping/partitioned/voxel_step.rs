@@ -1,4 +1,4 @@
-//! Subproblems of more than [`SMALL`](super::brute_force::SMALL) bodies: the exact schedule's voxel
+//! Subproblems of more than `brute_force::MAX_BODIES` bodies: the exact schedule's voxel
 //! hash and MPairs on the subproblem's bodies, stopped at `keep` bodies.
 
 use super::subproblem::{Body, Counters, MergeInfo, MergeSlots, RunInputs};
@@ -25,9 +25,9 @@ impl Observer for MergeLog {
     }
 }
 
-/// A subproblem of more than [`SMALL`](super::brute_force::SMALL) bodies, with the exact schedule's voxel hash and
+/// A subproblem of more than `brute_force::MAX_BODIES` bodies, with the exact schedule's voxel hash and
 /// MPairs (local ids mapped increasingly onto the run's ids, ties broken by the run's ids).
-pub(super) fn combine(
+pub(super) fn combine_by_voxels(
     ctx: &RunInputs,
     mut bodies: Vec<Body>,
     keep: usize,

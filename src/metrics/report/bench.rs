@@ -159,7 +159,7 @@ pub fn bench_table(rows: &[&Row]) -> String {
     );
     let ploc = rows
         .iter()
-        .find(|r| r.method == Method::ObvhsPloc.name())
+        .find(|r| r.method == Method::OBVHS_PLOC.name())
         .map(|r| r.build_s);
     // Contact queries run with box BVs only: other rows leave the cell empty.
     let contact = |q: &crate::query::QueryCost| {

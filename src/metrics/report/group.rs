@@ -14,31 +14,32 @@ pub fn group_text(scene: &Scene, g: &Grouping, threads: usize, seconds: f64) -> 
         "params      A={} B={} C={} DLimit0={:.6e} GLimit0={:.6e} pset={:?}",
         p.weights.a, p.weights.b, p.weights.c, p.dlimit0, p.glimit0, p.pset
     );
-    // Without pre-grouping, a scene of at most 1.5 × the root share is one subproblem.
-    let whole = p.mode.pregroup == Pregroup::None
-        && grouping::partitioned::chunking_of(p, scene.len()).whole(scene.len());
-    let chunking = match p.mode.schedule {
-        grouping::Schedule::Partitioned => format!(
-            " (chunks of δ = {}, ε = {}, root share {}, {}{})",
-            p.mode.chunk_delta,
-            p.mode.chunk_epsilon,
-            p.mode.chunk_top,
-            match p.mode.chunk_sah {
-                0 => "Morton cuts only".to_string(),
-                n => format!("SAH cuts up to {n} primitives"),
-            },
-            if whole {
-                "; grouped whole, the exact schedule's tree: at most 1.5 × the root share"
-            } else {
-                ""
-            }
-        ),
-        grouping::Schedule::Exact => String::new(),
+    let (name, chunking) = match &p.mode.schedule {
+        grouping::Schedule::Partitioned(c) => {
+            // Without pre-grouping, a scene of at most 1.5 × the root share is one subproblem.
+            let whole = p.mode.pregroup == Pregroup::None && c.whole(scene.len());
+            let text = format!(
+                " (chunks of δ = {}, ε = {}, root share {}, {}{})",
+                c.delta,
+                c.epsilon,
+                c.top,
+                match c.sah_below {
+                    0 => "Morton cuts only".to_string(),
+                    n => format!("SAH cuts up to {n} primitives"),
+                },
+                if whole {
+                    "; grouped whole, the exact schedule's tree: at most 1.5 × the root share"
+                } else {
+                    ""
+                }
+            );
+            ("Partitioned", text)
+        }
+        grouping::Schedule::Exact => ("Exact", String::new()),
     };
     let _ = writeln!(
         s,
-        "schedule    {:?} on {threads} thread{}{chunking}",
-        p.mode.schedule,
+        "schedule    {name} on {threads} thread{}{chunking}",
         if threads == 1 { "" } else { "s" }
     );
     if let Some(p) = &g.pregrouping {

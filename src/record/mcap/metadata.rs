@@ -5,8 +5,8 @@
 //! them gives back the exact `f64`.
 
 use crate::grouping::partitioned::Chunking;
-use crate::grouping::{Mode, PSet, ResolvedParams, Schedule, Weights};
-use crate::record::{Detail, Outcome, RunInfo};
+use crate::grouping::{CostMeasure, Mode, PSet, Pregroup, ResolvedParams, Schedule, Weights};
+use crate::record::{Detail, FORMAT_VERSION, Outcome, RunInfo};
 use crate::refine::RefineParams;
 use anyhow::{Context, Result, anyhow};
 use clap::ValueEnum;
@@ -20,6 +20,7 @@ pub const TIMING: &str = "wraptree.timing";
 /// Keys of the `wraptree` record, in the order `docs/recordings.md` ("Metadata") lists them.
 pub const KEYS: &[&str] = &[
     "version",
+    "format_version",
     "git_commit",
     "a",
     "b",
@@ -60,22 +61,103 @@ pub const STOP_KEYS: &[&str] = &["stop_reason", "stop_eligible_pairs"];
 pub const LOAD_KEYS: &[&str] = &["up"];
 
 /// Keys the `wraptree` record adds for the partitioned schedule ([`Chunking`]): its chunk size
-/// δ (4, or 2 on the fast path), the reduction function's ε (`--chunk-epsilon`), the root's
-/// share `top` (`--chunk-top`), the SAH cuts' range size (`--chunk-sah`), the largest chunk
-/// (0 = δ), the largest range cut by trying every partition (4 on the fast path, else 0) and
-/// whether identical neighbours were merged first (`true` on the fast path), all read back by
-/// `replay` (a recording without `chunk_sah` was cut at Morton bits only, one without
-/// `chunk_max` into chunks of fewer than δ, one without `chunk_few` by sweeps, one without
-/// `chunk_twins` merged no identical neighbours first).
+/// δ as the run used it, the reduction function's ε (`--chunk-epsilon`), the root's share
+/// `top` (`--chunk-top`), the SAH cuts' range size (`--chunk-sah`), the largest range cut by
+/// trying every partition (4 on the fast path, else 0) and whether identical neighbours were
+/// merged first (`true` on the fast path), all read back by `replay`.
 pub const PARTITIONED_KEYS: &[&str] = &[
     "chunk_delta",
     "chunk_epsilon",
     "chunk_top",
     "chunk_sah",
-    "chunk_max",
     "chunk_few",
     "chunk_twins",
 ];
+
+/// The values recordings without `format_version` (made before it existed) leave out, each
+/// the setting they were made with: `(key, value, whether it applies to the record)`. These
+/// recordings are read by filling them in ([`current_form`]); it is the only place that
+/// knows older forms.
+const LEGACY_DEFAULTS: &[(&str, &str, fn(&Record) -> bool)] = &[
+    // Made before modes existed: the default mode.
+    ("schedule", "exact", always),
+    ("pregroup", "none", always),
+    ("instancing", "false", always),
+    ("cost", "diameter", always),
+    // Partitioned runs made before these keys: the root share's default, δ = 4, the
+    // default ε, Morton cuts throughout, sweeps only and no identical neighbours merged.
+    ("chunk_top", "8192", partitioned),
+    ("chunk_delta", "4", partitioned),
+    ("chunk_epsilon", "0.5", partitioned),
+    ("chunk_sah", "0", partitioned),
+    ("chunk_few", "0", partitioned),
+    ("chunk_twins", "false", partitioned),
+    // Refined runs made before treelet roots had a size bound: by the tree's size.
+    ("refine_treelet_min", "0", refined),
+    // Stopped runs made before the reason was written.
+    ("stop_reason", "unknown", incomplete),
+];
+
+/// A `wraptree` metadata record.
+type Record = BTreeMap<String, String>;
+
+fn always(_: &Record) -> bool {
+    true
+}
+
+fn partitioned(m: &Record) -> bool {
+    m.get("schedule").map(String::as_str) == Some("partitioned")
+}
+
+fn refined(m: &Record) -> bool {
+    m.contains_key("refine")
+}
+
+fn incomplete(m: &Record) -> bool {
+    m.get("complete").map(String::as_str) == Some("false")
+}
+
+/// The record `m` in the current form: as it is with the current `format_version`; without
+/// one (older recordings), with the legacy defaults (`LEGACY_DEFAULTS`) filled in and the older
+/// spellings of two settings rewritten (`refine` = `reinsert`, refinement without treelet
+/// passes; `chunk_max`, which was 0 = δ, dropped). A newer `format_version`, or an older run this version cannot
+/// re-run (chunks of fewer than δ primitives), is one error line.
+pub fn current_form(mut m: Record) -> Result<Record> {
+    if let Some(v) = m.get("format_version") {
+        let v: u32 = v
+            .parse()
+            .map_err(|_| anyhow!("`{RUN}` metadata has a bad `format_version`: {v:?}"))?;
+        if v > FORMAT_VERSION {
+            return Err(anyhow!(
+                "the recording's format_version is {v}, newer than this wraptree reads \
+                 ({FORMAT_VERSION}): read it with a newer wraptree"
+            ));
+        }
+        return Ok(m);
+    }
+    // `chunk_max` was always 0 (= δ) but in runs made before it was written.
+    if partitioned(&m) && m.remove("chunk_max").as_deref() != Some("0") {
+        return Err(anyhow!(
+            "`{RUN}` metadata: the run cut its split into chunks of fewer than δ primitives \
+             (no `chunk_max` = 0), which this wraptree no longer does"
+        ));
+    }
+    if m.get("refine").map(String::as_str) == Some("reinsert") {
+        m.insert("refine".into(), "treelet+reinsert".into());
+        m.insert(
+            "refine_treelet".into(),
+            RefineParams::default().treelet.to_string(),
+        );
+        m.insert("refine_treelet_passes".into(), "0".into());
+    }
+    for (key, value, applies) in LEGACY_DEFAULTS {
+        if !m.contains_key(*key) && applies(&m) {
+            m.insert((*key).into(), (*value).into());
+        }
+    }
+    m.insert("format_version".into(), FORMAT_VERSION.to_string());
+    Ok(m)
+}
 
 /// Keys the `wraptree` record adds when a cover is logged (`cover_budget` only for a cover
 /// asked for by budget).
@@ -136,30 +218,17 @@ pub fn put_refine(m: &mut BTreeMap<String, String>, r: &RefineSummary) {
 }
 
 /// The refinement the record names, if any (a recording without the `refine` key was not
-/// refined).
+/// refined); `m` in the current form ([`current_form`]).
 pub fn refine(m: &BTreeMap<String, String>) -> Result<Option<RefineSummary>> {
     match m.get("refine").map(String::as_str) {
         None => Ok(None),
-        Some(method @ ("reinsert" | "treelet+reinsert")) => {
-            let treelets = method != "reinsert";
+        Some("treelet+reinsert") => {
             let params = RefineParams {
                 passes: parse(m, "refine_passes")?,
                 batch: parse(m, "refine_batch")?,
-                treelet: if treelets {
-                    parse(m, "refine_treelet")?
-                } else {
-                    RefineParams::default().treelet
-                },
-                treelet_passes: if treelets {
-                    parse(m, "refine_treelet_passes")?
-                } else {
-                    0
-                },
-                treelet_min: if m.contains_key("refine_treelet_min") {
-                    parse(m, "refine_treelet_min")?
-                } else {
-                    0
-                },
+                treelet: parse(m, "refine_treelet")?,
+                treelet_passes: parse(m, "refine_treelet_passes")?,
+                treelet_min: parse(m, "refine_treelet_min")?,
             };
             params
                 .check()
@@ -202,6 +271,7 @@ pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String,
         m.insert(k.to_string(), v);
     };
     put("version", env!("CARGO_PKG_VERSION").to_string());
+    put("format_version", FORMAT_VERSION.to_string());
     put(
         "git_commit",
         option_env!("WRAPTREE_GIT_COMMIT")
@@ -215,18 +285,17 @@ pub fn run_record(info: &RunInfo<'_>, outcome: &Outcome<'_>) -> BTreeMap<String,
     put("glimit0", p.glimit0.to_string());
     put("pset", value_name(&p.pset));
     put("seed", p.seed.map_or("none".to_string(), |s| s.to_string()));
-    put("schedule", value_name(&p.mode.schedule));
+    put("schedule", p.mode.schedule.name().to_string());
     put("pregroup", value_name(&p.mode.pregroup));
     put("instancing", p.mode.instancing.to_string());
     put("cost", value_name(&p.mode.cost));
-    if p.mode.schedule == Schedule::Partitioned {
-        put("chunk_delta", p.mode.chunk_delta.to_string());
-        put("chunk_epsilon", p.mode.chunk_epsilon.to_string());
-        put("chunk_top", p.mode.chunk_top.to_string());
-        put("chunk_sah", p.mode.chunk_sah.to_string());
-        put("chunk_max", p.mode.chunk_max.to_string());
-        put("chunk_few", p.mode.chunk_few.to_string());
-        put("chunk_twins", p.mode.chunk_twins.to_string());
+    if let Schedule::Partitioned(c) = &p.mode.schedule {
+        put("chunk_delta", c.delta.to_string());
+        put("chunk_epsilon", c.epsilon.to_string());
+        put("chunk_top", c.top.to_string());
+        put("chunk_sah", c.sah_below.to_string());
+        put("chunk_few", c.few.to_string());
+        put("chunk_twins", c.twins.to_string());
     }
     put("detail", value_name(&info.detail));
     put("scene", info.scene.name.clone());
@@ -288,7 +357,7 @@ fn parse_enum<T: ValueEnum>(m: &BTreeMap<String, String>, key: &str) -> Result<T
     T::from_str(v, false).map_err(|_| anyhow!("`{RUN}` metadata has a bad `{key}`: {v:?}"))
 }
 
-/// The run's parameters, exactly as recorded.
+/// The run's parameters, exactly as recorded; `m` in the current form ([`current_form`]).
 pub fn params(m: &BTreeMap<String, String>) -> Result<ResolvedParams> {
     let seed = match get(m, "seed")? {
         "none" => None,
@@ -312,79 +381,36 @@ pub fn params(m: &BTreeMap<String, String>) -> Result<ResolvedParams> {
     Ok(params)
 }
 
-/// The run's [`Mode`]; recordings made before modes existed lack the keys and were made in
-/// the default mode.
+/// The run's [`Mode`], its schedule with its [`Chunking`].
 fn mode(m: &BTreeMap<String, String>) -> Result<Mode> {
-    let d = Mode::default();
+    let schedule = match get(m, "schedule")? {
+        "exact" => Schedule::Exact,
+        "partitioned" => Schedule::Partitioned(Chunking {
+            delta: parse(m, "chunk_delta")?,
+            epsilon: parse(m, "chunk_epsilon")?,
+            top: parse(m, "chunk_top")?,
+            sah_below: parse(m, "chunk_sah")?,
+            few: parse(m, "chunk_few")?,
+            twins: parse(m, "chunk_twins")?,
+        }),
+        v => return Err(anyhow!("`{RUN}` metadata has a bad `schedule`: {v:?}")),
+    };
     Ok(Mode {
-        schedule: match m.contains_key("schedule") {
-            true => parse_enum(m, "schedule")?,
-            false => d.schedule,
-        },
-        pregroup: match m.contains_key("pregroup") {
-            true => parse_enum(m, "pregroup")?,
-            false => d.pregroup,
-        },
-        instancing: match m.contains_key("instancing") {
-            true => parse(m, "instancing")?,
-            false => d.instancing,
-        },
-        cost: match m.contains_key("cost") {
-            true => parse_enum(m, "cost")?,
-            false => d.cost,
-        },
-        chunk_top: match m.contains_key("chunk_top") {
-            true => parse(m, "chunk_top")?,
-            false => d.chunk_top,
-        },
-        // A partitioned recording without `chunk_delta` (it has `chunk_top`) was made when δ
-        // was 4; other schedules do not write the chunking.
-        chunk_delta: match (m.contains_key("chunk_delta"), m.contains_key("chunk_top")) {
-            (true, _) => parse(m, "chunk_delta")?,
-            (false, true) => Chunking::DEFAULT.delta,
-            (false, false) => d.chunk_delta,
-        },
-        // A recording without `chunk_epsilon` was made with the default ε.
-        chunk_epsilon: match m.contains_key("chunk_epsilon") {
-            true => parse(m, "chunk_epsilon")?,
-            false => d.chunk_epsilon,
-        },
-        // A partitioned recording without `chunk_sah` (it has `chunk_top`) was cut at Morton
-        // bits throughout; other schedules do not write the chunking.
-        chunk_sah: match (m.contains_key("chunk_sah"), m.contains_key("chunk_top")) {
-            (true, _) => parse(m, "chunk_sah")?,
-            (false, true) => 0,
-            (false, false) => d.chunk_sah,
-        },
-        // A partitioned recording without `chunk_max` made its chunks of fewer than δ
-        // primitives, as AAC does.
-        chunk_max: match (m.contains_key("chunk_max"), m.contains_key("chunk_top")) {
-            (true, _) => parse(m, "chunk_max")?,
-            (false, true) => Chunking::DEFAULT.delta - 1,
-            (false, false) => d.chunk_max,
-        },
-        // A recording without `chunk_few` cut every range by the SAH sweep.
-        chunk_few: match m.contains_key("chunk_few") {
-            true => parse(m, "chunk_few")?,
-            false => 0,
-        },
-        // A recording without `chunk_twins` merged no identical neighbours first.
-        chunk_twins: match m.contains_key("chunk_twins") {
-            true => parse(m, "chunk_twins")?,
-            false => false,
-        },
+        schedule,
+        pregroup: parse_enum::<Pregroup>(m, "pregroup")?,
+        instancing: parse(m, "instancing")?,
+        cost: parse_enum::<CostMeasure>(m, "cost")?,
     })
 }
 
-/// Why the recorded run stopped before the root: `None` for a complete recording,
-/// `Some("unknown")` when an incomplete one does not say (older recordings).
+/// Why the recorded run stopped before the root: `None` for a complete recording; `m` in the
+/// current form ([`current_form`]).
 pub fn stop_reason(m: &BTreeMap<String, String>) -> Option<&str> {
     match m.get("complete").map(String::as_str) {
-        Some("false") => Some(m.get("stop_reason").map_or("unknown", String::as_str)),
+        Some("false") => m.get("stop_reason").map(String::as_str),
         _ => None,
     }
 }
-
 /// The recording's detail level.
 pub fn detail(m: &BTreeMap<String, String>) -> Result<Detail> {
     parse_enum(m, "detail").context("reading the detail level")

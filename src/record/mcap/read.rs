@@ -294,6 +294,8 @@ fn fill_boxes(merges: &mut [Merge], boxes: &[Option<Aabb>], scene: &Scene) {
 /// [`Recorded`] run.
 fn interpret(mut raw: Raw) -> Result<(Recorded, Loaded)> {
     let (m, timing) = run_and_timing(raw.metadata)?;
+    // Older recordings' settings filled in, once; a newer format is an error here.
+    let m = metadata::current_form(m)?;
     let (scene_file_name, scene_bytes) = embedded_scene(raw.attachments, &m, raw.limit)?;
     let complete = metadata::parse::<bool>(&m, "complete")?;
     let primitives = metadata::parse::<u32>(&m, "primitives")?;

@@ -103,6 +103,10 @@ fn send_run_properties(rec: &RecordingStream, info: &RunInfo<'_>) -> anyhow::Res
                 "version",
                 text(env!("CARGO_PKG_VERSION").into()),
             )
+            .with_component::<rerun::components::Text>(
+                "format_version",
+                text(crate::record::FORMAT_VERSION.to_string()),
+            )
             .with_component::<rerun::components::Text>("scene", text(info.source.file_name.clone()))
             .with_component::<rerun::components::Text>("sha256", text(info.source.sha256.clone()))
             .with_component::<rerun::components::Text>("primitives", text(scene.len().to_string()))

@@ -11,10 +11,10 @@ use super::{Cover, CoverKind, CoverNode};
 use crate::geom::{P3, V3};
 use crate::grouping::SubsetTree;
 use crate::scene::Scene;
+use crate::scene::obj_writer::ObjWriter;
 use crate::wrap::hull::BOX_TRIANGLES;
 use crate::wrap::kind::Wrappers;
 use crate::wrap::obb::Obb;
-use std::fmt::Write as _;
 
 /// The shape of one cover wrapper, in scene coordinates.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -207,26 +207,27 @@ pub fn mesh(g: &Geometry) -> (Vec<P3>, Vec<[u32; 3]>) {
 
 /// Wavefront OBJ of the wrappers, one `o node<id>-<kind>` group each.
 pub fn to_obj(records: &[WrapperRecord], title: &str) -> String {
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "# wraptree cover of '{title}': {} wrappers",
-        records.len()
-    );
-    let mut base = 1usize;
+    let comment = format!("wraptree cover of '{title}': {} wrappers", records.len());
+    // Writing to a Vec cannot fail.
+    let mut w = ObjWriter::new(Vec::new(), &comment).expect("writing to memory");
     for r in records {
         let (v, t) = mesh(&r.geometry);
-        let _ = writeln!(s, "o node{}-{}", r.node.node, r.node.choice.kind.name());
+        let base = w.vertices();
+        w.object(&format!(
+            "node{}-{}",
+            r.node.node,
+            r.node.choice.kind.name()
+        ))
+        .expect("writing to memory");
         for q in &v {
-            let _ = writeln!(s, "v {} {} {}", q.x, q.y, q.z);
+            w.vertex(q).expect("writing to memory");
         }
         for f in &t {
-            let [a, b, c] = f.map(|i| i as usize + base);
-            let _ = writeln!(s, "f {a} {b} {c}");
+            w.face(f.map(|i| i as usize + base))
+                .expect("writing to memory");
         }
-        base += v.len();
     }
-    s
+    String::from_utf8(w.into_inner()).expect("OBJ text is UTF-8")
 }
 
 /// Unit icosphere, subdivision 2, circumscribed (every face at distance ≥ 1 from the centre).

@@ -79,9 +79,20 @@ fn main() -> anyhow::Result<()> {
         let mut part = Vec::new();
         let partitioned = |s: &Scene| {
             let params = Params::default().resolve(s);
-            pool.install(|| group_with(s, &params, &Chunking::DEFAULT, (), &Budget::default()))
-                .map_err(|s| anyhow::anyhow!("stopped: {:?}", s.reason))
-                .map(|g| g.tree)
+            pool.install(|| {
+                group_with(
+                    s,
+                    &params,
+                    &Chunking {
+                        delta: Chunking::LARGE_DELTA,
+                        ..Chunking::DEFAULT
+                    },
+                    (),
+                    &Budget::default(),
+                )
+            })
+            .map_err(|s| anyhow::anyhow!("stopped: {:?}", s.reason))
+            .map(|g| g.tree)
         };
         part.push(quality(&partitioned(&scene)?));
         for o in &orders {

@@ -69,7 +69,7 @@ fn spliced(scene: &Scene, share: f64) -> anyhow::Result<(SubsetTree, f64, f64)> 
         .filter(|&x| !merged[x as usize])
         .collect();
     let mut rest = params;
-    rest.mode.schedule = Schedule::Partitioned;
+    rest.mode.schedule = Schedule::PARTITIONED;
     let t = Instant::now();
     let top = group_boxes(left.iter().map(|&x| boxes[x as usize]).collect(), &rest, ()).tree;
     let t_rest = t.elapsed().as_secs_f64();
@@ -117,7 +117,18 @@ fn main() -> anyhow::Result<()> {
         let (se, qe) = quality(&exact);
         let params = Params::default().resolve(&scene);
         let part = pool
-            .install(|| group_with(&scene, &params, &Chunking::DEFAULT, (), &Budget::default()))
+            .install(|| {
+                group_with(
+                    &scene,
+                    &params,
+                    &Chunking {
+                        delta: Chunking::LARGE_DELTA,
+                        ..Chunking::DEFAULT
+                    },
+                    (),
+                    &Budget::default(),
+                )
+            })
             .map_err(|s| anyhow::anyhow!("stopped: {:?}", s.reason))?;
         let (sp, qp) = quality(&part.tree);
         print!(

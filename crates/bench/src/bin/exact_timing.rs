@@ -70,7 +70,7 @@ fn main() -> anyhow::Result<()> {
                         hash = h.finish();
                         stats = Some((g.stats, g.rounds));
                         let c0 = cpu();
-                        let p = build(Method::ObvhsPloc, &scene, &params)
+                        let p = build(Method::OBVHS_PLOC, &scene, &params)
                             .map_err(anyhow::Error::msg)?;
                         ploc = ploc.min(p.seconds);
                         ploc_cpu = ploc_cpu.min(cpu() - c0);

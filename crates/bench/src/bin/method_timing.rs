@@ -21,8 +21,8 @@
 //! and poses of the copy). `TOUCH=T` gives it `T` touching poses instead of 8: those of seed
 //! `S`, then of seeds `S + 1`, `S + 2`, … in turn.
 //!
-//! The fast path's settings can be varied through the environment: `TOP`, `SAH`, `EPS`, `MAX`
-//! (its split: root share, SAH-cut size, ε, largest chunk), `PASSES`, `BATCH` (its reinsertion
+//! The fast path's settings can be varied through the environment: `TOP`, `SAH`, `EPS`
+//! (its split: root share, SAH-cut size, ε), `PASSES`, `BATCH` (its reinsertion
 //! passes), `TREELETS` (treelet passes before them), `TK` (a treelet's leaves) and `GAMMA` (the
 //! fewest leaves under a treelet root).
 //!
@@ -31,7 +31,8 @@
 
 use std::path::Path;
 use std::time::Instant;
-use wraptree::grouping::{Params, group_boxes, sah};
+use wraptree::grouping::partitioned::Chunking;
+use wraptree::grouping::{Params, Schedule, group_boxes, sah};
 use wraptree::metrics::compare::query_values;
 use wraptree::metrics::timing::fastest_builds;
 use wraptree::peers::{Built, Method, build};
@@ -57,22 +58,24 @@ fn load(f: &str) -> anyhow::Result<Scene> {
 }
 
 /// The environment variables that vary the fast path's settings.
-const VARIED: [&str; 9] = [
-    "TOP", "SAH", "EPS", "MAX", "PASSES", "BATCH", "TREELETS", "TK", "GAMMA",
+const VARIED: [&str; 8] = [
+    "TOP", "SAH", "EPS", "PASSES", "BATCH", "TREELETS", "TK", "GAMMA",
 ];
 
 /// `method` built, the fast path with the settings the environment varies (without them, as
 /// `wraptree bench` builds it).
 fn build_varied(method: Method, scene: &Scene, params: &Params) -> Result<Built, String> {
-    if method != Method::Fast || !VARIED.iter().any(|v| std::env::var_os(v).is_some()) {
+    if method != Method::FAST || !VARIED.iter().any(|v| std::env::var_os(v).is_some()) {
         return build(method, scene, params);
     }
     let mut p = params.clone();
-    p.mode = p.mode.fast();
-    p.mode.chunk_top = env("TOP").unwrap_or(p.mode.chunk_top);
-    p.mode.chunk_sah = env("SAH").unwrap_or(p.mode.chunk_sah);
-    p.mode.chunk_epsilon = env("EPS").unwrap_or(p.mode.chunk_epsilon);
-    p.mode.chunk_max = env("MAX").unwrap_or(p.mode.chunk_max);
+    let fast = Chunking::FAST;
+    p.mode.schedule = Schedule::Partitioned(Chunking {
+        top: env("TOP").unwrap_or(fast.top),
+        sah_below: env("SAH").unwrap_or(fast.sah_below),
+        epsilon: env("EPS").unwrap_or(fast.epsilon),
+        ..fast
+    });
     let mut rp = refine::fast_for(scene.len());
     rp.passes = env("PASSES").unwrap_or(rp.passes);
     rp.batch = env("BATCH").unwrap_or(rp.batch);
@@ -128,7 +131,7 @@ impl Row {
 fn main() -> anyhow::Result<()> {
     let mut threads = 1usize;
     let mut repeat = 5u32;
-    let mut methods = vec![Method::Fast];
+    let mut methods = vec![Method::FAST];
     let mut files = Vec::new();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -175,12 +178,12 @@ fn main() -> anyhow::Result<()> {
     let quality = env::<u32>("QUALITY") != Some(0);
     let peers: &[Method] = if quality {
         &[
-            Method::ParryBinned,
-            Method::ObvhsPloc,
-            Method::ObvhsPlocReinsert,
+            Method::PARRY_BINNED,
+            Method::OBVHS_PLOC,
+            Method::OBVHS_PLOC_REINSERT,
         ]
     } else {
-        &[Method::ObvhsPloc]
+        &[Method::OBVHS_PLOC]
     };
     let ploc_slot = if quality { 1 } else { 0 };
     let mut mirrored_rows = Vec::new();

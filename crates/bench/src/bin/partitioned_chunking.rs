@@ -6,7 +6,7 @@
 //!
 //! `cargo run --release -p wraptree-bench --bin partitioned_chunking [MAX_SOUP] [DELTA:EPSILON[:TOP[:SAH]] ...]
 //! [FILE ...]` — default 100000 and the default chunking and 20:0.1 (AAC's high-quality
-//! setting); δ = 0 is the default's δ by the scene's size (`Chunking::delta_for`); scene files are grouped after the targets scenes (held-out scenes). `THREADS=T` runs
+//! setting); δ = 0 is the default's δ by the scene's size (`Chunking::for_size`); scene files are grouped after the targets scenes (held-out scenes). `THREADS=T` runs
 //! every build in a pool of T threads instead of one.
 
 use std::time::Instant;
@@ -73,10 +73,7 @@ fn main() -> anyhow::Result<()> {
         print!("{:<18} {:>8} {:>9.2}", scene.name, scene.len(), te * 1e3);
         let params = Params::default().resolve(scene);
         for (ch, sum) in chunkings.iter().zip(&mut sums) {
-            let ch = &Chunking {
-                delta: Chunking::delta_for(ch.delta, scene.len()),
-                ..*ch
-            };
+            let ch = &ch.for_size(scene.len());
             let t = Instant::now();
             let g = pool
                 .install(|| group_with(scene, &params, ch, (), &budget))

@@ -30,7 +30,18 @@ fn main() -> anyhow::Result<()> {
         let exact = pool.install(|| group(&scene, &Params::default(), ()));
         let params = Params::default().resolve(&scene);
         let part = pool
-            .install(|| group_with(&scene, &params, &Chunking::DEFAULT, (), &Budget::default()))
+            .install(|| {
+                group_with(
+                    &scene,
+                    &params,
+                    &Chunking {
+                        delta: Chunking::LARGE_DELTA,
+                        ..Chunking::DEFAULT
+                    },
+                    (),
+                    &Budget::default(),
+                )
+            })
             .map_err(|s| anyhow::anyhow!("stopped: {:?}", s.reason))?;
         let (e, p) = (by_size(&exact.tree), by_size(&part.tree));
         println!("{} ({} primitives)", scene.name, scene.len());

@@ -99,8 +99,8 @@ fn main() -> anyhow::Result<()> {
             (sah(tree), query_values(&q)[6])
         };
         let build = |m| peers::build(m, scene, &Params::default()).map_err(anyhow::Error::msg);
-        let (sb, qb) = quality(&build(Method::ParryBinned)?.tree);
-        let (so, qo) = quality(&build(Method::ObvhsPlocReinsert)?.tree);
+        let (sb, qb) = quality(&build(Method::PARRY_BINNED)?.tree);
+        let (so, qo) = quality(&build(Method::OBVHS_PLOC_REINSERT)?.tree);
         let (s_best, q_best) = (sb.min(so), qb.min(qo));
         let tree = group(scene, &Params::default(), ()).tree;
         // Rounds of one PLOC build and one run of every variant, so that a busy spell of the
@@ -109,7 +109,7 @@ fn main() -> anyhow::Result<()> {
         let mut times = vec![f64::INFINITY; variants.len()];
         let mut trees = vec![None; variants.len()];
         for _ in 0..repeat.max(1) {
-            ploc = ploc.min(build(Method::ObvhsPloc)?.seconds);
+            ploc = ploc.min(build(Method::OBVHS_PLOC)?.seconds);
             for ((p, tu), (t, out)) in variants.iter().zip(times.iter_mut().zip(&mut trees)) {
                 let start = Instant::now();
                 let r = refine_tuned(&tree, p, tu, ());

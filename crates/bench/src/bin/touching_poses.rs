@@ -20,10 +20,10 @@ fn main() -> anyhow::Result<()> {
     let seeds: u64 = seeds.parse()?;
     let scene = load_path(Path::new(file), &LoadOptions::default())?.scene;
     let methods = [
-        Method::Fast,
-        Method::ParryBinned,
-        Method::ObvhsPloc,
-        Method::ObvhsPlocReinsert,
+        Method::FAST,
+        Method::PARRY_BINNED,
+        Method::OBVHS_PLOC,
+        Method::OBVHS_PLOC_REINSERT,
     ];
     let trees = methods
         .iter()

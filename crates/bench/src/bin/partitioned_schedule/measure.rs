@@ -131,7 +131,7 @@ pub fn row(scene: &Scene, repeat: u32) -> Result<Row> {
         Ok([c1, c2])
     };
     let exact = if n <= EXACT_MAX_N {
-        let [a, b] = each(Method::Grouping, true)?;
+        let [a, b] = each(Method::GROUPING, true)?;
         [Some(a), Some(b)]
     } else {
         [None, None]
@@ -141,8 +141,8 @@ pub fn row(scene: &Scene, repeat: u32) -> Result<Row> {
         n,
         exact,
         // Quality only where the exact tree is there to compare with.
-        partitioned: each(Method::GroupingPartitioned, n <= EXACT_MAX_N)?,
-        ploc: each(Method::ObvhsPloc, false)?,
+        partitioned: each(Method::GROUPING_PARTITIONED, n <= EXACT_MAX_N)?,
+        ploc: each(Method::OBVHS_PLOC, false)?,
     })
 }
 
@@ -156,7 +156,7 @@ pub const RECORD_N: usize = 1_000_000;
 pub fn record_row(scene: &Scene, repeat: u32) -> Result<RecordCost> {
     let loaded = as_loaded(scene)?;
     let mut params = Params::default();
-    params.mode.schedule = Schedule::Partitioned;
+    params.mode.schedule = Schedule::PARTITIONED;
     let dir = tempfile::tempdir()?;
     let prefix = dir.path().join("partitioned");
     let pool = rayon::ThreadPoolBuilder::new()
