@@ -27,9 +27,7 @@ pub const C_P: f64 = 1.0;
 /// Tests (BV and primitive) per primitive of the scene after which a query of
 /// [`Workload::standard`] stops ([`Counts::capped`]) on larger scenes ([`Workload::cap`]). The
 /// cap is at least twice the most any query of the workload makes on the bundled and reference
-/// meshes above 2,000 primitives (1.4·10^7 = 110·n, a scene–copy distance with sphere BVs on
-/// the 124,705-polygon monastery; box contact queries on 69 real meshes at most 0.37 of the cap,
-/// 825·n on a 7,436-triangle CAD part of thin features, within the [`MIN_MAX_TESTS`] floor), so
+/// meshes above 2,000 primitives (docs/benchmarks.md), within the [`MIN_MAX_TESTS`] floor, so
 /// only exact ties reach it: `k` stacked coincident copies of a part make a scene–copy query
 /// test `k²` tied pairs (up to `n²`).
 pub const MAX_TESTS_PER_PRIM: u64 = 256;
