@@ -8,7 +8,7 @@
 //! `converted` does that and returns the scene loaded back from the text, so what a recording
 //! embeds is exactly what was grouped.
 
-use super::load::{LoadError, LoadOptions, Loaded};
+use super::input::{LoadError, LoadOptions, Loaded};
 use super::{PrimitiveKind, Scene, obj};
 
 /// The OBJ text of `scene`, whose object `k` is named `names[k]` (`object<k>` past the end).
