@@ -4,7 +4,9 @@
     python formats_reader.py urdf FILE [NAME=VALUE...]
 
 `mesh`: the triangles trimesh reads (process=False: nothing merged or dropped; polygons are
-triangulated), in the scene graph's placement, and the bounds of the vertices the triangles use.
+triangulated), in the scene graph's placement, and the bounds of the vertices the triangles use;
+for a small mesh (200 triangles or fewer) those vertices too; for COLLADA the file's unit
+(pycollada's `<unit meter>`, which trimesh records but does not apply).
 
 `urdf`: for each link with visuals, in file order: the triangles of its meshes (read by
 trimesh), the shapes it has, and, when it has only boxes and meshes, the bounds of their
@@ -34,6 +36,12 @@ def mesh(path):
     if tris:
         used = np.concatenate([m.vertices[m.faces.ravel()] for m in meshes if len(m.faces)])
         out["min"], out["max"] = bounds(used)
+        if tris <= 200:
+            out["points"] = used.tolist()
+    if path.lower().endswith(".dae"):
+        import collada
+
+        out["unit"] = collada.Collada(path).assetInfo.unitmeter or 1.0
     return out
 
 

@@ -1,8 +1,9 @@
-//! Fuzzing the STL, PLY, glTF/GLB and URDF readers with mutations of valid files, as
+//! Fuzzing the STL, PLY, glTF/GLB, COLLADA and URDF readers with mutations of valid files, as
 //! `tests/fuzz_obj.rs` does for OBJ.
 //!
 //! Seeds: real files of `tests/data/formats/` (binary and ASCII STL, binary and ASCII PLY, a
-//! GLB with a node hierarchy, a `.gltf` with data URIs) and a URDF of shapes and joints. Each
+//! GLB with a node hierarchy, a `.gltf` with data URIs, a COLLADA scene of nested nodes) and a
+//! URDF of shapes and joints. Each
 //! case applies a few mutations: byte flips, 32-bit little-endian words written anywhere (counts,
 //! lengths, offsets, indices), truncations, splices of another seed, replaced number tokens,
 //! deleted and duplicated lines. `wraptree::scene::load_bytes` must never panic: it accepts a
@@ -74,6 +75,7 @@ fn seeds() -> Vec<(&'static str, Vec<u8>)> {
         ("seed.glb", data("nested.glb")),
         ("seed.gltf", data("rgb_cube_with_primitives.gltf")),
         ("seed.urdf", URDF.as_bytes().to_vec()),
+        ("seed.dae", data("two_parts.dae")),
     ]
 }
 
@@ -138,7 +140,7 @@ fn mutation() -> impl Strategy<Value = Mutation> {
         2 => (frac(), prop_oneof![prop::sample::select(WORDS), any::<u32>()])
             .prop_map(|(p, w)| Mutation::Word(p, w)),
         1 => frac().prop_map(Mutation::Truncate),
-        1 => (frac(), frac(), 0usize..7, frac(), frac())
+        1 => (frac(), frac(), 0usize..9, frac(), frac())
             .prop_map(|(a, b, s, c, d)| Mutation::Splice(a, b, s, c, d)),
         3 => (any::<usize>(), prop::sample::select(TOKENS)).prop_map(|(k, t)| Mutation::Token(k, t)),
         1 => any::<usize>().prop_map(Mutation::DeleteLine),
@@ -200,7 +202,7 @@ fn check_scene(s: &Scene) -> Result<(), TestCaseError> {
 }
 
 #[test]
-fn mutated_stl_ply_off_gltf_and_urdf_files_load_or_fail_with_one_line() {
+fn mutated_stl_ply_off_gltf_dae_and_urdf_files_load_or_fail_with_one_line() {
     let seeds = seeds();
     for (name, bytes) in &seeds {
         load_bytes(name, bytes.clone(), &LoadOptions::default())

@@ -1,10 +1,11 @@
-//! Input formats besides OBJ (STL, PLY, glTF/GLB, URDF), the up axis, OBJ files of other
-//! parsers' test suites, and recordings of multi-file inputs.
+//! Input formats besides OBJ (STL, PLY, glTF/GLB, COLLADA, URDF), the up axis, OBJ files of
+//! other parsers' test suites, and recordings of multi-file inputs.
 //!
 //! The real files are in `tests/data/formats/` (from trimesh's and tobj's test models, MIT;
 //! see its README) and `scenes/r2d2/` (pybullet's R2-D2). Counts and placements are compared
-//! with independent readers: trimesh (meshes) and urdf_parser_py with numpy forward kinematics
-//! (URDF), run by `tests/formats_reader.py` in the tests' Python environment.
+//! with independent readers: trimesh (meshes; COLLADA through pycollada) and urdf_parser_py with
+//! numpy forward kinematics (URDF), run by `tests/formats_reader.py` in the tests' Python
+//! environment.
 
 mod common;
 
@@ -433,6 +434,18 @@ fn bad_input_in_every_format_is_one_error_line_and_exit_code_1() {
     .unwrap();
     let gltf = std::fs::read_to_string(formats("TestScene.gltf")).unwrap();
     std::fs::write(d.join("nobin.gltf"), &gltf).unwrap();
+    let dae = std::fs::read_to_string(formats("two_parts.dae")).unwrap();
+    std::fs::write(d.join("truncated.dae"), &dae[..dae.len() / 2]).unwrap();
+    std::fs::write(
+        d.join("badref.dae"),
+        dae.replace("\"#box-mesh\"", "\"#nope\""),
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("skew.dae"),
+        dae.replace("<scale>2 1 1</scale>", "<skew>45 0 1 0 1 0 0</skew>"),
+    )
+    .unwrap();
     let mesh = |name: &str, file: &str| {
         format!(
             "<link name=\"{name}\"><visual><geometry><mesh filename=\"{file}\"/></geometry>\
@@ -475,15 +488,16 @@ fn bad_input_in_every_format_is_one_error_line_and_exit_code_1() {
         ),
         (
             "dae.urdf",
-            robot(mesh("a", "x.dae")),
-            "link 'a': mesh \"x.dae\": COLLADA (.dae) files are not read",
+            robot(mesh("a", "truncated.dae")),
+            "link 'a': mesh \"truncated.dae\": not a valid COLLADA file (XML: ",
         ),
     ];
     for (name, text, _) in &cases {
         std::fs::write(d.join(name), text).unwrap();
     }
     std::fs::write(d.join("robot.xacro"), "<robot/>").unwrap();
-    let mut expect: Vec<(&str, String)> = vec![
+    let mut expect: Vec<(&str, String)> =
+        vec![
         (
             "truncated.stl",
             "not a valid STL file (truncated: the header says 1572 triangles, the file holds 1569"
@@ -491,6 +505,14 @@ fn bad_input_in_every_format_is_one_error_line_and_exit_code_1() {
         ),
         ("counts.ply", "not a valid PLY file (".into()),
         ("nobin.gltf", "buffer 0 (".into()),
+        ("truncated.dae", "not a valid COLLADA file (XML: ".into()),
+        (
+            "badref.dae",
+            "not a valid COLLADA file (<instance_geometry url=\"#nope\"> names no <geometry> of \
+             this file)"
+                .into(),
+        ),
+        ("skew.dae", "node 'arm': a <skew> transform is not read".into()),
         (
             "robot.xacro",
             "a xacro macro file: expand it to a URDF first".into(),
@@ -724,4 +746,126 @@ fn a_micrometre_link_far_from_the_origin_keeps_every_face_and_records() {
         l.warnings,
         ["needle.urdf: dropped 1 degenerate faces (fewer than 3 distinct vertices or zero area)"]
     );
+}
+
+/// Asserts that the points `ours` and `theirs` are the same set, each within `tol` of one of
+/// the other's.
+fn assert_same_points(what: &str, ours: &[[f64; 3]], theirs: &[[f64; 3]], tol: f64) {
+    let near = |p: &[f64; 3], set: &[[f64; 3]]| {
+        set.iter()
+            .any(|q| (0..3).all(|k| (p[k] - q[k]).abs() <= tol))
+    };
+    for p in theirs {
+        assert!(near(p, ours), "{what}: their point {p:?} is not ours");
+    }
+    for p in ours {
+        assert!(near(p, theirs), "{what}: our point {p:?} is not theirs");
+    }
+}
+
+/// A COLLADA file (two geometries, one used twice, one through `<instance_node>`, placed by
+/// nested translate/rotate/matrix/scale nodes, in centimetres) loads with the triangles and
+/// the points trimesh with pycollada reads, those times the file's unit: in metres.
+#[test]
+fn collada_loads_as_trimesh_with_pycollada_places_it_in_metres() {
+    let file = formats("two_parts.dae");
+    let theirs = reader(&["mesh", &file.display().to_string()]);
+    let t = &theirs[0];
+    let unit = t["unit"].as_f64().unwrap();
+    assert_eq!(unit, 0.01);
+    let n = t["triangles"].as_u64().unwrap() as usize;
+    assert_eq!((n, t["geometries"].as_u64()), (20, Some(3)));
+    let l = load_path(&file, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    assert_eq!((l.scene.len(), l.scene.tris.len()), (n, n));
+    let objects: std::collections::BTreeSet<u32> = l.scene.objects.iter().copied().collect();
+    assert_eq!(objects.len(), 3, "one object per placed geometry");
+    let ours: Vec<[f64; 3]> = l.scene.points.iter().map(|p| [p.x, p.y, p.z]).collect();
+    let theirs: Vec<[f64; 3]> = t["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| xyz(p).map(|c| c * unit))
+        .collect();
+    let size = l.scene.aabb().diameter();
+    assert_same_points("two_parts.dae", &ours, &theirs, 1e-6 * size);
+    let (min, max) = (xyz(&t["min"]), xyz(&t["max"]));
+    let scaled = |v: [f64; 3]| v.map(|c| c * unit);
+    assert_box(
+        "two_parts.dae",
+        &l.scene.aabb(),
+        scaled(min),
+        scaled(max),
+        1e-6,
+    );
+    // A single file: embedded byte for byte.
+    assert_eq!(l.source.file_name, "two_parts.dae");
+}
+
+/// A COLLADA file alone is turned by its `<up_axis>` (Y when it names none, the
+/// specification's default; `--up` overrides); as a URDF's mesh it is not, as in ROS.
+#[test]
+fn a_collada_up_axis_turns_the_file_alone_but_not_as_a_urdf_mesh() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let text = std::fs::read_to_string(formats("two_parts.dae")).unwrap();
+    let variants = [
+        ("z.dae", text.clone()),
+        ("y.dae", text.replace("Z_UP", "Y_UP")),
+        ("none.dae", text.replace("<up_axis>Z_UP</up_axis>", "")),
+    ];
+    for (name, t) in &variants {
+        std::fs::write(d.join(name), t).unwrap();
+    }
+    let load = |name: &str, opts: &LoadOptions| load_path(&d.join(name), opts).unwrap().scene;
+    let z = load("z.dae", &LoadOptions::default());
+    for (name, opts) in [
+        ("y.dae", LoadOptions::default()),
+        ("none.dae", LoadOptions::default()),
+    ] {
+        let turned = load(name, &opts);
+        assert_eq!(turned.len(), z.len());
+        for (p, q) in z.points.iter().zip(&turned.points) {
+            assert_eq!(
+                [q.x, q.y, q.z],
+                [p.x, -p.z + 0.0, p.y],
+                "{name}: (x, y, z) -> (x, -z, y)"
+            );
+        }
+    }
+    assert_eq!(
+        load("y.dae", &Z_UP).points,
+        z.points,
+        "--up z keeps a Y_UP file"
+    );
+    // In a URDF, visual and collision: the same points whatever the file's up axis.
+    let robot = |mesh: &str| {
+        format!(
+            "<robot name=\"r\"><link name=\"a\"><visual><geometry><mesh filename=\"{mesh}\"/>\
+             </geometry></visual><collision><origin xyz=\"0 0 1\"/><geometry>\
+             <mesh filename=\"{mesh}\" scale=\"2 2 2\"/></geometry></collision></link></robot>"
+        )
+    };
+    let mut seen = Vec::new();
+    for (name, _) in &variants {
+        let urdf = d.join(format!("{name}.urdf"));
+        std::fs::write(&urdf, robot(name)).unwrap();
+        let visual = load_path(&urdf, &LoadOptions::default()).unwrap().scene;
+        let collision = UrdfOptions {
+            collision: true,
+            ..UrdfOptions::default()
+        };
+        let coll = load_path_with(&urdf, &LoadOptions::default(), &collision)
+            .unwrap()
+            .scene;
+        assert_eq!((visual.len(), coll.len()), (z.len(), z.len()), "{name}");
+        assert_eq!(visual.points, z.points, "{name}: the file's own axes");
+        let (a, b) = (visual.aabb(), coll.aabb());
+        assert!(
+            (b.max.z - (2.0 * a.max.z + 1.0)).abs() < 1e-12,
+            "{name}: {a:?} {b:?}"
+        );
+        seen.push(coll.points);
+    }
+    assert!(seen.windows(2).all(|w| w[0] == w[1]));
 }

@@ -78,17 +78,17 @@ enum Command {
 /// How to read a scene file.
 #[derive(Args, Debug, Clone)]
 pub struct SceneArgs {
-    /// Scene file: Wavefront OBJ, STL, PLY, OFF, glTF/GLB or URDF (by its extension).
+    /// Scene file: Wavefront OBJ, STL, PLY, OFF, glTF/GLB, COLLADA or URDF (by its extension).
     pub scene: PathBuf,
-    /// Treat each object (OBJ o/g, STL solid, glTF node, URDF link) as one convex polyhedron
-    /// (default: each face is a polygon).
+    /// Treat each object (OBJ o/g, STL solid, glTF or COLLADA node, URDF link) as one convex
+    /// polyhedron (default: each face is a polygon).
     #[arg(long)]
     pub polyhedra: bool,
     /// With --polyhedra: an object whose vertices are not in convex position is an error.
     #[arg(long)]
     pub strict: bool,
-    /// The file's up axis, turned to +Z when loading: y or z [default: y for glTF, z for the
-    /// other formats].
+    /// The file's up axis, turned to +Z when loading: y or z [default: y for glTF, a COLLADA
+    /// file's <up_axis> (y if none), z for the other formats].
     #[arg(long, value_enum)]
     pub up: Option<Up>,
     /// URDF: read each link's collision geometry instead of its visual geometry.

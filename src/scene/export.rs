@@ -8,7 +8,7 @@
 //! `converted` does that and returns the scene loaded back from the text, so what a recording
 //! embeds is exactly what was grouped.
 
-use super::load::{LoadError, LoadOptions, Loaded};
+use super::input::{LoadError, LoadOptions, Loaded};
 use super::obj_writer::{ObjWriter, write_scene};
 use super::{PrimitiveKind, Scene, obj};
 use crate::geom::P3;

@@ -11,7 +11,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::Scene;
-use super::load::{LoadError, LoadErrorKind, LoadOptions, MAX_COORDINATE, Up};
+use super::input::{LoadError, LoadErrorKind, LoadOptions, MAX_COORDINATE, Up};
 use super::obj::polygon::{self, PolygonStats};
 use super::obj::polyhedron::{self, PolyhedronStats};
 use crate::geom::P3;

@@ -2,7 +2,7 @@
 //!
 //! The document is parsed and validated by `gltf`; the buffers are read here: a GLB's `BIN`
 //! chunk, `data:` URIs (base64), and files next to the `.gltf` (`Box0.bin`; such a file is then
-//! embedded in recordings as the OBJ of the scene, [`super::export`]). Every mesh primitive of
+//! embedded in recordings as the OBJ of the scene, `export.rs`). Every mesh primitive of
 //! the default scene (the first scene when none is named default, every root node when there
 //! is no scene) is read in the node's world transform (matrix or TRS, composed in `f64`):
 //! triangle lists, strips and fans become triangles; points and lines are skipped with one
@@ -23,7 +23,7 @@ use base64::Engine;
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 
 use super::faces::{Affine, Faces};
-use super::load::{LoadError, LoadErrorKind, one_line, read_file};
+use super::input::{LoadError, LoadErrorKind, one_line, read_file};
 
 /// What [`read`] found.
 #[derive(Debug)]

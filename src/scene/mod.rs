@@ -6,9 +6,11 @@
 //! the hull's faces for a polyhedron).
 //!
 //! - [`load`] loads a scene file by its extension: [`obj`] Wavefront OBJ (via `tobj`), [`stl`],
-//!   [`ply`], [`off`], [`gltf`] (glTF/GLB) and [`urdf`] (a robot's links placed by its joints), as
-//!   polygons or as polyhedra, with validation; `faces` holds the rules the non-OBJ formats
-//!   share and [`export`] the OBJ a multi-file input is embedded as in recordings;
+//!   [`ply`], [`off`], [`gltf`] (glTF/GLB), [`dae`] (COLLADA) and [`urdf`] (a robot's links
+//!   placed by its joints), as polygons or as polyhedra, with validation; `mesh` picks a mesh
+//!   file's reader, `faces` holds the rules the non-OBJ formats share, [`input`] the types they
+//!   all share (formats, options, errors), and [`export`] the OBJ a multi-file input is embedded
+//!   as in recordings;
 //! - [`generate`] makes the seeded synthetic scenes (robot base, lamp, replicas, soups);
 //! - [`pathological`] makes the seeded scenes that stress builders (spaghetti, slabs, …);
 //! - [`soup`] makes random triangle soups (used by both);
@@ -18,11 +20,15 @@
 pub mod assembly;
 pub mod coincident;
 pub mod components;
+pub mod dae;
 pub mod export;
 pub(crate) mod faces;
 pub mod generate;
 pub mod gltf;
+pub(crate) mod guard;
+pub mod input;
 pub mod load;
+pub(crate) mod mesh;
 pub mod obj;
 pub mod obj_writer;
 pub mod off;
@@ -34,10 +40,8 @@ pub mod split;
 pub mod stl;
 pub mod urdf;
 
-pub use load::{
-    Format, LoadError, LoadErrorKind, LoadOptions, Loaded, SceneSource, Up, load_bytes, load_path,
-    load_path_with,
-};
+pub use input::{Format, LoadError, LoadErrorKind, LoadOptions, Loaded, SceneSource, Up};
+pub use load::{load_bytes, load_path, load_path_with};
 pub use urdf::UrdfOptions;
 
 use crate::geom::{Aabb, P3};

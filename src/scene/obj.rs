@@ -18,11 +18,10 @@ use self::polygon::PolygonStats;
 use self::polyhedron::PolyhedronStats;
 use super::Scene;
 use super::faces::{Faces, turn_y_up};
-use super::load::{Format, Up};
-// The loading API lived here before other formats came; these paths keep working.
-pub use super::load::{
-    LoadError, LoadErrorKind, LoadOptions, Loaded, MAX_COORDINATE, SceneSource, load_bytes,
-    load_path,
+use super::input::{Format, Up};
+// The loading API's types lived here before other formats came; these paths keep working.
+pub use super::input::{
+    LoadError, LoadErrorKind, LoadOptions, Loaded, MAX_COORDINATE, SceneSource,
 };
 
 mod groups;
@@ -185,7 +184,7 @@ fn load_piped_from(
         ));
     }
     debug_assert!(scene.points.iter().all(|p| p.iter().all(|c| c.is_finite())));
-    let source = super::load::source(file_name, bytes, *opts);
+    let source = super::input::source(file_name, bytes, *opts);
     Ok(Loaded {
         scene,
         source,

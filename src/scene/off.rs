@@ -12,7 +12,7 @@
 //! number and a face index outside the vertices are errors naming the line.
 
 use super::faces::Faces;
-use super::load::{LoadError, LoadErrorKind};
+use super::input::{LoadError, LoadErrorKind};
 
 /// The faces of the OFF file `bytes` named `file_name`.
 pub(crate) fn read(file_name: &str, bytes: &[u8]) -> Result<Faces, LoadError> {

@@ -15,7 +15,7 @@ use ply_rs_bw::parser::{Parser, Reader};
 use ply_rs_bw::ply::{Encoding, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType};
 
 use super::faces::Faces;
-use super::load::{LoadError, LoadErrorKind, one_line};
+use super::input::{LoadError, LoadErrorKind, one_line};
 
 /// A vertex: its coordinates, and which of them the file set.
 #[derive(Default)]

@@ -1,5 +1,5 @@
-//! Random triangle soups: the synthetic scene both [`generate`](super::generate) and
-//! [`pathological`](super::pathological) build on.
+//! Random triangle soups: the synthetic scene both `generate.rs` and `pathological.rs` build
+//! on.
 
 use super::{PrimitiveKind, Scene};
 use crate::geom::{P3, V3};

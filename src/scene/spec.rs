@@ -4,7 +4,8 @@
 
 use super::Scene;
 use super::generate;
-use super::obj::{LoadOptions, Loaded, load_bytes, load_path};
+use super::input::{Format, LoadOptions, Loaded};
+use super::load::{load_bytes, load_path};
 use anyhow::{Result, anyhow};
 use std::path::Path;
 
@@ -20,7 +21,7 @@ use std::path::Path;
 /// ```
 pub fn scene_spec(spec: &str) -> Result<(Scene, Vec<String>)> {
     let path = Path::new(spec);
-    if path.exists() || super::load::Format::is_scene_file(spec) {
+    if path.exists() || Format::is_scene_file(spec) {
         let loaded = load_path(path, &LoadOptions::default())?;
         return Ok((loaded.scene, loaded.warnings));
     }

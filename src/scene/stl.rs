@@ -10,7 +10,7 @@
 use std::io::Cursor;
 
 use super::faces::Faces;
-use super::load::{LoadError, LoadErrorKind, one_line};
+use super::input::{LoadError, LoadErrorKind, one_line};
 
 /// Bytes of a binary STL's header: 80 free bytes and the triangle count.
 const HEADER: usize = 84;

@@ -9,8 +9,10 @@
 //! joint follows its joint (multiplier × value + offset) unless given a value itself.
 //!
 //! **Geometry.** Each `<visual>` (or `<collision>`) is placed by the link's pose and its own
-//! `<origin>`. A `<mesh>` (STL, OBJ, PLY, OFF, glTF/GLB; COLLADA `.dae` is refused with one error
-//! line) is scaled by its `scale` first; its path is resolved as [`resolve`] says. Shapes are
+//! `<origin>`. A `<mesh>` (STL, OBJ, PLY, OFF, glTF/GLB, COLLADA) is scaled by its `scale` first;
+//! its path is resolved as [`resolve`] says. A mesh is taken in its file's own coordinates, as
+//! ROS tools (RViz, MoveIt's `geometric_shapes`) take it: a COLLADA file's node transforms and
+//! `<unit meter>` apply, its `<up_axis>` does not, nor does glTF's Y-up. Shapes are
 //! meshed ([`shapes`]): a box as 6 rectangles, a cylinder as [`shapes::SIDES`] rectangles and
 //! two [`shapes::SIDES`]-gons, a sphere as [`shapes::SLICES`] × [`shapes::STACKS`] polygons
 //! (triangles at the poles, quadrilaterals between), a capsule as a cylinder's side between two
@@ -30,7 +32,8 @@ use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 use urdf_rs::{Geometry, JointType, Pose, Robot};
 
 use super::faces::{Affine, Faces};
-use super::load::{Format, LoadError, LoadErrorKind, mesh_faces, one_line, read_file};
+use super::input::{Format, LoadError, LoadErrorKind, one_line, read_file};
+use super::mesh;
 
 /// How a URDF is posed and where its meshes are found.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -153,18 +156,19 @@ fn read_robot(
                             .file_name()
                             .map(|n| n.to_string_lossy().into_owned())
                             .unwrap_or_default();
-                        // A refused format (COLLADA) is named before the file is looked for.
-                        Format::of(&name).map_err(|p| (LoadErrorKind::Unsupported, ctx(p)))?;
+                        // A refused format (xacro) is named before the file is looked for.
+                        let format =
+                            Format::of(&name).map_err(|p| (LoadErrorKind::Unsupported, ctx(p)))?;
                         let bytes = read_file(&path).map_err(|e| {
                             (
                                 LoadErrorKind::Read,
                                 ctx(format!("{e} ({})", path.display())),
                             )
                         })?;
-                        let (mesh, w) = mesh_faces(&name, bytes, path.parent())
+                        let mesh = mesh::read(&name, format, &bytes, path.parent())
                             .map_err(|e| (e.kind, ctx(e.problem)))?;
-                        warnings.extend(w);
-                        meshes.insert(path.clone(), mesh);
+                        warnings.extend(mesh.warnings);
+                        meshes.insert(path.clone(), mesh.faces);
                     }
                     let s = scale.map_or([1.0; 3], |s| s.0);
                     let scaled = Affine {

@@ -106,7 +106,7 @@ pub(super) fn collect_groups(
 
 #[cfg(test)]
 mod tests {
-    use super::super::{LoadOptions, load_bytes};
+    use super::super::{LoadOptions, load};
     use crate::geom::P3;
 
     #[test]
@@ -114,7 +114,7 @@ mod tests {
         // Vertex 4 repeats 2 (with −0), 5 repeats 3, 6 is unused; the first face uses 4, 5, 7.
         let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 -0\nv 0 1 0\nv 5 5 5\nv 0 0 1\n\
                    o a\nf 4 5 7\no b\nf 1 2 3\n";
-        let l = load_bytes("dup.obj", obj.as_bytes().to_vec(), &LoadOptions::default()).unwrap();
+        let l = load("dup.obj", obj.as_bytes().to_vec(), &LoadOptions::default()).unwrap();
         let want = [
             [1.0, 0.0, 0.0],
             [0.0, 1.0, 0.0],

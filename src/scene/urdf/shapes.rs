@@ -134,7 +134,7 @@ fn revolved(name: &str, top: f64, bottom: f64, rings: &[(f64, f64)]) -> Faces {
 mod tests {
     use super::*;
     use crate::scene::faces::build;
-    use crate::scene::load::{LoadOptions, Up};
+    use crate::scene::input::{LoadOptions, Up};
 
     fn count(f: Faces) -> usize {
         let b = build("s.urdf", f, &LoadOptions::default(), Up::Z).unwrap();
