@@ -10,6 +10,7 @@
 
 use super::load::{LoadError, LoadOptions, Loaded};
 use super::{PrimitiveKind, Scene, obj};
+use crate::stop::Stop;
 
 /// The OBJ text of `scene`, whose object `k` is named `names[k]` (`object<k>` past the end).
 /// `what` is written in the first comment line.
@@ -62,11 +63,12 @@ pub(super) fn converted(
     names: &[String],
     opts: &LoadOptions,
     warnings: Vec<String>,
+    stop: &Stop,
 ) -> Result<Loaded, LoadError> {
     let text = obj_text(scene, names, &format!("{file_name} as loaded"));
     let obj_name = format!("{}.obj", scene.name);
     let opts = LoadOptions { up: None, ..*opts };
-    let mut loaded = obj::load(&obj_name, text, &opts).map_err(|e| LoadError {
+    let mut loaded = obj::load(&obj_name, text, &opts, stop).map_err(|e| LoadError {
         file: file_name.to_string(),
         problem: format!(
             "the scene does not load back from its OBJ form ({})",

@@ -29,6 +29,7 @@ use sha2::{Digest, Sha256};
 use super::faces::Faces;
 use super::urdf::UrdfOptions;
 use super::{Scene, export, gltf, obj, off, ply, stl, urdf};
+use crate::stop::{Interrupted, Stop};
 
 /// Which axis of a file points up. The loader turns the scene so that it is +Z, the up axis
 /// of the recordings and snapshots.
@@ -124,6 +125,8 @@ pub enum LoadErrorKind {
     NotConvex,
     /// A format or feature wraptree does not read (COLLADA, xacro, compressed glTF meshes).
     Unsupported,
+    /// A [`Stop`] was requested while loading; the error's source is [`Interrupted`].
+    Interrupted,
 }
 
 /// A loading failure; its `Display` is one line `FILE: PROBLEM`.
@@ -143,7 +146,22 @@ impl fmt::Display for LoadError {
     }
 }
 
-impl std::error::Error for LoadError {}
+impl std::error::Error for LoadError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        (self.kind == LoadErrorKind::Interrupted).then_some(&Interrupted as _)
+    }
+}
+
+impl LoadError {
+    /// The error of a load of `file` that obeyed a [`Stop`].
+    pub(crate) fn interrupted(file: &str) -> LoadError {
+        LoadError {
+            file: file.to_string(),
+            kind: LoadErrorKind::Interrupted,
+            problem: Interrupted.to_string(),
+        }
+    }
+}
 
 /// Largest accepted coordinate magnitude: squared distances must stay finite in `f64`.
 pub const MAX_COORDINATE: f64 = 1e100;
@@ -231,6 +249,17 @@ pub fn load_path_with(
     opts: &LoadOptions,
     urdf: &UrdfOptions,
 ) -> Result<Loaded, LoadError> {
+    load_path_until(path, opts, urdf, &Stop::new())
+}
+
+/// [`load_path_with`], its long loops checking `stop` (Err: kind
+/// [`LoadErrorKind::Interrupted`]).
+pub fn load_path_until(
+    path: &Path,
+    opts: &LoadOptions,
+    urdf: &UrdfOptions,
+    stop: &Stop,
+) -> Result<Loaded, LoadError> {
     let shown = path.display().to_string();
     let bytes = read_file(path).map_err(|problem| LoadError {
         file: shown.clone(),
@@ -248,7 +277,8 @@ pub fn load_path_with(
             d.to_path_buf()
         }
     });
-    load_in(&name, bytes, opts, dir.as_deref(), urdf).map_err(|e| LoadError { file: shown, ..e })
+    load_in(&name, bytes, opts, dir.as_deref(), urdf, stop)
+        .map_err(|e| LoadError { file: shown, ..e })
 }
 
 /// Loads the bytes of a file named `file_name` (the format is its extension's; the scene is
@@ -261,7 +291,17 @@ pub fn load_bytes(
     bytes: Vec<u8>,
     opts: &LoadOptions,
 ) -> Result<Loaded, LoadError> {
-    load_in(file_name, bytes, opts, None, &UrdfOptions::default())
+    load_bytes_until(file_name, bytes, opts, &Stop::new())
+}
+
+/// [`load_bytes`], its long loops checking `stop` (Err: kind [`LoadErrorKind::Interrupted`]).
+pub fn load_bytes_until(
+    file_name: &str,
+    bytes: Vec<u8>,
+    opts: &LoadOptions,
+    stop: &Stop,
+) -> Result<Loaded, LoadError> {
+    load_in(file_name, bytes, opts, None, &UrdfOptions::default(), stop)
 }
 
 /// Reads `path`, the error as one line without the OS error number.
@@ -281,11 +321,15 @@ fn load_in(
     opts: &LoadOptions,
     dir: Option<&Path>,
     urdf_opts: &UrdfOptions,
+    stop: &Stop,
 ) -> Result<Loaded, LoadError> {
-    let mut loaded = load_format(file_name, bytes, opts, dir, urdf_opts)?;
+    let mut loaded = load_format(file_name, bytes, opts, dir, urdf_opts, stop)?;
+    let interrupted = |_| LoadError::interrupted(file_name);
+    stop.check().map_err(interrupted)?;
     loaded
         .warnings
         .extend(super::coincident::warning(file_name, &loaded.scene));
+    stop.check().map_err(interrupted)?;
     Ok(loaded)
 }
 
@@ -296,6 +340,7 @@ fn load_format(
     opts: &LoadOptions,
     dir: Option<&Path>,
     urdf_opts: &UrdfOptions,
+    stop: &Stop,
 ) -> Result<Loaded, LoadError> {
     let err = |kind, problem: String| LoadError {
         file: file_name.to_string(),
@@ -304,10 +349,10 @@ fn load_format(
     };
     let format = Format::of(file_name).map_err(|p| err(LoadErrorKind::Unsupported, p))?;
     if format == Format::Obj {
-        return obj::load(file_name, bytes, opts);
+        return obj::load(file_name, bytes, opts, stop);
     }
     // Names from the file (links, solids, nodes) may hold line breaks: one line, whatever.
-    load_other(file_name, format, bytes, opts, dir, urdf_opts).map_err(|e| LoadError {
+    load_other(file_name, format, bytes, opts, dir, urdf_opts, stop).map_err(|e| LoadError {
         problem: one_line(&e.problem, 1000),
         ..e
     })
@@ -321,10 +366,11 @@ fn load_other(
     opts: &LoadOptions,
     dir: Option<&Path>,
     urdf_opts: &UrdfOptions,
+    stop: &Stop,
 ) -> Result<Loaded, LoadError> {
     let up = opts.up.unwrap_or(format.default_up());
     let (faces, converted, mut warnings) = match format {
-        Format::Obj => return obj::load(file_name, bytes, opts),
+        Format::Obj => return obj::load(file_name, bytes, opts, stop),
         Format::Stl => (stl::read(file_name, &bytes)?, false, Vec::new()),
         Format::Ply => (ply::read(file_name, &bytes)?, false, Vec::new()),
         Format::Off => (off::read(file_name, &bytes)?, false, Vec::new()),
@@ -337,10 +383,12 @@ fn load_other(
             (faces, true, warnings)
         }
     };
-    let built = super::faces::build(file_name, faces, opts, up)?;
+    stop.check()
+        .map_err(|_| LoadError::interrupted(file_name))?;
+    let built = super::faces::build(file_name, faces, opts, up, stop)?;
     warnings.extend(built.warnings);
     if converted {
-        return export::converted(file_name, &built.scene, &built.names, opts, warnings);
+        return export::converted(file_name, &built.scene, &built.names, opts, warnings, stop);
     }
     Ok(Loaded {
         scene: built.scene,

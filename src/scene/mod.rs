@@ -34,8 +34,8 @@ pub mod stl;
 pub mod urdf;
 
 pub use load::{
-    Format, LoadError, LoadErrorKind, LoadOptions, Loaded, SceneSource, Up, load_bytes, load_path,
-    load_path_with,
+    Format, LoadError, LoadErrorKind, LoadOptions, Loaded, SceneSource, Up, load_bytes,
+    load_bytes_until, load_path, load_path_until, load_path_with,
 };
 pub use urdf::UrdfOptions;
 
