@@ -271,7 +271,7 @@ pub fn evaluate(
     let measure_tightness = scene.len() <= opts.tightness_max_n;
     let built = fastest_builds(&opts.methods, opts.repeat, stop, |m| {
         progress(Step::Build(m));
-        peers::build(m, scene, &opts.params)
+        peers::build_until(m, scene, &opts.params, stop)
     })?;
     let mut rows = Vec::new();
     for (&method, built) in opts.methods.iter().zip(&built) {

@@ -118,12 +118,8 @@ fn parse(
     if up == Some(Up::Y) {
         turn_y_up(&mut scanned.coords);
     }
-    stop.check()
-        .map_err(|_| LoadError::interrupted(file_name))?;
-    let groups = collect_groups(&models, &scanned.coords, points)
-        .map_err(|p| err(LoadErrorKind::Malformed, p))?;
-    stop.check()
-        .map_err(|_| LoadError::interrupted(file_name))?;
+    let groups =
+        collect_groups(&models, &scanned.coords, points, stop).map_err(|(kind, p)| err(kind, p))?;
     Ok((groups, scanned))
 }
 

@@ -85,7 +85,7 @@ pub fn obb_tree(tree: &SubsetTree, scene: &Scene, hulls: Option<&[Hull]>) -> Vec
     }
 }
 
-/// [`obb_tree`], checking `stop` every [`STRIDE`](crate::stop::STRIDE) nodes.
+/// [`obb_tree`], checking `stop` at every node.
 pub fn obb_tree_until(
     tree: &SubsetTree,
     scene: &Scene,
@@ -95,7 +95,8 @@ pub fn obb_tree_until(
     let order = LeafOrder::new(tree, scene);
     (0..tree.len() as u32)
         .map(|x| {
-            stop.check_every(x as usize)?;
+            // Every node: a node near the root alone visits most of the scene.
+            stop.check()?;
             let pts = order.node_points(x);
             let basis = match hulls {
                 Some(h) => h[x as usize].vertices.as_slice(),

@@ -45,7 +45,8 @@ pub fn sphere_tree(tree: &SubsetTree, scene: &Scene, method: SphereMethod) -> Ve
     }
 }
 
-/// [`sphere_tree`], checking `stop` every [`STRIDE`](crate::stop::STRIDE) nodes or leaves.
+/// [`sphere_tree`], checking `stop` at every node of the per-node methods, else every
+/// [`STRIDE`](crate::stop::STRIDE) leaves.
 pub fn sphere_tree_until(
     tree: &SubsetTree,
     scene: &Scene,
@@ -56,7 +57,8 @@ pub fn sphere_tree_until(
         let order = LeafOrder::new(tree, scene);
         (0..tree.len() as u32)
             .map(|x| {
-                stop.check_every(x as usize)?;
+                // Every node: a node near the root alone visits most of the scene.
+                stop.check()?;
                 Ok(f(order.node_points(x)))
             })
             .collect()
