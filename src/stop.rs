@@ -13,6 +13,9 @@ use std::sync::Arc;
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+/// Items a loop handles between two looks at its [`Stop`] ([`Stop::check_every`]).
+pub const STRIDE: usize = 1024;
+
 /// A shared stop request; clones see the same request.
 #[derive(Clone, Debug, Default)]
 pub struct Stop(Arc<AtomicBool>);
@@ -69,6 +72,17 @@ impl Stop {
         }
     }
 
+    /// [`Stop::check`] when `i` is a multiple of [`STRIDE`], else `Ok`: `stop.check_every(i)?`
+    /// at the top of a loop over items `i` keeps the look cheap however small each item is.
+    #[inline]
+    pub fn check_every(&self, i: usize) -> Result<(), Interrupted> {
+        if i % STRIDE == 0 {
+            self.check()
+        } else {
+            Ok(())
+        }
+    }
+
     /// The flag itself, for APIs that take one (the grouping's budget).
     pub fn flag(&self) -> &AtomicBool {
         &self.0
@@ -77,6 +91,13 @@ impl Stop {
     /// The shared flag, for APIs that keep one.
     pub fn shared(&self) -> Arc<AtomicBool> {
         Arc::clone(&self.0)
+    }
+}
+
+impl From<Arc<AtomicBool>> for Stop {
+    /// The token of a shared flag (an API that keeps the flag itself, e.g. a recording's).
+    fn from(flag: Arc<AtomicBool>) -> Stop {
+        Stop(flag)
     }
 }
 

@@ -63,7 +63,7 @@ fn record_scene_writes_both_recordings_of_the_lamp_and_they_replay() {
     let replay = replay::open(&mcap).unwrap();
     assert!(replay.rec.complete);
     assert_eq!(replay.loaded.scene.len(), 626);
-    match replay::verify(&replay, &Limits::default()).unwrap() {
+    match replay::verify(&replay, &Limits::default(), &wraptree::stop::Stop::new()).unwrap() {
         Verified::Identical { merges, .. } => assert_eq!(merges, 625),
         v => panic!("the recording does not replay: {v:?}"),
     }

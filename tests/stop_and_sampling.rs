@@ -1,5 +1,6 @@
 //! A requested [`Stop`] ends `bench`, `stress`, `snapshot`, `cover`, `wrap` and `compare`
-//! early without their output, a `sweep` setting
+//! early without their output, and every Wrapper Tree builder, measure and loader at once; a
+//! `sweep` setting
 //! over its grouping limits is left out, and the sampled tightness of `bench` and `wrap` is
 //! deterministic for any thread count and near the value over every node.
 
@@ -10,10 +11,11 @@ use wraptree::metrics::stress::{self, StressOptions};
 use wraptree::metrics::sweep::{SweepRuns, grid, sweep};
 use wraptree::peers::Method;
 use wraptree::scene::{Scene, generate};
-use wraptree::stop::{Stop, is_interrupted};
+use wraptree::stop::{Interrupted, Stop, is_interrupted};
 use wraptree::wrap::{
-    LevelStats, SphereMethod, WrapperKind, Wrappers, hull_tree, level_tightness,
-    level_tightness_sampled,
+    LevelStats, SphereMethod, WrapperKind, WrapperTree, Wrappers, containment_excess_until,
+    hull_tree, hull_tree_until, level_tightness, level_tightness_sampled, obb_tree_until,
+    sphere_tree_until,
 };
 
 fn options(tightness_nodes: usize) -> Options {
@@ -132,13 +134,17 @@ fn wrap_levels_sampled_match_every_node() {
         let levels = |per_depth: usize| {
             w.trees()
                 .into_iter()
-                .map(|t| level_tightness_sampled(&tree, &scene, t, &hulls, 16, (per_depth, 1)))
+                .map(|t| {
+                    let how = (per_depth, 1);
+                    level_tightness_sampled(&tree, &scene, t, &hulls, 16, how, &Stop::new())
+                        .unwrap()
+                })
                 .collect::<Vec<_>>()
         };
         let every: Vec<_> = w
             .trees()
             .into_iter()
-            .map(|t| level_tightness(&tree, &scene, t, &hulls, 16))
+            .map(|t| level_tightness(&tree, &scene, t, &hulls, 16, &Stop::new()).unwrap())
             .collect();
         assert_eq!(levels(0), every);
         let sampled = on(1, &|| levels(per_depth));
@@ -291,4 +297,58 @@ fn a_comparison_stopped_before_both_files_are_complete_writes_neither() {
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     let written = write_comparison(&prefix, &scene, "s", &runs, false, &go).unwrap();
     assert!(written.iter().all(|p| p.is_file()));
+}
+
+#[test]
+fn a_requested_stop_ends_every_wrapper_builder_measure_and_loader_at_once() {
+    let scene = scene();
+    let tree = group(&scene, &Params::default(), ()).tree;
+    let hulls = hull_tree(&tree, &scene);
+    let stop = Stop::new();
+    stop.request();
+    for m in [
+        SphereMethod::Merged,
+        SphereMethod::AabbCenter,
+        SphereMethod::Ritter,
+        SphereMethod::Minimum,
+    ] {
+        assert_eq!(
+            sphere_tree_until(&tree, &scene, m, &stop).err(),
+            Some(Interrupted)
+        );
+    }
+    assert_eq!(
+        hull_tree_until(&tree, &scene, &stop).err(),
+        Some(Interrupted)
+    );
+    assert_eq!(
+        obb_tree_until(&tree, &scene, None, &stop).err(),
+        Some(Interrupted)
+    );
+    let built = Wrappers::build_until(
+        &tree,
+        &scene,
+        &WrapperKind::ALL,
+        SphereMethod::Merged,
+        &stop,
+    );
+    assert_eq!(built.err(), Some(Interrupted));
+    let boxes = WrapperTree::Boxes(&tree.aabb);
+    assert_eq!(
+        containment_excess_until(&tree, &scene, boxes, &stop),
+        Err(Interrupted)
+    );
+    let levels = level_tightness_sampled(&tree, &scene, boxes, &hulls, 16, (64, 1), &stop);
+    assert_eq!(levels, Err(Interrupted));
+    // The same calls with a token nobody requested finish.
+    let go = Stop::new();
+    assert!(containment_excess_until(&tree, &scene, boxes, &go).is_ok());
+    // Loading: the error names the file, and its source is the stop.
+    let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_vec();
+    let opts = wraptree::scene::LoadOptions::default();
+    let e = wraptree::scene::load_bytes_until("t.obj", obj.clone(), &opts, &stop).unwrap_err();
+    assert_eq!(e.kind, wraptree::scene::LoadErrorKind::Interrupted);
+    assert!(is_interrupted(&anyhow::Error::new(e.clone())), "{e}");
+    assert_eq!(e.to_string(), "t.obj: interrupted");
+    assert!(wraptree::scene::load_bytes_until("t.obj", obj, &opts, &go).is_ok());
 }

@@ -35,7 +35,7 @@ impl CompareCmd {
             .map(|f| {
                 stop.check()?;
                 status.set_message(format!("reading {}", f.display()));
-                replay::open(f)
+                replay::open_until(f, &stop)
             })
             .collect::<Result<Vec<Replay>>>()?;
         let mut labels: Vec<String> = replays

@@ -123,7 +123,8 @@ impl SceneArgs {
             joints: self.joint.clone(),
             package_path,
         };
-        let mut loaded = wraptree::scene::load_path_with(&self.scene, &opts, &urdf)?;
+        let stop = wraptree::stop::Stop::on_signals();
+        let mut loaded = wraptree::scene::load_path_until(&self.scene, &opts, &urdf, &stop)?;
         if let Some(r) = self.split_aspect {
             let (split, line) = wraptree::scene::split::split_flag(loaded, r)?;
             eprintln!("{line}");
@@ -376,9 +377,9 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         build_pool(threads)?;
     }
     match cli.command {
-        Command::Group(c) => c.run(),
-        Command::Record(c) => c.run(),
-        Command::Replay(c) => c.run(),
+        Command::Group(c) => progress::or_stopped("group", c.run()),
+        Command::Record(c) => progress::or_stopped("record", c.run()),
+        Command::Replay(c) => progress::or_stopped("replay", c.run()),
         Command::Compare(c) => progress::or_stopped("compare", c.run()),
         Command::Scene(c) => c.run(),
         Command::Bench(c) => progress::or_stopped("bench", c.run()),

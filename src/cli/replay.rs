@@ -11,6 +11,7 @@ use std::process::ExitCode;
 use wraptree::output::output_prefix;
 use wraptree::record::{Detail, RecordOptions};
 use wraptree::replay::{self, Replay, report};
+use wraptree::stop::Stop;
 
 /// Arguments of `wraptree replay`.
 #[derive(Args, Debug)]
@@ -60,8 +61,9 @@ impl ReplayCmd {
                  --b or --c"
             );
         }
+        let stop = Stop::on_signals();
         let status = Status::new("replay", "reading the recording");
-        let replay = replay::open(&self.file)?;
+        let replay = replay::open_until(&self.file, &stop)?;
         drop(status);
         let (rec, loaded) = (&replay.rec, &replay.loaded);
         let name = self.file.display().to_string();
@@ -69,7 +71,7 @@ impl ReplayCmd {
         print!("{}", report::state(&replay, &name)?);
         if self.verify {
             let status = Status::new("replay --verify", "re-running the grouping");
-            let v = report::verification(&replay, &limits)?;
+            let v = report::verification(&replay, &limits, &stop)?;
             drop(status);
             let v = match v {
                 Ok(v) => v,

@@ -71,7 +71,7 @@ fn load(cmd: &SnapshotCmd) -> Result<(Scene, ResolvedParams, Option<Vec<Merge>>)
             path.display()
         );
     }
-    from_recording(path)
+    from_recording(path, &wraptree::stop::Stop::on_signals())
 }
 
 impl SnapshotCmd {

@@ -128,22 +128,36 @@ pub fn group_boxes<O: Observer>(
     params: &ResolvedParams,
     observer: O,
 ) -> Grouping {
+    group_boxes_within(boxes, params, observer, &Budget::default())
+        .expect("an unlimited budget never stops")
+}
+
+/// Like [`group_boxes`] within `budget` (see [`group_within`]).
+pub fn group_boxes_within<O: Observer>(
+    boxes: Vec<Aabb>,
+    params: &ResolvedParams,
+    observer: O,
+    budget: &Budget<'_>,
+) -> Result<Grouping, Stopped> {
     if observer.is_silent() {
         // Nothing to tell: the whole run goes to the pool in one piece (`crate::par`).
         let worth = boxes.len() >= POOL_MIN;
-        return on_pool(worth, move || run_boxes(boxes, params, ()));
+        return on_pool(worth, move || run_boxes(boxes, params, (), budget));
     }
-    run_boxes(boxes, params, observer)
+    run_boxes(boxes, params, observer, budget)
 }
 
-/// [`group_boxes`] on the caller's thread.
-fn run_boxes<O: Observer>(boxes: Vec<Aabb>, params: &ResolvedParams, observer: O) -> Grouping {
-    let budget = Budget::default();
+/// [`group_boxes_within`] on the caller's thread.
+fn run_boxes<O: Observer>(
+    boxes: Vec<Aabb>,
+    params: &ResolvedParams,
+    observer: O,
+    budget: &Budget<'_>,
+) -> Result<Grouping, Stopped> {
     match params.mode.schedule {
-        Schedule::Exact => cluster::run_boxes(boxes, params, observer, &budget),
-        Schedule::Partitioned(c) => partitioned::group_boxes(boxes, params, &c, observer, &budget),
+        Schedule::Exact => cluster::run_boxes(boxes, params, observer, budget),
+        Schedule::Partitioned(c) => partitioned::group_boxes(boxes, params, &c, observer, budget),
     }
-    .expect("an unlimited budget never stops")
 }
 
 /// Runs the grouping phase in the schedule and mode that `params` names: with an observer that

@@ -17,10 +17,10 @@ use crate::grouping::{Params, SubsetTree};
 use crate::peers::{self, Method};
 use crate::query::{self, Bv, QueryCost, Workload};
 use crate::scene::Scene;
-use crate::stop::Stop;
+use crate::stop::{Interrupted, Stop};
 use crate::wrap::{
-    DepthSample, Hull, MAX_VISITS, NODES_PER_DEPTH, Sphere, SphereMethod, WrapperTree, hull_tree,
-    nodes_tightness, obb_tree, sphere_tree,
+    DepthSample, Hull, MAX_VISITS, NODES_PER_DEPTH, Sphere, SphereMethod, WrapperTree,
+    hull_tree_until, nodes_tightness, obb_tree_until, sphere_tree_until,
 };
 use anyhow::Result;
 use std::time::Instant;
@@ -200,21 +200,22 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
 
 /// Mean over interior nodes of each node's sampled error over its box diagonal, and the
 /// same per level (the cut at each depth, its interior nodes only; 0 for a cut of leaves),
-/// from at most `per_depth` nodes per depth (0: every node, exact queries).
+/// from at most `per_depth` nodes per depth (0: every node, exact queries). Err: `stop`.
 fn tightness(
     tree: &SubsetTree,
     scene: &Scene,
     w: WrapperTree<'_>,
     hulls: &[Hull],
     (k, per_depth, seed): (usize, usize, u64),
-) -> (f64, Vec<f64>) {
+    stop: &Stop,
+) -> Result<(f64, Vec<f64>), Interrupted> {
     let (per_depth, max_visits) = match per_depth {
         0 => (usize::MAX, usize::MAX),
         m => (m, MAX_VISITS),
     };
     let sample = DepthSample::new(tree, per_depth, seed);
     let nodes = sample.flat();
-    let stats = nodes_tightness(tree, scene, w, hulls, k, &nodes, max_visits);
+    let stats = nodes_tightness(tree, scene, w, hulls, k, &nodes, max_visits, stop)?;
     let rel: Vec<Option<f64>> = nodes
         .iter()
         .zip(&stats)
@@ -228,7 +229,7 @@ fn tightness(
     let levels = tree.depth_max() as usize + 1;
     let mut per_level = per_level;
     per_level.resize(levels, 0.0);
-    (all, per_level)
+    Ok((all, per_level))
 }
 
 /// What `bench` is measuring, for progress reports.
@@ -270,7 +271,7 @@ pub fn evaluate(
     let measure_tightness = scene.len() <= opts.tightness_max_n;
     let built = fastest_builds(&opts.methods, opts.repeat, stop, |m| {
         progress(Step::Build(m));
-        peers::build(m, scene, &opts.params)
+        peers::build_until(m, scene, &opts.params, stop)
     })?;
     let mut rows = Vec::new();
     for (&method, built) in opts.methods.iter().zip(&built) {
@@ -281,7 +282,8 @@ pub fn evaluate(
         let hulls = if need_hulls {
             stop.check()?;
             progress(Step::Wrapper(method, Wrapper::Hull));
-            best_of(opts.repeat, || timed(|| hull_tree(tree, scene)))
+            let (h, t) = best_of(opts.repeat, || timed(|| hull_tree_until(tree, scene, stop)));
+            (h?, t)
         } else {
             (Vec::new(), 0.0)
         };
@@ -358,13 +360,19 @@ impl Measuring<'_> {
             Wrapper::Box => 0.0,
             Wrapper::Hull => *hull_s,
             Wrapper::Sphere(m) => {
-                let (s, t) = best_of(opts.repeat, || timed(|| sphere_tree(tree, scene, m)));
-                spheres = s;
+                let stop = self.stop;
+                let (s, t) = best_of(opts.repeat, || {
+                    timed(|| sphere_tree_until(tree, scene, m, stop))
+                });
+                spheres = s?;
                 t
             }
             Wrapper::Obb => {
-                let (o, t) = best_of(opts.repeat, || timed(|| obb_tree(tree, scene, None)));
-                obbs = o;
+                let stop = self.stop;
+                let (o, t) = best_of(opts.repeat, || {
+                    timed(|| obb_tree_until(tree, scene, None, stop))
+                });
+                obbs = o?;
                 t
             }
         };
@@ -379,7 +387,7 @@ impl Measuring<'_> {
             self.stop.check()?;
             progress(Step::Tightness);
             let how = (opts.samples, opts.tightness_nodes, opts.seed);
-            let (t, l) = tightness(tree, scene, view, hulls, how);
+            let (t, l) = tightness(tree, scene, view, hulls, how, self.stop)?;
             (tightness_value, tightness_levels) = (Some(t), l);
         }
         let bv = match wrapper {

@@ -285,8 +285,9 @@ fn scene_cases(scene: Scene, r: f64, budget: Duration, halt: &Stop) -> Result<Ve
             method: m.name().into(),
             ..Row::default()
         };
+        let h = halt.clone();
         let out = on_thread(budget, halt, None, move || {
-            peers::build(m, &s, &Params::default())
+            peers::build_until(m, &s, &Params::default(), &h)
         });
         halt.check()?;
         match out {

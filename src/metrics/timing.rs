@@ -7,7 +7,7 @@
 use crate::grouping::Params;
 use crate::peers::{self, Built, Method};
 use crate::scene::Scene;
-use crate::stop::Stop;
+use crate::stop::{Interrupted, Stop};
 use anyhow::{Result, anyhow};
 
 /// The rounds `wraptree bench` runs by default: with fewer, its fast path / obvhs PLOC ratio
@@ -17,7 +17,8 @@ pub const ROUNDS: u32 = 9;
 /// The fastest of `rounds` (at least one) builds of each of `methods`, in `methods`' order. Each
 /// round calls `build` once per method, in `methods`' order; a build is kept when its
 /// [`Built::seconds`] is below that method's fastest so far. `stop` is checked before each
-/// build (Err: [`Interrupted`](crate::stop::Interrupted), or why a build failed).
+/// build, and a build that fails once it is requested counts as stopped (Err: [`Interrupted`],
+/// or why a build failed).
 pub fn fastest_builds(
     methods: &[Method],
     rounds: u32,
@@ -29,7 +30,11 @@ pub fn fastest_builds(
         for _ in 0..rounds.max(1) {
             for (slot, &m) in fastest.iter_mut().zip(methods) {
                 stop.check()?;
-                let b = build(m).map_err(|e| anyhow!(e))?;
+                let b = match build(m) {
+                    // A build that obeyed the stop (`peers::build_until`).
+                    Err(_) if stop.is_requested() => return Err(Interrupted.into()),
+                    b => b.map_err(|e| anyhow!(e))?,
+                };
                 if slot.as_ref().is_none_or(|x| b.seconds < x.seconds) {
                     *slot = Some(b);
                 }
@@ -51,5 +56,7 @@ pub fn fastest(
     rounds: u32,
     stop: &Stop,
 ) -> Result<Vec<Built>> {
-    fastest_builds(methods, rounds, stop, |m| peers::build(m, scene, params))
+    fastest_builds(methods, rounds, stop, |m| {
+        peers::build_until(m, scene, params, stop)
+    })
 }

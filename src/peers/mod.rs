@@ -26,9 +26,10 @@ pub mod topology;
 
 #[cfg(doc)]
 use crate::grouping::partitioned::Chunking;
-use crate::grouping::{self, PSet, Params, Pregroup, Schedule, Stats, SubsetTree};
+use crate::grouping::{self, Budget, PSet, Params, Pregroup, Schedule, Stats, SubsetTree};
 use crate::refine::{self, Refinement};
 use crate::scene::Scene;
+use crate::stop::{Interrupted, Stop};
 use parry3d::partitioning::BvhBuildStrategy;
 use std::time::Instant;
 
@@ -310,14 +311,30 @@ pub struct Built {
 /// A refined method's time includes the refinement (which searches on rayon's threads);
 /// [`Built::refine_seconds`] is its part.
 pub fn build(method: Method, scene: &Scene, params: &Params) -> Result<Built, String> {
-    // Every method is timed on a thread of the pool, as a caller inside it would run it: from
-    // outside, each of a builder's parallel steps would be handed over (`crate::par`).
-    crate::par::on_pool(true, || build_here(method, scene, params))
+    build_until(method, scene, params, &Stop::new())
 }
 
-/// [`build`] on the caller's thread.
-fn build_here(method: Method, scene: &Scene, params: &Params) -> Result<Built, String> {
-    let mut built = build_base(method.builder, scene, params)?;
+/// [`build`], the grouping methods checking `stop` between merges and in their scans (Err:
+/// [`Interrupted`]'s text once `stop` is requested; the peers' own builders run to the end).
+pub fn build_until(
+    method: Method,
+    scene: &Scene,
+    params: &Params,
+    stop: &Stop,
+) -> Result<Built, String> {
+    // Every method is timed on a thread of the pool, as a caller inside it would run it: from
+    // outside, each of a builder's parallel steps would be handed over (`crate::par`).
+    crate::par::on_pool(true, || build_here(method, scene, params, stop))
+}
+
+/// [`build_until`] on the caller's thread.
+fn build_here(
+    method: Method,
+    scene: &Scene,
+    params: &Params,
+    stop: &Stop,
+) -> Result<Built, String> {
+    let mut built = build_base(method.builder, scene, params, stop)?;
     if let Some(refinement) = method.refinement {
         let t = Instant::now();
         let Built {
@@ -341,7 +358,17 @@ fn build_here(method: Method, scene: &Scene, params: &Params) -> Result<Built, S
 }
 
 /// Builds `builder`'s hierarchy (see [`build`]).
-fn build_base(builder: Builder, scene: &Scene, params: &Params) -> Result<Built, String> {
+fn build_base(
+    builder: Builder,
+    scene: &Scene,
+    params: &Params,
+    stop: &Stop,
+) -> Result<Built, String> {
+    let budget = Budget {
+        stop: Some(stop.flag()),
+        ..Budget::default()
+    };
+    let interrupted = |_| Interrupted.to_string();
     let t = Instant::now();
     let method = Method::of(builder);
     let done = |tree: SubsetTree, stats: Option<Stats>, seconds: f64| Built {
@@ -385,11 +412,13 @@ fn build_base(builder: Builder, scene: &Scene, params: &Params) -> Result<Built,
             boxes.extend((0..n).map(|i| scene.prim_aabb(i)));
             let t = Instant::now();
             let resolved = p.resolve_boxes(&boxes);
-            let g = grouping::group_boxes(boxes, &resolved, ());
+            let g =
+                grouping::group_boxes_within(boxes, &resolved, (), &budget).map_err(interrupted)?;
             let seconds = t.elapsed().as_secs_f64();
             return Ok(done(g.tree, Some(g.stats), seconds));
         }
-        let g = grouping::group(scene, &p, ());
+        let g =
+            grouping::group_within(scene, &p.resolve(scene), (), &budget).map_err(interrupted)?;
         let seconds = t.elapsed().as_secs_f64();
         return Ok(done(g.tree, Some(g.stats), seconds));
     }

@@ -20,6 +20,7 @@ use super::{CoverLevel, Detail, Outcome, RunInfo, background};
 use crate::grouping::{self, Grouping, Limits, Observer, ResolvedParams, Stopped, Tee};
 use crate::output::{Pending, with_ext};
 use crate::scene::{Loaded, Scene};
+use crate::stop::Stop;
 use crate::wrap::cover::Cover;
 use crate::wrap::cover::export::WrapperRecord;
 use crate::wrap::cover::solve::{CoverLimit, solve};
@@ -160,7 +161,8 @@ pub fn record<O: Observer>(
             }
             Err(s) => (None, Some(s), s.merges, s.rounds),
         };
-        let extras = Extras::build(scene, grouping.as_ref(), opts)?;
+        let token = opts.stop.clone().map(Stop::from).unwrap_or_default();
+        let extras = Extras::build(scene, grouping.as_ref(), opts, &token)?;
         let outcome = extras.outcome(grouping.as_ref(), merges, rounds, seconds, stopped);
         let (rrd_done, mcap_done) =
             finish_both(rrd_thread, mcap_thread, &outcome, &rrd_file, &mcap_file);
@@ -213,6 +215,7 @@ fn spawn_mcap<'scope, 'a: 'scope>(
             let live = opts.live.mcap_tee();
             let mut mcap = McapRecorder::start_live(out, info, opts.mcap_compression, live)?;
             mcap.set_reproducible(opts.reproducible);
+            mcap.set_stop(opts.stop.clone().map(Stop::from).unwrap_or_default());
             mcap.set_all_levels(opts.all_levels);
             mcap.write_scene();
             worker.run(&mut mcap);
@@ -317,14 +320,22 @@ struct Extras {
 }
 
 impl Extras {
-    fn build(scene: &Scene, grouping: Option<&Grouping>, opts: &RecordOptions) -> Result<Extras> {
+    /// The extras of a finished grouping; a stop requested meanwhile ends the recording
+    /// ([`Interrupted`](crate::stop::Interrupted), no files written).
+    fn build(
+        scene: &Scene,
+        grouping: Option<&Grouping>,
+        opts: &RecordOptions,
+        stop: &Stop,
+    ) -> Result<Extras> {
         let mut wrappers = match (grouping, opts.detail.levels()) {
-            (Some(g), true) => Some(Wrappers::build(
+            (Some(g), true) => Some(Wrappers::build_until(
                 &g.tree,
                 scene,
                 &opts.wrappers,
                 SphereMethod::AabbCenter,
-            )),
+                stop,
+            )?),
             _ => None,
         };
         let spheres = wrappers
@@ -332,8 +343,7 @@ impl Extras {
             .map(|w| w.spheres.take().unwrap_or_default());
         let cover = match (grouping, &opts.cover) {
             (Some(g), Some((limit, kinds))) => {
-                // After a finished grouping the recording is completed, not stopped.
-                let s = solve(&g.tree, scene, *limit, kinds, &crate::stop::Stop::new())?;
+                let s = solve(&g.tree, scene, *limit, kinds, stop)?;
                 Some((s.cover, s.records))
             }
             _ => None,

@@ -71,9 +71,12 @@ impl Default for SnapshotOptions {
 }
 
 /// The embedded scene and parameters of the `.mcap` recording at `path` (read through
-/// [`replay::open`]), and its merges when it is complete and holds them.
-pub fn from_recording(path: &Path) -> Result<(Scene, ResolvedParams, Option<Vec<Merge>>)> {
-    let replay::Replay { rec, loaded } = replay::open(path)?;
+/// [`replay::open_until`], obeying `stop`), and its merges when it is complete and holds them.
+pub fn from_recording(
+    path: &Path,
+    stop: &Stop,
+) -> Result<(Scene, ResolvedParams, Option<Vec<Merge>>)> {
+    let replay::Replay { rec, loaded } = replay::open_until(path, stop)?;
     let merges = (rec.complete && rec.detail.merges()).then_some(rec.merges);
     Ok((loaded.scene, rec.params, merges))
 }
@@ -204,7 +207,7 @@ pub fn parse_angle(s: &str, lo: f64, hi: f64) -> Result<f64, String> {
 /// Draws the input and the chosen levels of `tree` over `scene` into `dir` (created with its
 /// parents if missing): `frame-NN-….{png,svg}` per frame and `figure.{png,svg}`, the sheet of
 /// them all. Every picture is drawn before any file is moved into place, and `stop` is obeyed
-/// between the wrappers and each picture ([`Interrupted`], nothing written).
+/// while the wrappers are built and between the pictures ([`Interrupted`], nothing written).
 pub fn draw(
     scene: &Scene,
     tree: &SubsetTree,
@@ -219,8 +222,7 @@ pub fn draw(
             kinds.push(*k);
         }
     }
-    let built = Wrappers::build(tree, scene, &kinds, SphereMethod::AabbCenter);
-    stop.check()?;
+    let built = Wrappers::build_until(tree, scene, &kinds, SphereMethod::AabbCenter, stop)?;
     let mut frames: Vec<Frame> = vec![super::input_frame(scene)];
     let mut names = vec!["frame-00-input".to_string()];
     for &kind in &kinds {

@@ -7,7 +7,8 @@
 //! ```no_run
 //! use wraptree::grouping::Limits;
 //! let replay = wraptree::replay::open("recordings/lamp.mcap".as_ref())?;
-//! match wraptree::replay::verify(&replay, &Limits::default()) {
+//! let stop = wraptree::stop::Stop::new();
+//! match wraptree::replay::verify(&replay, &Limits::default(), &stop) {
 //!     Ok(v) => println!("{v:?}"),
 //!     Err(stopped) => println!("re-run stopped: {stopped:?}"),
 //! }
@@ -22,10 +23,11 @@ use crate::grouping::{
 };
 use crate::output::with_ext;
 use crate::record::compare::{CompareRun, divergence, write_comparison};
-use crate::record::mcap::{Recorded, read_with_scene};
+use crate::record::mcap::{Recorded, read_with_scene_until};
 use crate::record::{RecordOptions, Written, record};
 use crate::refine::{self, Step};
 use crate::scene::Loaded;
+use crate::stop::{Interrupted, Stop};
 use anyhow::{Result, bail};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -94,10 +96,15 @@ pub struct Replay {
 /// (a `.rrd`, an empty file: [`not_an_mcap`]), an unreadable recording, or an embedded scene
 /// that does not load or does not match the metadata.
 pub fn open(path: &Path) -> Result<Replay> {
+    open_until(path, &Stop::new())
+}
+
+/// [`open`], its passes checking `stop` (Err: [`Interrupted`]).
+pub fn open_until(path: &Path, stop: &Stop) -> Result<Replay> {
     if let Some(why) = not_an_mcap(path) {
         bail!("{why}");
     }
-    let (rec, loaded) = read_with_scene(path)?;
+    let (rec, loaded) = read_with_scene_until(path, stop)?;
     Ok(Replay { rec, loaded })
 }
 
@@ -112,17 +119,18 @@ impl Replay {
 }
 
 /// An observer that keeps the event log and sets `stop` once `limit` merges are made, so a
-/// re-run of an incomplete recording ends where the recording did.
+/// re-run of an incomplete recording ends where the recording did, or once `user` is requested.
 struct UpTo<'a> {
     log: EventLog,
     limit: Option<usize>,
     stop: &'a AtomicBool,
+    user: &'a Stop,
 }
 
 impl Observer for UpTo<'_> {
     fn on_event(&mut self, event: &Event<'_>) {
         self.log.on_event(event);
-        if self.limit.is_some_and(|k| self.log.merges.len() >= k) {
+        if self.limit.is_some_and(|k| self.log.merges.len() >= k) || self.user.is_requested() {
             self.stop.store(true, Ordering::Relaxed);
         }
     }
@@ -130,24 +138,29 @@ impl Observer for UpTo<'_> {
 
 /// Re-runs the grouping of `loaded` within `limits`, up to `merges` merges when given (the
 /// length of an incomplete recording), and returns its events. Err: the stop, when a limit of
-/// `limits` ended the re-run first.
+/// `limits` or `stop` ended the re-run first.
 pub fn rerun(
     loaded: &Loaded,
     params: &ResolvedParams,
     limits: &Limits,
     merges: Option<usize>,
+    stop: &Stop,
 ) -> Result<EventLog, Stopped> {
-    let stop = AtomicBool::new(merges == Some(0));
+    // A whole re-run obeys `stop` itself; one up to a recorded length has a flag of its own,
+    // which the observer also sets once `stop` is requested.
+    let own = AtomicBool::new(merges == Some(0));
+    let flag = if merges.is_some() { &own } else { stop.flag() };
     let mut obs = UpTo {
         log: EventLog::default(),
         limit: merges,
-        stop: &stop,
+        stop: &own,
+        user: stop,
     };
-    let budget = limits.budget(Some(&stop));
+    let budget = limits.budget(Some(flag));
     match grouping::group_within(&loaded.scene, params, &mut obs, &budget) {
         Ok(_) => Ok(obs.log),
         // Our own flag, set at the recorded length: the re-run went as far as the recording.
-        Err(s) if s.reason == StopReason::Interrupted => Ok(obs.log),
+        Err(s) if s.reason == StopReason::Interrupted && !stop.is_requested() => Ok(obs.log),
         Err(s) => Err(s),
     }
 }
@@ -204,11 +217,11 @@ pub enum Verified {
 
 /// Re-runs the grouping from the embedded scene and recorded parameters within `limits` (up to
 /// the recorded length when the recording is incomplete) and compares it merge by merge. Err:
-/// the stop, when a limit ended the re-run first.
-pub fn verify(replay: &Replay, limits: &Limits) -> Result<Verified, Stopped> {
+/// the stop, when a limit or `stop` ended the re-run first.
+pub fn verify(replay: &Replay, limits: &Limits, stop: &Stop) -> Result<Verified, Stopped> {
     let rec = &replay.rec;
     let upto = (!rec.complete).then_some(rec.merges.len());
-    let log = rerun(&replay.loaded, &rec.params, limits, upto)?;
+    let log = rerun(&replay.loaded, &rec.params, limits, upto, stop)?;
     let k = rec.parts.len();
     if log.parts.get(..k) != Some(&rec.parts[..]) || (rec.complete && log.parts.len() != k) {
         let index = (0..k)
@@ -391,7 +404,9 @@ pub fn compare(
 }
 
 /// Re-runs the recording with `weights` (other parameters as recorded) and records the new run
-/// to `prefix` with `opts` (see [`record`]); `progress` sees the recorded run's events.
+/// to `prefix` with `opts` (see [`record`]); `progress` sees the recorded run's events. A stop
+/// (`opts.stop`) while the comparison is written takes the new recording away again
+/// ([`Interrupted`]: a stopped run leaves nothing).
 pub fn reweight<O: Observer>(
     replay: &Replay,
     weights: Weights,
@@ -403,12 +418,15 @@ pub fn reweight<O: Observer>(
         weights,
         ..replay.rec.params
     };
-    let written = record(&replay.loaded, &params, prefix, opts, progress)?;
-    // The same run again for its events: it finished within the limits just now.
-    let log = written.grouping.as_ref().map(|_| {
-        rerun(&replay.loaded, &params, &Limits::default(), None)
-            .expect("an unlimited re-run is never stopped")
-    });
+    let mut events = EventLog::default();
+    let written = record(
+        &replay.loaded,
+        &params,
+        prefix,
+        opts,
+        grouping::Tee(&mut events, progress),
+    )?;
+    let log = written.grouping.as_ref().map(|_| events);
     let comparison = match (&log, &written.grouping) {
         (Some(log), Some(g)) => {
             let old = replay.rec.complete.then(|| replay.tree()).transpose()?;
@@ -427,11 +445,16 @@ pub fn reweight<O: Observer>(
             let scene = &replay.loaded.scene;
             let name = &replay.rec.scene_file_name;
             let prefix = with_ext(prefix, ".compare");
-            // The new recording is complete by now: its comparison is completed too.
-            let never = crate::stop::Stop::new();
-            Some(write_comparison(
-                &prefix, scene, name, &runs, opts.force, &never,
-            )?)
+            let stop = opts.stop.clone().map(Stop::from).unwrap_or_default();
+            match write_comparison(&prefix, scene, name, &runs, opts.force, &stop) {
+                Err(e) if crate::stop::is_interrupted(&e) => {
+                    // Failing only when already gone: nothing is left either way.
+                    let _ = std::fs::remove_file(&written.rrd);
+                    let _ = std::fs::remove_file(&written.mcap);
+                    return Err(Interrupted.into());
+                }
+                c => Some(c?),
+            }
         }
         _ => None,
     };

@@ -180,9 +180,13 @@ pub struct Verification {
 
 /// Runs [`verify`] within `limits` and, when the merges match, [`verify_refinement`], and
 /// words what they found ([`verified_text`], [`refine_verified_text`]). Inner Err: the stop,
-/// when a limit ended the re-run first.
-pub fn verification(replay: &Replay, limits: &Limits) -> Result<Result<Verification, Stopped>> {
-    let v = match verify(replay, limits) {
+/// when a limit or `stop` ended the re-run first.
+pub fn verification(
+    replay: &Replay,
+    limits: &Limits,
+    stop: &crate::stop::Stop,
+) -> Result<Result<Verification, Stopped>> {
+    let v = match verify(replay, limits, stop) {
         Ok(v) => v,
         Err(s) => return Ok(Err(s)),
     };

@@ -12,6 +12,7 @@ use super::input::{LoadError, LoadOptions, Loaded};
 use super::obj_writer::{ObjWriter, write_scene};
 use super::{PrimitiveKind, Scene, obj};
 use crate::geom::P3;
+use crate::stop::Stop;
 
 /// The OBJ text of `scene`, whose object `k` is named `names[k]` (`object<k>` past the end).
 /// `what` is written in the first comment line.
@@ -54,11 +55,12 @@ pub(super) fn converted(
     names: &[String],
     opts: &LoadOptions,
     warnings: Vec<String>,
+    stop: &Stop,
 ) -> Result<Loaded, LoadError> {
     let text = obj_text(scene, names, &format!("{file_name} as loaded"));
     let obj_name = format!("{}.obj", scene.name);
     let opts = LoadOptions { up: None, ..*opts };
-    let mut loaded = obj::load(&obj_name, text, &opts).map_err(|e| LoadError {
+    let mut loaded = obj::load(&obj_name, text, &opts, stop).map_err(|e| LoadError {
         file: file_name.to_string(),
         problem: format!(
             "the scene does not load back from its OBJ form ({})",

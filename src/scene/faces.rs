@@ -15,6 +15,7 @@ use super::input::{LoadError, LoadErrorKind, LoadOptions, MAX_COORDINATE, Up};
 use super::obj::polygon::{self, PolygonStats};
 use super::obj::polyhedron::{self, PolyhedronStats};
 use crate::geom::P3;
+use crate::stop::Stop;
 
 /// Faces over a vertex list, each in one named object.
 #[derive(Clone, Debug, Default)]
@@ -178,13 +179,16 @@ pub(crate) fn stem(file_name: &str) -> String {
         .unwrap_or_default()
 }
 
-/// Turns `faces` of the file `file_name` into a scene by the rules of the module docs.
+/// Turns `faces` of the file `file_name` into a scene by the rules of the module docs, checking
+/// `stop` as it goes.
 pub(crate) fn build(
     file_name: &str,
     mut faces: Faces,
     opts: &LoadOptions,
     up: Up,
+    stop: &Stop,
 ) -> Result<Built, LoadError> {
+    let interrupted = |_| LoadError::interrupted(file_name);
     let err = |kind, problem: String| LoadError {
         file: file_name.to_string(),
         kind,
@@ -215,6 +219,7 @@ pub(crate) fn build(
     }
     let stem = stem(file_name);
     let mut scene = Scene::new(stem);
+    stop.check().map_err(interrupted)?;
     let of_coord = weld(&faces.coords, &mut scene.points);
     let face_verts = |f: &[u32]| {
         f.iter()
@@ -236,6 +241,7 @@ pub(crate) fn build(
             list.push(face_verts(f));
         }
         for o in order {
+            stop.check().map_err(interrupted)?;
             let list: Vec<&[u32]> = by_object[o as usize].iter().map(Vec::as_slice).collect();
             polyhedron::add(
                 &mut scene,
@@ -254,7 +260,8 @@ pub(crate) fn build(
             ..PolygonStats::default()
         };
         let mut scratch = polygon::Scratch::default();
-        for (f, o) in faces.faces() {
+        for (k, (f, o)) in faces.faces().enumerate() {
+            stop.check_every(k).map_err(interrupted)?;
             polygon::add(&mut scene, &face_verts(f), &mut stats, &mut scratch);
             objects.resize(scene.len(), o);
         }
@@ -343,7 +350,7 @@ mod tests {
         let f = quad_faces();
         assert_eq!(f.names, ["a", "a.2"]);
         assert_eq!((f.len(), f.short), (2, 1));
-        let b = build("q.stl", f, &LoadOptions::default(), Up::Z).unwrap();
+        let b = build("q.stl", f, &LoadOptions::default(), Up::Z, &Stop::new()).unwrap();
         assert_eq!(b.scene.len(), 2);
         assert_eq!(b.scene.objects, [0, 1]);
         assert_eq!(b.names, ["a.2", "a"]);
@@ -355,7 +362,14 @@ mod tests {
 
     #[test]
     fn y_up_turns_plus_y_to_plus_z() {
-        let b = build("q.glb", quad_faces(), &LoadOptions::default(), Up::Y).unwrap();
+        let b = build(
+            "q.glb",
+            quad_faces(),
+            &LoadOptions::default(),
+            Up::Y,
+            &Stop::new(),
+        )
+        .unwrap();
         assert!(b.scene.points.iter().all(|p| p.z >= 0.0 && p.y == 0.0));
         assert!(b.scene.points.iter().any(|p| p.z == 1.0));
     }
@@ -364,10 +378,17 @@ mod tests {
     fn bad_coordinates_and_empty_files_are_one_line_errors() {
         let mut f = quad_faces();
         f.coords[2][1] = f64::NAN;
-        let e = build("q.ply", f, &LoadOptions::default(), Up::Z).unwrap_err();
+        let e = build("q.ply", f, &LoadOptions::default(), Up::Z, &Stop::new()).unwrap_err();
         assert_eq!(e.kind, LoadErrorKind::NonFinite);
         assert!(e.problem.starts_with("vertex 3 has a non-finite"), "{e}");
-        let e = build("q.ply", Faces::new(), &LoadOptions::default(), Up::Z).unwrap_err();
+        let e = build(
+            "q.ply",
+            Faces::new(),
+            &LoadOptions::default(),
+            Up::Z,
+            &Stop::new(),
+        )
+        .unwrap_err();
         assert_eq!(
             (e.kind, e.problem.as_str()),
             (LoadErrorKind::NoFaces, "no faces")
@@ -394,7 +415,7 @@ mod tests {
             strict: true,
             up: None,
         };
-        let b = build("t.stl", f, &opts, Up::Z).unwrap();
+        let b = build("t.stl", f, &opts, Up::Z, &Stop::new()).unwrap();
         assert_eq!(b.scene.len(), 1);
         assert_eq!(b.scene.kind, Some(PrimitiveKind::Polyhedron));
         assert_eq!(b.scene.labels, ["tet"]);

@@ -9,6 +9,7 @@ use std::path::Path;
 use sha2::{Digest, Sha256};
 
 use super::Scene;
+use crate::stop::Interrupted;
 
 /// Which axis of a file points up. The loader turns the scene so that it is +Z, the up axis
 /// of the recordings and snapshots.
@@ -106,6 +107,9 @@ pub enum LoadErrorKind {
     /// A format or feature wraptree does not read (xacro, compressed glTF meshes, a COLLADA
     /// `<lookat>` or `<skew>` transform).
     Unsupported,
+    /// A [`Stop`](crate::stop::Stop) was requested while loading; the error's source is
+    /// [`Interrupted`].
+    Interrupted,
 }
 
 /// A loading failure; its `Display` is one line `FILE: PROBLEM`.
@@ -125,7 +129,22 @@ impl fmt::Display for LoadError {
     }
 }
 
-impl std::error::Error for LoadError {}
+impl std::error::Error for LoadError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        (self.kind == LoadErrorKind::Interrupted).then_some(&Interrupted as _)
+    }
+}
+
+impl LoadError {
+    /// The error of a load of `file` that obeyed a [`Stop`](crate::stop::Stop).
+    pub(crate) fn interrupted(file: &str) -> LoadError {
+        LoadError {
+            file: file.to_string(),
+            kind: LoadErrorKind::Interrupted,
+            problem: Interrupted.to_string(),
+        }
+    }
+}
 
 /// Largest accepted coordinate magnitude: squared distances must stay finite in `f64`.
 pub const MAX_COORDINATE: f64 = 1e100;

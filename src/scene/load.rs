@@ -36,6 +36,7 @@ pub use super::input::{
 use super::input::{one_line, read_file, source};
 use super::urdf::UrdfOptions;
 use super::{export, mesh, obj, urdf};
+use crate::stop::Stop;
 
 /// Reads and loads the scene file at `path`; errors name the path as given.
 pub fn load_path(path: &Path, opts: &LoadOptions) -> Result<Loaded, LoadError> {
@@ -47,6 +48,17 @@ pub fn load_path_with(
     path: &Path,
     opts: &LoadOptions,
     urdf: &UrdfOptions,
+) -> Result<Loaded, LoadError> {
+    load_path_until(path, opts, urdf, &Stop::new())
+}
+
+/// [`load_path_with`], its long loops checking `stop` (Err: kind
+/// [`LoadErrorKind::Interrupted`]).
+pub fn load_path_until(
+    path: &Path,
+    opts: &LoadOptions,
+    urdf: &UrdfOptions,
+    stop: &Stop,
 ) -> Result<Loaded, LoadError> {
     let shown = path.display().to_string();
     let bytes = read_file(path).map_err(|problem| LoadError {
@@ -65,7 +77,8 @@ pub fn load_path_with(
             d.to_path_buf()
         }
     });
-    load_in(&name, bytes, opts, dir.as_deref(), urdf).map_err(|e| LoadError { file: shown, ..e })
+    load_in(&name, bytes, opts, dir.as_deref(), urdf, stop)
+        .map_err(|e| LoadError { file: shown, ..e })
 }
 
 /// Loads the bytes of a file named `file_name` (the format is its extension's; the scene is
@@ -78,7 +91,17 @@ pub fn load_bytes(
     bytes: Vec<u8>,
     opts: &LoadOptions,
 ) -> Result<Loaded, LoadError> {
-    load_in(file_name, bytes, opts, None, &UrdfOptions::default())
+    load_bytes_until(file_name, bytes, opts, &Stop::new())
+}
+
+/// [`load_bytes`], its long loops checking `stop` (Err: kind [`LoadErrorKind::Interrupted`]).
+pub fn load_bytes_until(
+    file_name: &str,
+    bytes: Vec<u8>,
+    opts: &LoadOptions,
+    stop: &Stop,
+) -> Result<Loaded, LoadError> {
+    load_in(file_name, bytes, opts, None, &UrdfOptions::default(), stop)
 }
 
 /// Loads `bytes` named `file_name`, with the directory of the files it refers to (`None`: it
@@ -89,11 +112,15 @@ fn load_in(
     opts: &LoadOptions,
     dir: Option<&Path>,
     urdf_opts: &UrdfOptions,
+    stop: &Stop,
 ) -> Result<Loaded, LoadError> {
-    let mut loaded = load_format(file_name, bytes, opts, dir, urdf_opts)?;
+    let mut loaded = load_format(file_name, bytes, opts, dir, urdf_opts, stop)?;
+    let interrupted = |_| LoadError::interrupted(file_name);
+    stop.check().map_err(interrupted)?;
     loaded
         .warnings
         .extend(super::coincident::warning(file_name, &loaded.scene));
+    stop.check().map_err(interrupted)?;
     Ok(loaded)
 }
 
@@ -104,6 +131,7 @@ fn load_format(
     opts: &LoadOptions,
     dir: Option<&Path>,
     urdf_opts: &UrdfOptions,
+    stop: &Stop,
 ) -> Result<Loaded, LoadError> {
     let format = Format::of(file_name).map_err(|problem| LoadError {
         file: file_name.to_string(),
@@ -111,10 +139,10 @@ fn load_format(
         problem,
     })?;
     if format == Format::Obj {
-        return obj::load(file_name, bytes, opts);
+        return obj::load(file_name, bytes, opts, stop);
     }
     // Names from the file (links, solids, nodes) may hold line breaks: one line, whatever.
-    load_other(file_name, format, bytes, opts, dir, urdf_opts).map_err(|e| LoadError {
+    load_other(file_name, format, bytes, opts, dir, urdf_opts, stop).map_err(|e| LoadError {
         problem: one_line(&e.problem, 1000),
         ..e
     })
@@ -128,6 +156,7 @@ fn load_other(
     opts: &LoadOptions,
     dir: Option<&Path>,
     urdf_opts: &UrdfOptions,
+    stop: &Stop,
 ) -> Result<Loaded, LoadError> {
     let read = if format == Format::Urdf {
         let (faces, warnings) = urdf::read(file_name, &bytes, dir, urdf_opts)?;
@@ -141,11 +170,13 @@ fn load_other(
         mesh::read(file_name, format, &bytes, dir)?
     };
     let up = opts.up.or(read.up).unwrap_or(format.default_up());
-    let built = super::faces::build(file_name, read.faces, opts, up)?;
+    stop.check()
+        .map_err(|_| LoadError::interrupted(file_name))?;
+    let built = super::faces::build(file_name, read.faces, opts, up, stop)?;
     let mut warnings = read.warnings;
     warnings.extend(built.warnings);
     if read.external {
-        return export::converted(file_name, &built.scene, &built.names, opts, warnings);
+        return export::converted(file_name, &built.scene, &built.names, opts, warnings, stop);
     }
     Ok(Loaded {
         scene: built.scene,

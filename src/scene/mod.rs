@@ -41,7 +41,7 @@ pub mod stl;
 pub mod urdf;
 
 pub use input::{Format, LoadError, LoadErrorKind, LoadOptions, Loaded, SceneSource, Up};
-pub use load::{load_bytes, load_path, load_path_with};
+pub use load::{load_bytes, load_bytes_until, load_path, load_path_until, load_path_with};
 pub use urdf::UrdfOptions;
 
 use crate::geom::{Aabb, P3};

@@ -19,6 +19,7 @@ use self::polyhedron::PolyhedronStats;
 use super::Scene;
 use super::faces::{Faces, turn_y_up};
 use super::input::{Format, Up};
+use crate::stop::Stop;
 // The loading API's types lived here before other formats came; these paths keep working.
 pub use super::input::{
     LoadError, LoadErrorKind, LoadOptions, Loaded, MAX_COORDINATE, SceneSource,
@@ -34,15 +35,24 @@ pub(super) fn load(
     file_name: &str,
     bytes: Vec<u8>,
     opts: &LoadOptions,
+    stop: &Stop,
 ) -> Result<Loaded, LoadError> {
-    load_piped_from(file_name, bytes, opts, pipe::PIPELINE_FROM)
+    load_piped_from(file_name, bytes, opts, pipe::PIPELINE_FROM, stop)
 }
 
 /// The faces of OBJ `bytes`, one object per group (for a URDF's meshes): the file's
 /// coordinates, not turned.
 pub(super) fn read_faces(file_name: &str, bytes: Vec<u8>) -> Result<Faces, LoadError> {
     let mut points = Vec::new();
-    let (groups, scanned) = parse(file_name, &bytes, None, &mut points, pipe::PIPELINE_FROM)?;
+    let never = Stop::new();
+    let (groups, scanned) = parse(
+        file_name,
+        &bytes,
+        None,
+        &mut points,
+        pipe::PIPELINE_FROM,
+        &never,
+    )?;
     let mut faces = Faces::new();
     faces.coords = points.iter().map(|p| [p.x, p.y, p.z]).collect();
     faces.short = scanned.short_faces;
@@ -56,13 +66,15 @@ pub(super) fn read_faces(file_name: &str, bytes: Vec<u8>) -> Result<Faces, LoadE
 }
 
 /// Checks and parses OBJ `bytes` (pre-pass, then `tobj`): the groups over `points`, which it
-/// fills (turned by `up` when that is Y), and the pre-pass's counts.
+/// fills (turned by `up` when that is Y), and the pre-pass's counts. The pre-pass checks `stop`
+/// (ending it ends `tobj`'s input too).
 fn parse(
     file_name: &str,
     bytes: &[u8],
     up: Option<Up>,
     points: &mut Vec<crate::geom::P3>,
     pipeline_from: usize,
+    stop: &Stop,
 ) -> Result<(Vec<Group>, Scanned), LoadError> {
     let err = |kind, problem: String| LoadError {
         file: file_name.to_string(),
@@ -82,7 +94,8 @@ fn parse(
         ignore_lines: true,
     };
     // tobj reads the pre-pass's cleaned text as it is written (a large file) or after it.
-    let (mut scanned, parsed) = pipe::scan_then(text, pipeline_from, scan, |cleaned| {
+    let scan_until = |text: &str, out: &mut dyn Cleaned| scan(text, out, stop);
+    let (mut scanned, parsed) = pipe::scan_then(text, pipeline_from, scan_until, |cleaned| {
         tobj::load_obj_buf(cleaned, &tobj_opts, |_| {
             Err(tobj::LoadError::OpenFileFailed)
         })
@@ -104,17 +117,19 @@ fn parse(
     if up == Some(Up::Y) {
         turn_y_up(&mut scanned.coords);
     }
-    let groups = collect_groups(&models, &scanned.coords, points)
-        .map_err(|p| err(LoadErrorKind::Malformed, p))?;
+    let groups =
+        collect_groups(&models, &scanned.coords, points, stop).map_err(|(kind, p)| err(kind, p))?;
     Ok((groups, scanned))
 }
 
-/// [`load_bytes`], with the pre-pass and `tobj` at once from `pipeline_from` bytes up.
+/// [`load_bytes`], with the pre-pass and `tobj` at once from `pipeline_from` bytes up, checking
+/// `stop`.
 fn load_piped_from(
     file_name: &str,
     bytes: Vec<u8>,
     opts: &LoadOptions,
     pipeline_from: usize,
+    stop: &Stop,
 ) -> Result<Loaded, LoadError> {
     let err = |kind, problem: String| LoadError {
         file: file_name.to_string(),
@@ -130,6 +145,7 @@ fn load_piped_from(
         Some(up),
         &mut scene.points,
         pipeline_from,
+        stop,
     )?;
     let mut warnings = Vec::new();
     // Object ids by group name, in order of first appearance.
@@ -144,6 +160,8 @@ fn load_piped_from(
     if opts.polyhedra {
         let mut stats = PolyhedronStats::default();
         for (g, &id) in groups.iter().zip(&group_ids) {
+            stop.check()
+                .map_err(|_| LoadError::interrupted(file_name))?;
             let faces: Vec<&[u32]> = g.faces().collect();
             polyhedron::add(&mut scene, &g.name, &faces, opts.strict, &mut stats)
                 .map_err(|p| err(LoadErrorKind::NotConvex, p))?;
@@ -162,7 +180,9 @@ fn load_piped_from(
         };
         let mut scratch = polygon::Scratch::default();
         for (g, &id) in groups.iter().zip(&group_ids) {
-            for face in g.faces() {
+            for (k, face) in g.faces().enumerate() {
+                stop.check_every(k)
+                    .map_err(|_| LoadError::interrupted(file_name))?;
                 polygon::add(&mut scene, face, &mut stats, &mut scratch);
             }
             scene.objects.resize(scene.len(), id);
@@ -237,7 +257,11 @@ fn shown(tok: &str) -> String {
 /// `f`, `o` and `g` lines are kept verbatim. A line ending in `\\` continues on the next (the
 /// OBJ specification's long lines): the statement is checked and copied whole on its last line,
 /// its errors naming its first.
-fn scan(text: &str, out: &mut dyn Cleaned) -> Result<Scanned, (LoadErrorKind, String)> {
+fn scan(
+    text: &str,
+    out: &mut dyn Cleaned,
+    stop: &Stop,
+) -> Result<Scanned, (LoadErrorKind, String)> {
     let mut s = Scanned::default();
     // A vertex's rewritten line, written out whole.
     let mut vline = String::with_capacity(32);
@@ -250,6 +274,8 @@ fn scan(text: &str, out: &mut dyn Cleaned) -> Result<Scanned, (LoadErrorKind, St
     let mut joined_from = 0;
     let mut pieces = text.split('\n').enumerate().peekable();
     while let Some((i, piece)) = pieces.next() {
+        stop.check_every(i)
+            .map_err(|e| (LoadErrorKind::Interrupted, e.to_string()))?;
         let piece = piece.strip_suffix('\r').unwrap_or(piece);
         if let Some(head) = piece.trim_end_matches([' ', '\t']).strip_suffix('\\')
             && pieces.peek().is_some()

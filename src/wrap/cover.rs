@@ -14,7 +14,7 @@
 pub mod export;
 pub mod solve;
 
-use super::hull::{Hull, hull_tree};
+use super::hull::{Hull, hull_tree_until};
 use super::kind::{WrapperKind, Wrappers};
 use super::tightness::node_tightness;
 use crate::grouping::SubsetTree;
@@ -146,7 +146,7 @@ impl Fits {
     /// Measures every kind of `wrappers` on every node with `samples` surface samples
     /// ([`node_tightness`]); leaves also get [`CoverKind::Primitive`]. `hulls` are the hulls of
     /// the same tree (reference volumes, hull vertex counts); built when `None`. `stop` is
-    /// obeyed before each kind is measured.
+    /// obeyed throughout.
     pub fn measure(
         tree: &SubsetTree,
         scene: &Scene,
@@ -159,7 +159,7 @@ impl Fits {
         let hulls = match hulls.or(wrappers.hulls.as_deref()) {
             Some(h) => h,
             None => {
-                built = hull_tree(tree, scene);
+                built = hull_tree_until(tree, scene, stop)?;
                 &built
             }
         };
@@ -180,7 +180,7 @@ impl Fits {
         for w in wrappers.trees() {
             stop.check()?;
             let kind = CoverKind::of(w.kind());
-            let stats = node_tightness(tree, scene, w, hulls, samples);
+            let stats = node_tightness(tree, scene, w, hulls, samples, stop)?;
             for (x, s) in stats.iter().enumerate() {
                 let error = if s.error.is_finite() {
                     s.error

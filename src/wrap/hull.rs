@@ -19,7 +19,7 @@ pub fn hull_tree(tree: &SubsetTree, scene: &Scene) -> Vec<Hull> {
     }
 }
 
-/// [`hull_tree`], checking `stop` before each interior node and every 1,024 leaves.
+/// [`hull_tree`], checking `stop` before each interior node and every [`STRIDE`](crate::stop::STRIDE) leaves.
 pub fn hull_tree_until(
     tree: &SubsetTree,
     scene: &Scene,
@@ -28,9 +28,7 @@ pub fn hull_tree_until(
     let n = tree.leaves();
     let mut hulls: Vec<Hull> = Vec::with_capacity(tree.len());
     for leaf in 0..n {
-        if leaf % 1024 == 0 {
-            stop.check()?;
-        }
+        stop.check_every(leaf)?;
         hulls.push(hull_of(scene.prim_vertices(leaf).copied().collect()));
     }
     for [a, b] in &tree.children {

@@ -1,12 +1,13 @@
 //! The wrapper kinds and a set of Wrapper Trees built together.
 
-use super::hull::{Hull, hull_tree};
-use super::obb::{Obb, obb_tree};
-use super::sphere::{SphereMethod, sphere_tree};
+use super::hull::{Hull, hull_tree_until};
+use super::obb::{Obb, obb_tree_until};
+use super::sphere::{SphereMethod, sphere_tree_until};
 use crate::geom::Aabb;
 use crate::geom::Sphere;
 use crate::grouping::SubsetTree;
 use crate::scene::Scene;
+use crate::stop::{Interrupted, Stop};
 
 /// A kind of wrapper (`--wrapper`).
 #[derive(
@@ -91,7 +92,8 @@ impl WrapperKind {
 /// let w = Wrappers::build(tree, scene, &kinds, SphereMethod::Minimum);
 /// let hulls = w.hulls.as_deref().unwrap();
 /// for t in w.trees() {
-///     let stats = level_tightness(tree, scene, t, hulls, wraptree::wrap::DEFAULT_SAMPLES);
+///     let (samples, stop) = (wraptree::wrap::DEFAULT_SAMPLES, wraptree::stop::Stop::new());
+///     let stats = level_tightness(tree, scene, t, hulls, samples, &stop).expect("not stopped");
 ///     println!("{}: {:?}", t.kind().name(), stats.last());
 /// }
 /// # }
@@ -157,14 +159,36 @@ impl Wrappers {
         kinds: &[WrapperKind],
         sphere: SphereMethod,
     ) -> Wrappers {
-        let want = |k| kinds.contains(&k);
-        let hulls = want(WrapperKind::Hull).then(|| hull_tree(tree, scene));
-        Wrappers {
-            spheres: want(WrapperKind::Sphere).then(|| sphere_tree(tree, scene, sphere)),
-            boxes: want(WrapperKind::Box).then(|| tree.aabb.clone()),
-            obbs: want(WrapperKind::Obb).then(|| obb_tree(tree, scene, hulls.as_deref())),
-            hulls,
+        match Wrappers::build_until(tree, scene, kinds, sphere, &Stop::new()) {
+            Ok(w) => w,
+            Err(Interrupted) => unreachable!("a new stop token is never set"),
         }
+    }
+
+    /// [`Wrappers::build`], each tree's builder checking `stop` as it goes.
+    pub fn build_until(
+        tree: &SubsetTree,
+        scene: &Scene,
+        kinds: &[WrapperKind],
+        sphere: SphereMethod,
+        stop: &Stop,
+    ) -> Result<Wrappers, Interrupted> {
+        let want = |k| kinds.contains(&k);
+        let hulls = want(WrapperKind::Hull)
+            .then(|| hull_tree_until(tree, scene, stop))
+            .transpose()?;
+        let spheres = want(WrapperKind::Sphere)
+            .then(|| sphere_tree_until(tree, scene, sphere, stop))
+            .transpose()?;
+        let obbs = want(WrapperKind::Obb)
+            .then(|| obb_tree_until(tree, scene, hulls.as_deref(), stop))
+            .transpose()?;
+        Ok(Wrappers {
+            spheres,
+            boxes: want(WrapperKind::Box).then(|| tree.aabb.clone()),
+            obbs,
+            hulls,
+        })
     }
 
     /// The trees present, in [`WrapperKind`] order.

@@ -27,10 +27,11 @@ pub mod welzl;
 pub use crate::geom::Sphere;
 pub use hull::{HULL_TOL_REL, Hull, hull_tree, hull_tree_until};
 pub use kind::{WrapperKind, WrapperTree, Wrappers};
-pub use obb::{Obb, obb_tree};
+pub use obb::{Obb, obb_tree, obb_tree_until};
 pub use order::LeafOrder;
-pub use sphere::{SphereMethod, sphere_tree};
+pub use sphere::{SphereMethod, sphere_tree, sphere_tree_until};
 pub use tightness::{
     DEFAULT_SAMPLES, DepthSample, LevelStats, MAX_VISITS, NODES_PER_DEPTH, NodeStats,
-    containment_excess, level_tightness, level_tightness_sampled, node_tightness, nodes_tightness,
+    containment_excess, containment_excess_until, level_tightness, level_tightness_sampled,
+    node_tightness, nodes_tightness,
 };

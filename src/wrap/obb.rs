@@ -10,6 +10,7 @@ use crate::geom::pca::Frame;
 use crate::geom::{Aabb, P3, V3};
 use crate::grouping::SubsetTree;
 use crate::scene::Scene;
+use crate::stop::{Interrupted, Stop};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion};
 
 /// An oriented box.
@@ -78,9 +79,24 @@ impl Obb {
 /// One oriented box per Subset Tree node (index = node id). With `hulls`, the axes come from
 /// the PCA of each node's hull vertices; without, from all its vertices.
 pub fn obb_tree(tree: &SubsetTree, scene: &Scene, hulls: Option<&[Hull]>) -> Vec<Obb> {
+    match obb_tree_until(tree, scene, hulls, &Stop::new()) {
+        Ok(obbs) => obbs,
+        Err(Interrupted) => unreachable!("a new stop token is never set"),
+    }
+}
+
+/// [`obb_tree`], checking `stop` at every node.
+pub fn obb_tree_until(
+    tree: &SubsetTree,
+    scene: &Scene,
+    hulls: Option<&[Hull]>,
+    stop: &Stop,
+) -> Result<Vec<Obb>, Interrupted> {
     let order = LeafOrder::new(tree, scene);
     (0..tree.len() as u32)
         .map(|x| {
+            // Every node: a node near the root alone visits most of the scene.
+            stop.check()?;
             let pts = order.node_points(x);
             let basis = match hulls {
                 Some(h) => h[x as usize].vertices.as_slice(),
@@ -89,7 +105,7 @@ pub fn obb_tree(tree: &SubsetTree, scene: &Scene, hulls: Option<&[Hull]>) -> Vec
             let obb = Obb::fit(&Frame::principal(basis), pts);
             let aabb = Obb::from_aabb(&crate::geom::Aabb::from_points(pts));
             let key = |b: &Obb| (b.volume(), b.half_area());
-            if key(&aabb) < key(&obb) { aabb } else { obb }
+            Ok(if key(&aabb) < key(&obb) { aabb } else { obb })
         })
         .collect()
 }

@@ -22,7 +22,8 @@
 
 use super::{
     HULL_TOL_REL, Hull, LevelStats, Obb, Sphere, SphereMethod, WrapperKind, WrapperTree,
-    containment_excess, hull_tree_until, level_tightness_sampled, obb_tree, sphere_tree,
+    containment_excess_until, hull_tree_until, level_tightness_sampled, obb_tree_until,
+    sphere_tree_until,
 };
 use crate::geom::Aabb;
 use crate::grouping::SubsetTree;
@@ -83,7 +84,7 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
 
 impl Built {
     /// Builds the trees of `kinds` (OBB axes from the hulls when hulls are built too, as
-    /// [`Wrappers::build`](super::Wrappers::build) does), checking `stop` before each.
+    /// [`Wrappers::build`](super::Wrappers::build) does), checking `stop` before and within each.
     fn new(
         tree: &SubsetTree,
         scene: &Scene,
@@ -95,7 +96,8 @@ impl Built {
         let mut b = Built::default();
         if want(WrapperKind::Sphere) {
             stop.check()?;
-            b.spheres = Some(timed(|| sphere_tree(tree, scene, method)));
+            let (spheres, t) = timed(|| sphere_tree_until(tree, scene, method, stop));
+            b.spheres = Some((spheres?, t));
         }
         if want(WrapperKind::Hull) {
             stop.check()?;
@@ -108,7 +110,8 @@ impl Built {
         if want(WrapperKind::Obb) {
             stop.check()?;
             let hulls = b.hulls.as_ref().map(|(h, _)| h.as_slice());
-            b.obbs = Some(timed(|| obb_tree(tree, scene, hulls)));
+            let (obbs, t) = timed(|| obb_tree_until(tree, scene, hulls, stop));
+            b.obbs = Some((obbs?, t));
         }
         Ok(b)
     }
@@ -134,9 +137,14 @@ impl Built {
 
 /// Checks that every vertex below each node is inside its wrapper: hulls within
 /// [`HULL_TOL_REL`] × the node's AABB diameter, the others within [`TOL_REL`] × the scene
-/// diagonal.
-pub fn containment(tree: &SubsetTree, scene: &Scene, w: WrapperTree<'_>) -> Containment {
-    let excess = containment_excess(tree, scene, w);
+/// diagonal. [`Interrupted`] once `stop` is requested.
+pub fn containment(
+    tree: &SubsetTree,
+    scene: &Scene,
+    w: WrapperTree<'_>,
+    stop: &Stop,
+) -> Result<Containment, Interrupted> {
+    let excess = containment_excess_until(tree, scene, w, stop)?;
     let diagonal = scene.aabb().diameter();
     let (rule, tol): (&str, Box<dyn Fn(usize) -> f64>) = match w {
         WrapperTree::Hulls(_) => (
@@ -148,7 +156,7 @@ pub fn containment(tree: &SubsetTree, scene: &Scene, w: WrapperTree<'_>) -> Cont
     let worst =
         (0..excess.len()).max_by(|&a, &b| (excess[a] - tol(a)).total_cmp(&(excess[b] - tol(b))));
     let max_excess = excess.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    match worst {
+    Ok(match worst {
         Some(i) => Containment {
             max_excess,
             tolerance_rule: rule,
@@ -163,7 +171,7 @@ pub fn containment(tree: &SubsetTree, scene: &Scene, w: WrapperTree<'_>) -> Cont
             excess_at_worst: max_excess,
             holds: true,
         },
-    }
+    })
 }
 
 /// Builds the Wrapper Trees of `kinds` (each once, in [`WrapperKind`] order) over `tree` and
@@ -171,8 +179,8 @@ pub fn containment(tree: &SubsetTree, scene: &Scene, w: WrapperTree<'_>) -> Cont
 /// `how.samples` surface samples per wrapper, the error measured on every leaf and at most
 /// `how.per_depth` interior nodes per depth ([`level_tightness_sampled`], seed
 /// [`SAMPLE_SEED`]; 0: every node), spheres by `how.method`. The reference volumes are the
-/// hulls', built untimed when not asked for. `stop` is obeyed before each wrapper tree is built
-/// and before each kind's containment and tightness are measured.
+/// hulls', built untimed when not asked for. `stop` is obeyed throughout (every builder and
+/// measure checks it as it goes).
 pub fn report(
     tree: &SubsetTree,
     scene: &Scene,
@@ -201,9 +209,7 @@ pub fn report(
         .trees()
         .into_iter()
         .map(|(w, build_seconds)| {
-            stop.check()?;
-            let containment = containment(tree, scene, w);
-            stop.check()?;
+            let containment = containment(tree, scene, w, stop)?;
             Ok(KindReport {
                 kind: w.kind(),
                 build_seconds,
@@ -215,7 +221,8 @@ pub fn report(
                     hulls,
                     samples,
                     (per_depth, SAMPLE_SEED),
-                ),
+                    stop,
+                )?,
             })
         })
         .collect()

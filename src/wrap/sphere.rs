@@ -3,6 +3,7 @@
 use crate::geom::{P3, Sphere};
 use crate::grouping::SubsetTree;
 use crate::scene::Scene;
+use crate::stop::{Interrupted, Stop};
 use crate::wrap::{LeafOrder, welzl};
 
 /// How a sphere Wrapper Tree is computed.
@@ -38,10 +39,28 @@ pub enum SphereMethod {
 /// tree of depth O(log N) (§2.4). All are `f64`; every radius is at least the distance from
 /// the centre to the farthest vertex below, so containment is exact up to rounding.
 pub fn sphere_tree(tree: &SubsetTree, scene: &Scene, method: SphereMethod) -> Vec<Sphere> {
+    match sphere_tree_until(tree, scene, method, &Stop::new()) {
+        Ok(spheres) => spheres,
+        Err(Interrupted) => unreachable!("a new stop token is never set"),
+    }
+}
+
+/// [`sphere_tree`], checking `stop` at every node of the per-node methods, else every
+/// [`STRIDE`](crate::stop::STRIDE) leaves.
+pub fn sphere_tree_until(
+    tree: &SubsetTree,
+    scene: &Scene,
+    method: SphereMethod,
+    stop: &Stop,
+) -> Result<Vec<Sphere>, Interrupted> {
     let per_node = |f: fn(&[P3]) -> Sphere| {
         let order = LeafOrder::new(tree, scene);
         (0..tree.len() as u32)
-            .map(|x| f(order.node_points(x)))
+            .map(|x| {
+                // Every node: a node near the root alone visits most of the scene.
+                stop.check()?;
+                Ok(f(order.node_points(x)))
+            })
             .collect()
     };
     match method {
@@ -57,6 +76,7 @@ pub fn sphere_tree(tree: &SubsetTree, scene: &Scene, method: SphereMethod) -> Ve
         })
         .collect();
     for (leaf, s) in out.iter_mut().enumerate().take(n) {
+        stop.check_every(leaf)?;
         let c = s.center;
         s.radius = scene
             .prim_vertices(leaf)
@@ -71,6 +91,7 @@ pub fn sphere_tree(tree: &SubsetTree, scene: &Scene, method: SphereMethod) -> Ve
         }
         SphereMethod::AabbCenter => {
             for leaf in 0..n {
+                stop.check_every(leaf)?;
                 let mut node = tree.parent[leaf];
                 while node != crate::grouping::NONE {
                     let c = out[node as usize].center;
@@ -86,5 +107,5 @@ pub fn sphere_tree(tree: &SubsetTree, scene: &Scene, method: SphereMethod) -> Ve
         }
         SphereMethod::Ritter | SphereMethod::Minimum => {}
     }
-    out
+    Ok(out)
 }

@@ -26,6 +26,7 @@ use super::obb::Obb;
 use crate::geom::{P3, Sphere, V3};
 use crate::grouping::SubsetTree;
 use crate::scene::Scene;
+use crate::stop::{Interrupted, Stop};
 use rayon::prelude::*;
 use std::cmp::Ordering::Greater;
 
@@ -72,21 +73,23 @@ pub struct NodeStats {
 }
 
 /// Tightness of every node of `w`; `hulls` is the hull Wrapper Tree of the same tree (the
-/// reference volumes).
+/// reference volumes). [`Interrupted`] once `stop` is requested.
 pub fn node_tightness(
     tree: &SubsetTree,
     scene: &Scene,
     w: WrapperTree<'_>,
     hulls: &[Hull],
     samples: usize,
-) -> Vec<NodeStats> {
+    stop: &Stop,
+) -> Result<Vec<NodeStats>, Interrupted> {
     let all: Vec<u32> = (0..tree.len() as u32).collect();
-    nodes_tightness(tree, scene, w, hulls, samples, &all, usize::MAX)
+    nodes_tightness(tree, scene, w, hulls, samples, &all, usize::MAX, stop)
 }
 
 /// Tightness of the nodes `nodes` of `w`, in that order, each sample's query stopping after
 /// `max_visits` node visits (see [`point_node_within`]); the nodes are measured in parallel,
-/// with the same result for any thread count.
+/// with the same result for any thread count. `stop` is checked before each node.
+#[allow(clippy::too_many_arguments)]
 pub fn nodes_tightness(
     tree: &SubsetTree,
     scene: &Scene,
@@ -95,12 +98,14 @@ pub fn nodes_tightness(
     samples: usize,
     nodes: &[u32],
     max_visits: usize,
-) -> Vec<NodeStats> {
+    stop: &Stop,
+) -> Result<Vec<NodeStats>, Interrupted> {
     nodes
         .par_iter()
         .map_init(
             || (Vec::with_capacity(samples), Vec::new()),
             |(pts, stack), &x| {
+                stop.check()?;
                 let i = x as usize;
                 pts.clear();
                 let volume = surface_samples(w, i, samples, pts);
@@ -108,11 +113,11 @@ pub fn nodes_tightness(
                     .iter()
                     .map(|p| point_node_within(tree, scene, x, p, stack, max_visits))
                     .fold(0.0, f64::max);
-                NodeStats {
+                Ok(NodeStats {
                     volume,
                     reference_volume: reference_volume(tree, hulls, i),
                     error,
-                }
+                })
             },
         )
         .collect()
@@ -210,6 +215,7 @@ fn wrapper_volume(w: WrapperTree<'_>, i: usize) -> f64 {
 /// [`MAX_VISITS`] node visits) and on every leaf; `per_depth` 0 measures every node exactly
 /// ([`level_tightness`]). Volumes and nodes are exact; a level's error mean is the leaves' mean
 /// and its depth's sample mean weighted by their counts, its error max the largest measured.
+/// [`Interrupted`] once `stop` is requested.
 pub fn level_tightness_sampled(
     tree: &SubsetTree,
     scene: &Scene,
@@ -217,14 +223,15 @@ pub fn level_tightness_sampled(
     hulls: &[Hull],
     samples: usize,
     (per_depth, seed): (usize, u64),
-) -> Vec<LevelStats> {
+    stop: &Stop,
+) -> Result<Vec<LevelStats>, Interrupted> {
     if per_depth == 0 {
-        return level_tightness(tree, scene, w, hulls, samples);
+        return level_tightness(tree, scene, w, hulls, samples, stop);
     }
     let sample = DepthSample::new(tree, per_depth, seed);
     let mut measured: Vec<u32> = (0..tree.leaves() as u32).collect();
     measured.extend(sample.flat());
-    let stats = nodes_tightness(tree, scene, w, hulls, samples, &measured, MAX_VISITS);
+    let stats = nodes_tightness(tree, scene, w, hulls, samples, &measured, MAX_VISITS, stop)?;
     let mut error = vec![None; tree.len()];
     for (&x, s) in measured.iter().zip(&stats) {
         error[x as usize] = Some(s.error);
@@ -236,7 +243,7 @@ pub fn level_tightness_sampled(
             error: error[i].unwrap_or(0.0),
         })
         .collect();
-    (0..=tree.depth_max())
+    Ok((0..=tree.depth_max())
         .map(|d| {
             let mut level = levels_of(tree, &nodes, d);
             let cut = tree.level(d);
@@ -260,7 +267,7 @@ pub fn level_tightness_sampled(
             level.error_mean = (leaf_sum + inner) / cut.len().max(1) as f64;
             level
         })
-        .collect()
+        .collect())
 }
 
 /// The covered geometry's volume at node `i`: its hull's, or its AABB's where the hull is flat.
@@ -274,17 +281,19 @@ fn reference_volume(tree: &SubsetTree, hulls: &[Hull], i: usize) -> f64 {
 }
 
 /// Tightness of the cuts at depths 0..=depth max (see the [module docs](self)).
+/// [`Interrupted`] once `stop` is requested.
 pub fn level_tightness(
     tree: &SubsetTree,
     scene: &Scene,
     w: WrapperTree<'_>,
     hulls: &[Hull],
     samples: usize,
-) -> Vec<LevelStats> {
-    let nodes = node_tightness(tree, scene, w, hulls, samples);
-    (0..=tree.depth_max())
+    stop: &Stop,
+) -> Result<Vec<LevelStats>, Interrupted> {
+    let nodes = node_tightness(tree, scene, w, hulls, samples, stop)?;
+    Ok((0..=tree.depth_max())
         .map(|d| levels_of(tree, &nodes, d))
-        .collect()
+        .collect())
 }
 
 /// Aggregates per-node stats over the cut at depth `d`.
@@ -390,6 +399,19 @@ fn triangle_samples(v: &[P3], tris: &[[u32; 3]], n: usize, out: &mut Vec<P3>) {
 /// Hulls test each distinct vertex once per node (a vertex shared by several primitives counts
 /// once), as their test costs a pass over the faces.
 pub fn containment_excess(tree: &SubsetTree, scene: &Scene, w: WrapperTree<'_>) -> Vec<f64> {
+    match containment_excess_until(tree, scene, w, &Stop::new()) {
+        Ok(excess) => excess,
+        Err(Interrupted) => unreachable!("a new stop token is never set"),
+    }
+}
+
+/// [`containment_excess`], checking `stop` before each node.
+pub fn containment_excess_until(
+    tree: &SubsetTree,
+    scene: &Scene,
+    w: WrapperTree<'_>,
+    stop: &Stop,
+) -> Result<Vec<f64>, Interrupted> {
     let order = super::order::LeafOrder::new(tree, scene);
     let max = |pts: &mut dyn Iterator<Item = &P3>, f: &dyn Fn(&P3) -> f64| {
         pts.map(f).fold(f64::NEG_INFINITY, f64::max)
@@ -399,9 +421,10 @@ pub fn containment_excess(tree: &SubsetTree, scene: &Scene, w: WrapperTree<'_>) 
         .map_init(
             || vec![u32::MAX; scene.points.len()],
             |seen, x| {
+                stop.check()?;
                 let i = x as usize;
                 let mut pts = order.node_points(x).iter();
-                match w {
+                Ok(match w {
                     WrapperTree::Spheres(s) => {
                         max(&mut pts, &|p| (p - s[i].center).norm() - s[i].radius)
                     }
@@ -420,7 +443,7 @@ pub fn containment_excess(tree: &SubsetTree, scene: &Scene, w: WrapperTree<'_>) 
                         max(&mut pts, &|p| b.excess(p))
                     }
                     WrapperTree::Obbs(b) => max(&mut pts, &|p| b[i].excess(p)),
-                }
+                })
             },
         )
         .collect()

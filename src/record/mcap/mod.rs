@@ -21,13 +21,14 @@ mod read;
 pub mod scene_msgs;
 
 pub use compare::write_comparison_mcap;
-pub use read::{Recorded, read_recording, read_with_scene};
+pub use read::{Recorded, read_recording, read_with_scene, read_with_scene_until};
 
 use crate::events::{RefineParams, Step};
 use crate::geom::Aabb;
 use crate::grouping::{Event, Merge, Observer, Part};
 use crate::record::live::foxglove::McapTee;
 use crate::record::{Detail, Outcome, RunInfo};
+use crate::stop::Stop;
 use anyhow::{Context, Result, anyhow};
 use foxglove::Encode;
 use foxglove::messages::SceneUpdate;
@@ -120,6 +121,8 @@ pub struct McapRecorder<'a, W: Write + Seek> {
     all_levels: bool,
     /// Whether the scene is attached as it is (`--mcap-compression none`), not compressed.
     raw_scene: bool,
+    /// Obeyed while the scene is compressed ([`McapRecorder::set_stop`]).
+    stop: Stop,
     error: Option<anyhow::Error>,
     buf: Vec<u8>,
 }
@@ -285,6 +288,7 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             reproducible: false,
             all_levels: false,
             raw_scene: compression.is_none(),
+            stop: Stop::new(),
             error: None,
             buf: Vec::new(),
             scene_topic,
@@ -317,8 +321,8 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             let data = std::borrow::Cow::Borrowed(&source.bytes[..]);
             (source.file_name.clone(), SCENE_MEDIA_TYPE, data)
         } else {
-            let data = zstd::bulk::compress(&source.bytes, ZSTD_LEVEL as i32)
-                .context("compressing the scene")?;
+            let data =
+                compress_until(&source.bytes, &self.stop).context("compressing the scene")?;
             let name = format!("{}{ZSTD_SUFFIX}", source.file_name);
             (name, ZSTD_MEDIA_TYPE, std::borrow::Cow::Owned(data))
         };
@@ -332,6 +336,12 @@ impl<'a, W: Write + Seek> McapRecorder<'a, W> {
             })
             .context("attaching the scene")?;
         Ok(())
+    }
+
+    /// Ends the scene's compression early once `stop` is requested: [`McapRecorder::finish`]
+    /// then fails with [`Interrupted`](crate::stop::Interrupted).
+    pub fn set_stop(&mut self, stop: Stop) {
+        self.stop = stop;
     }
 
     /// Leaves out the `wraptree.timing` record, the only wall-clock value, so two recordings of
@@ -569,4 +579,17 @@ impl<W: Write + Seek> Observer for McapRecorder<'_, W> {
             self.error = Some(e);
         }
     }
+}
+
+/// `bytes` as one zstd frame at [`ZSTD_LEVEL`], fed in pieces of 1 MiB so that `stop` is seen
+/// between them.
+fn compress_until(bytes: &[u8], stop: &Stop) -> Result<Vec<u8>> {
+    let mut z = zstd::stream::Encoder::new(Vec::with_capacity(bytes.len() / 4), ZSTD_LEVEL as i32)?;
+    z.include_contentsize(true)?;
+    z.set_pledged_src_size(Some(bytes.len() as u64))?;
+    for piece in bytes.chunks(1 << 20) {
+        stop.check()?;
+        z.write_all(piece)?;
+    }
+    Ok(z.finish()?)
 }

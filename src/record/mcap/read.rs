@@ -12,7 +12,8 @@ use super::metadata;
 use crate::geom::Aabb;
 use crate::grouping::{EventLog, Merge, Part, ResolvedParams, SubsetTree};
 use crate::record::Detail;
-use crate::scene::{LoadOptions, Loaded, Scene, load_bytes};
+use crate::scene::{LoadOptions, Loaded, Scene, load_bytes_until};
+use crate::stop::{Interrupted, Stop, is_interrupted};
 use anyhow::{Context, Result, anyhow, bail};
 use mcap::records::Record;
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
@@ -206,8 +207,9 @@ fn describe(e: &mcap::McapError) -> String {
     format!("{what}: {}", one_line(e))
 }
 
-/// One validated pass over every record of `bytes`.
-fn scan(bytes: &[u8]) -> Result<Raw, String> {
+/// One validated pass over every record of `bytes`, ending early (with an error) once `stop` is
+/// requested.
+fn scan(bytes: &[u8], stop: &Stop) -> Result<Raw, String> {
     let limit = bytes.len().saturating_mul(64).max(64 << 20);
     let mut reader = LinearReader::new_with_options(
         LinearReaderOptions::default()
@@ -223,7 +225,10 @@ fn scan(bytes: &[u8]) -> Result<Raw, String> {
         ..Raw::default()
     };
     let mut rest = bytes;
+    let mut events = 0usize;
     while let Some(event) = reader.next_event() {
+        stop.check_every(events).map_err(|e| e.to_string())?;
+        events += 1;
         match event.map_err(|e| describe(&e))? {
             LinearReadEvent::ReadRequest(n) => {
                 let k = n.min(rest.len());
@@ -266,9 +271,15 @@ fn check_merges(merges: &[Merge], n: u32, complete: bool) -> Result<(), String> 
 
 /// The embedded scene loaded as recorded. Err: it does not load, or has another number of
 /// primitives than the metadata says.
-fn load_scene(name: &str, bytes: &[u8], options: &LoadOptions, primitives: u32) -> Result<Loaded> {
-    let loaded =
-        load_bytes(name, bytes.to_vec(), options).context("the embedded scene does not load")?;
+fn load_scene(
+    name: &str,
+    bytes: &[u8],
+    options: &LoadOptions,
+    primitives: u32,
+    stop: &Stop,
+) -> Result<Loaded> {
+    let loaded = load_bytes_until(name, bytes.to_vec(), options, stop)
+        .context("the embedded scene does not load")?;
     if loaded.scene.len() as u64 != u64::from(primitives) {
         bail!(
             "the embedded scene has {} primitives, the metadata says {primitives}",
@@ -292,7 +303,7 @@ fn fill_boxes(merges: &mut [Merge], boxes: &[Option<Aabb>], scene: &Scene) {
 
 /// Checks what was read against the run record, loads the embedded scene and assembles the
 /// [`Recorded`] run.
-fn interpret(mut raw: Raw) -> Result<(Recorded, Loaded)> {
+fn interpret(mut raw: Raw, stop: &Stop) -> Result<(Recorded, Loaded)> {
     let (m, timing) = run_and_timing(raw.metadata)?;
     // Older recordings' settings filled in, once; a newer format is an error here.
     let m = metadata::current_form(m)?;
@@ -309,7 +320,13 @@ fn interpret(mut raw: Raw) -> Result<(Recorded, Loaded)> {
             false => None,
         },
     };
-    let loaded = load_scene(&scene_file_name, &scene_bytes, &load_options, primitives)?;
+    let loaded = load_scene(
+        &scene_file_name,
+        &scene_bytes,
+        &load_options,
+        primitives,
+        stop,
+    )?;
     fill_boxes(&mut raw.merges, &raw.boxes, &loaded.scene);
     let refine = metadata::refine(&m)?;
     check_refine_steps(&raw.refine, refine.map_or(0, |r| r.steps as usize))?;
@@ -444,11 +461,22 @@ pub fn read_recording(path: &Path) -> Result<Recorded> {
 /// ([`read_recording`]); an embedded scene that does not load or does not match the metadata is
 /// one error line too.
 pub fn read_with_scene(path: &Path) -> Result<(Recorded, Loaded)> {
+    read_with_scene_until(path, &Stop::new())
+}
+
+/// [`read_with_scene`], its passes checking `stop` (Err: [`Interrupted`]).
+pub fn read_with_scene_until(path: &Path, stop: &Stop) -> Result<(Recorded, Loaded)> {
     let name = path.display();
     let bytes =
         std::fs::read(path).map_err(|e| anyhow!("{name}: cannot read: {}", one_line(&e)))?;
-    let raw = scan(&bytes).map_err(|e| anyhow!("{name}: {e}"))?;
-    interpret(raw).map_err(|e| {
+    let raw = match scan(&bytes, stop) {
+        Err(_) if stop.is_requested() => return Err(Interrupted.into()),
+        raw => raw.map_err(|e| anyhow!("{name}: {e}"))?,
+    };
+    interpret(raw, stop).map_err(|e| {
+        if is_interrupted(&e) {
+            return e;
+        }
         anyhow!(
             "{name}: {}",
             format!("{e:#}")

@@ -73,7 +73,8 @@ impl Envelope {
         keep.dedup();
         for r in keep {
             self.ticks.push(self.open_ticks[r]);
-            self.values.extend_from_slice(&self.open[r * s..(r + 1) * s]);
+            self.values
+                .extend_from_slice(&self.open[r * s..(r + 1) * s]);
         }
         self.open_ticks.clear();
         self.open.clear();
@@ -161,7 +162,11 @@ mod tests {
             sent.1.extend(b);
             let (ticks, values) = sent;
             assert!(ticks.len() <= ROWS_MAX, "{scalars}: {} rows", ticks.len());
-            assert!(ticks.len() > ROWS_MAX / 2, "{scalars}: {} rows", ticks.len());
+            assert!(
+                ticks.len() > ROWS_MAX / 2,
+                "{scalars}: {} rows",
+                ticks.len()
+            );
             assert!(ticks.windows(2).all(|w| w[0] < w[1]), "merge order");
             assert_eq!(ticks[0], 0, "the first row");
             assert!(ticks.contains(&spike), "the peak");

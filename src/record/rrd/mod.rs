@@ -20,8 +20,8 @@
 
 mod blueprint;
 mod columns;
-mod envelope;
 mod compare;
+mod envelope;
 mod header;
 mod levels;
 mod mesh;

@@ -4,6 +4,8 @@
 use std::hash::BuildHasher;
 
 use crate::geom::P3;
+use crate::scene::LoadErrorKind;
+use crate::stop::Stop;
 
 /// One OBJ object/group: its name and its faces as indices into the scene's points.
 pub(super) struct Group {
@@ -27,13 +29,20 @@ pub(super) const INDEX_SPLIT: u64 = 1 << 20;
 /// Moves `tobj`'s models into `points` (merging bit-identical positions) and returns the groups.
 ///
 /// `coords` are the file's vertices as parsed by [`scan`](super::scan); `tobj`'s positions
-/// only carry the vertex indices (see [`scan`](super::scan)).
+/// only carry the vertex indices (see [`scan`](super::scan)). `stop` is checked every
+/// [`STRIDE`](crate::stop::STRIDE) positions (Err: [`LoadErrorKind::Interrupted`]).
 pub(super) fn collect_groups(
     models: &[tobj::Model],
     coords: &[[f64; 3]],
     points: &mut Vec<P3>,
-) -> Result<Vec<Group>, String> {
-    let malformed = |what: &str| format!("not a valid OBJ file ({what})");
+    stop: &Stop,
+) -> Result<Vec<Group>, (LoadErrorKind, String)> {
+    let malformed = |what: &str| {
+        (
+            LoadErrorKind::Malformed,
+            format!("not a valid OBJ file ({what})"),
+        )
+    };
     // The distinct coordinates as a table of point ids (4 bytes a slot, not a key's 28: at 3×10^6
     // vertices the table stays in 16 MB), compared through `points`.
     let hasher = foldhash::fast::FixedState::with_seed(0);
@@ -47,7 +56,9 @@ pub(super) fn collect_groups(
     for model in models {
         let mesh = &model.mesh;
         let mut local = Vec::with_capacity(mesh.positions.len() / 3);
-        for c in mesh.positions.chunks_exact(3) {
+        for (k, c) in mesh.positions.chunks_exact(3).enumerate() {
+            stop.check_every(k)
+                .map_err(|e| (LoadErrorKind::Interrupted, e.to_string()))?;
             let file = (f64::from(c[1]) as u64 * INDEX_SPLIT + f64::from(c[0]) as u64) as usize;
             let slot = of_file
                 .get_mut(file)
@@ -114,7 +125,13 @@ mod tests {
         // Vertex 4 repeats 2 (with −0), 5 repeats 3, 6 is unused; the first face uses 4, 5, 7.
         let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 -0\nv 0 1 0\nv 5 5 5\nv 0 0 1\n\
                    o a\nf 4 5 7\no b\nf 1 2 3\n";
-        let l = load("dup.obj", obj.as_bytes().to_vec(), &LoadOptions::default()).unwrap();
+        let l = load(
+            "dup.obj",
+            obj.as_bytes().to_vec(),
+            &LoadOptions::default(),
+            &crate::stop::Stop::new(),
+        )
+        .unwrap();
         let want = [
             [1.0, 0.0, 0.0],
             [0.0, 1.0, 0.0],

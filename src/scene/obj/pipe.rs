@@ -216,8 +216,15 @@ mod tests {
             let shown = |r: Result<super::super::Loaded, _>| {
                 r.map(|l| format!("{:?} {:?} {}", l.scene, l.warnings, l.source.sha256))
             };
-            let at_once = shown(load_piped_from("soup.obj", bytes.clone(), &opts, 0));
-            let in_turn = shown(load_piped_from("soup.obj", bytes, &opts, usize::MAX));
+            let never = crate::stop::Stop::new();
+            let at_once = shown(load_piped_from("soup.obj", bytes.clone(), &opts, 0, &never));
+            let in_turn = shown(load_piped_from(
+                "soup.obj",
+                bytes,
+                &opts,
+                usize::MAX,
+                &never,
+            ));
             assert_eq!(at_once, in_turn);
             at_once
         };

@@ -135,9 +135,10 @@ mod tests {
     use super::*;
     use crate::scene::faces::build;
     use crate::scene::input::{LoadOptions, Up};
+    use crate::stop::Stop;
 
     fn count(f: Faces) -> usize {
-        let b = build("s.urdf", f, &LoadOptions::default(), Up::Z).unwrap();
+        let b = build("s.urdf", f, &LoadOptions::default(), Up::Z, &Stop::new()).unwrap();
         assert!(b.warnings.is_empty(), "{:?}", b.warnings);
         b.scene.len()
     }

@@ -84,7 +84,7 @@ pub struct Solved {
 /// The cover of `tree` within `limit`, choosing among `kinds` (spheres by
 /// [`SphereMethod::Minimum`], [`DEFAULT_SAMPLES`] surface samples per wrapper). Hulls are always
 /// built, as the reference the errors need. Err: a budget of 0, or [`Interrupted`] when `stop`
-/// is requested (checked after the wrappers are built and before each kind is measured).
+/// is requested (checked throughout).
 pub fn solve(
     tree: &SubsetTree,
     scene: &Scene,
@@ -96,8 +96,7 @@ pub fn solve(
     if !build.contains(&WrapperKind::Hull) {
         build.push(WrapperKind::Hull);
     }
-    let mut wrappers = Wrappers::build(tree, scene, &build, SphereMethod::Minimum);
-    stop.check()?;
+    let mut wrappers = Wrappers::build_until(tree, scene, &build, SphereMethod::Minimum, stop)?;
     let hulls = if kinds.contains(&WrapperKind::Hull) {
         None
     } else {
