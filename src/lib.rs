@@ -47,5 +47,6 @@ pub mod refine;
 pub mod render;
 pub mod replay;
 pub mod scene;
+pub mod spherize;
 pub mod stop;
 pub mod wrap;
