@@ -211,6 +211,15 @@ impl SpherizeCmd {
                 }
             }
         }
+        if !self.no_record {
+            let (rrd, mcap) = (with_ext(&prefix, ".rrd"), with_ext(&prefix, ".mcap"));
+            written.extend(wraptree::record::spherize::record_spherized(
+                &done,
+                Some(&rrd),
+                Some(&mcap),
+                self.force,
+            )?);
+        }
         if self.json {
             println!("{}", serde_json::to_string_pretty(&report)?);
         } else {

@@ -8,6 +8,13 @@
 //! says nothing about how well it hugs the surface. The distance is to the whole link, not just
 //! the node's pieces, so the largest node excess of a cover bounds the cover's outer excess up
 //! to sampling.
+//!
+//! **Tighter spheres.** The smallest enclosing sphere of a patch of surface is centred on the
+//! patch, so half of it stands out of the link. When a node's pieces face one way (their
+//! area-weighted normals sum to at least [`FACING`] of their area), spheres centred deeper
+//! along the inward normal ([`DEPTHS`] × the smallest radius), each just large enough to hold
+//! the node's vertices, are measured too, and the one of least excess is kept: still
+//! conservative, and closer to the surface outside.
 
 use rayon::prelude::*;
 
@@ -16,7 +23,13 @@ use crate::grouping::{self, Params, SubsetTree};
 use crate::scene::Scene;
 use crate::stop::{Interrupted, Stop};
 use crate::wrap::distance::{point_aabb, point_node, point_prim};
-use crate::wrap::{SphereMethod, sphere_tree};
+use crate::wrap::{LeafOrder, SphereMethod, sphere_tree};
+
+/// Depths (times the smallest enclosing radius) of the candidate centres along a node's
+/// inward normal.
+pub const DEPTHS: [f64; 7] = [0.0, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0];
+/// Share of a node's area its normals must sum to for deeper centres to be tried.
+pub const FACING: f64 = 0.2;
 
 /// Nodes measured between two checks of the stop request.
 const CHUNK: usize = 256;
@@ -29,12 +42,16 @@ pub struct LinkTree {
     pub mesh: Scene,
     /// The Subset Tree over `mesh`.
     pub tree: SubsetTree,
-    /// The smallest enclosing sphere of every node's vertices.
+    /// Every node's sphere: the smallest enclosing one, or once measured the best candidate.
     pub spheres: Vec<Sphere>,
     /// Every sphere's excess, NaN until measured.
     pub excess: Vec<f64>,
     /// Each piece's unit normal (zero when degenerate).
     normals: Vec<V3>,
+    /// Every node's area-weighted normal sum and area.
+    facing: Vec<(V3, f64)>,
+    /// Every node's vertices.
+    order: LeafOrder,
     /// The sample directions.
     dirs: Vec<V3>,
 }
@@ -87,7 +104,31 @@ impl LinkTree {
         stop.check()?;
         let spheres = sphere_tree(&tree, &mesh, SphereMethod::Minimum);
         let normals = prim_normals(&mesh);
+        let n = tree.leaves();
+        let mut facing: Vec<(V3, f64)> = (0..tree.len())
+            .map(|x| {
+                if x >= n {
+                    return (V3::zeros(), 0.0);
+                }
+                let area: f64 = mesh
+                    .prim_tris(x)
+                    .iter()
+                    .map(|t| {
+                        let p = t.map(|v| mesh.points[v as usize]);
+                        (p[1] - p[0]).cross(&(p[2] - p[0])).norm() / 2.0
+                    })
+                    .sum();
+                (normals[x] * area, area)
+            })
+            .collect();
+        for (i, [a, b]) in tree.children.iter().enumerate() {
+            let (fa, fb) = (facing[*a as usize], facing[*b as usize]);
+            facing[n + i] = (fa.0 + fb.0, fa.1 + fb.1);
+        }
+        let order = LeafOrder::new(&tree, &mesh);
         Ok(LinkTree {
+            facing,
+            order,
             excess: vec![f64::NAN; spheres.len()],
             mesh,
             tree,
@@ -149,7 +190,34 @@ impl LinkTree {
             .fold(0.0, f64::max)
     }
 
-    /// Measures the excess of every node of `nodes` not measured yet, in parallel.
+    /// The sphere of least excess for node `x` among the candidates (see the module), and its
+    /// excess.
+    pub fn best_sphere(&self, x: u32, stack: &mut Vec<u32>) -> (Sphere, f64) {
+        let base = self.spheres[x as usize];
+        let mut best = (base, self.sphere_excess(&base, stack));
+        let (sum, area) = self.facing[x as usize];
+        if !(sum.norm() >= FACING * area && area > 0.0) || base.radius <= 0.0 {
+            return best;
+        }
+        let inward = -sum.normalize();
+        let points = self.order.node_points(x);
+        for &k in &DEPTHS[1..] {
+            let center = base.center + inward * (k * base.radius);
+            let radius = points
+                .iter()
+                .map(|p| (p - center).norm())
+                .fold(0.0, f64::max);
+            let s = Sphere { center, radius };
+            let e = self.sphere_excess(&s, stack);
+            if e < best.1 {
+                best = (s, e);
+            }
+        }
+        best
+    }
+
+    /// Measures the excess of every node of `nodes` not measured yet, in parallel, keeping
+    /// each one's best sphere.
     pub fn measure(&mut self, nodes: &[u32], stop: &Stop) -> Result<(), Interrupted> {
         let todo: Vec<u32> = nodes
             .iter()
@@ -159,14 +227,13 @@ impl LinkTree {
         for chunk in todo.chunks(CHUNK) {
             stop.check()?;
             let this = &*self;
-            let values: Vec<f64> = chunk
+            let values: Vec<(Sphere, f64)> = chunk
                 .par_iter()
-                .map_init(Vec::new, |stack, &x| {
-                    this.sphere_excess(&this.spheres[x as usize], stack)
-                })
+                .map_init(Vec::new, |stack, &x| this.best_sphere(x, stack))
                 .collect();
-            for (&x, v) in chunk.iter().zip(values) {
-                self.excess[x as usize] = v;
+            for (&x, (s, e)) in chunk.iter().zip(values) {
+                self.spheres[x as usize] = s;
+                self.excess[x as usize] = e;
             }
         }
         Ok(())

@@ -36,7 +36,7 @@ use score::Score;
 /// Boundary samples per sphere when measuring a node's excess.
 pub const NODE_SAMPLES: usize = 64;
 /// Pieces are cut to edges of at most a link's box diagonal over this.
-pub const PIECES_PER_DIAGONAL: f64 = 16.0;
+pub const PIECES_PER_DIAGONAL: f64 = 8.0;
 /// Levels of every tree measured for the recording (depth ≤ this).
 pub const SHOWN_DEPTH: u32 = 6;
 /// Pieces are never cut below a link's box diagonal over this.
@@ -239,7 +239,14 @@ pub fn score_set(links: &[Link], set: &SphereSet, stop: &Stop) -> Result<Score> 
         let spheres = set.get(&l.name).map(Vec::as_slice).unwrap_or(&[]);
         per.push(score::score_link(&l.name, &l.mesh, &tree, &l.mesh, spheres));
     }
-    Ok(score::total(per))
+    let mut s = score::total(per);
+    for (name, spheres) in set {
+        if !links.iter().any(|l| l.name == *name) && !spheres.is_empty() {
+            s.spheres += spheres.len();
+            s.links_not_in_robot.push(name.clone());
+        }
+    }
+    Ok(s)
 }
 
 /// What `wraptree spherize` writes as JSON: the settings, the allocation, each link's tree
@@ -367,13 +374,22 @@ impl Report {
 
 /// The printed summary of a score (`wraptree spherize --score`).
 pub fn score_text(name: &str, s: &Score) -> String {
+    let extra = if s.links_not_in_robot.is_empty() {
+        String::new()
+    } else {
+        format!(
+            " (and on {} links without geometry: {})",
+            s.links_not_in_robot.len(),
+            s.links_not_in_robot.join(", ")
+        )
+    };
     let outside = if s.outside_max > score::SLACK {
         format!("{:.1} mm", s.outside_max * 1000.0)
     } else {
         "—".into()
     };
     format!(
-        "{name}: {} spheres on {}/{} links, uncovered {:.2} % (deepest {outside} outside), excess \
+        "{name}: {} spheres on {}/{} links{extra}, uncovered {:.2} % (deepest {outside} outside), excess \
          max {:.1} mm mean {:.1} mm, volume {:.2}× the mesh's\n",
         s.spheres,
         s.links - s.links_without_spheres.len(),

@@ -67,6 +67,9 @@ pub struct Score {
     pub links: usize,
     /// Links with geometry and no sphere.
     pub links_without_spheres: Vec<String>,
+    /// Links of the set without geometry in the robot (their spheres count in `spheres`, and
+    /// are scored against nothing).
+    pub links_not_in_robot: Vec<String>,
     /// Share of all points outside every sphere of their link.
     pub uncovered: f64,
     /// Deepest point outside over all links.
@@ -238,6 +241,7 @@ pub fn total(per_link: Vec<LinkScore>) -> Score {
             .filter(|l| l.spheres == 0)
             .map(|l| l.link.clone())
             .collect(),
+        links_not_in_robot: Vec::new(),
         uncovered: unc / points.max(1) as f64,
         outside_max: per_link
             .iter()
