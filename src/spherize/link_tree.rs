@@ -13,8 +13,9 @@
 //! patch, so half of it stands out of the link. When a node's pieces face one way (their
 //! area-weighted normals sum to at least [`FACING`] of their area), spheres centred deeper
 //! along the inward normal ([`DEPTHS`] × the smallest radius), each just large enough to hold
-//! the node's vertices, are measured too, and the one of least excess is kept: still
-//! conservative, and closer to the surface outside.
+//! the node's vertices, are measured too; of those within [`MEAN_SLACK`] of the least excess,
+//! the one of least mean distance outside is kept: still conservative, and closer to the
+//! surface outside.
 
 use rayon::prelude::*;
 
@@ -28,6 +29,9 @@ use crate::wrap::{LeafOrder, SphereMethod, sphere_tree};
 /// Depths (times the smallest enclosing radius) of the candidate centres along a node's
 /// inward normal.
 pub const DEPTHS: [f64; 7] = [0.0, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0];
+/// A candidate sphere within this share of a node's least excess may be kept for a smaller
+/// mean distance outside.
+pub const MEAN_SLACK: f64 = 0.1;
 /// Share of a node's area its normals must sum to for deeper centres to be tried.
 pub const FACING: f64 = 0.2;
 
@@ -182,38 +186,49 @@ impl LinkTree {
     /// The excess of sphere `s`: the largest distance to the surface of its sample points
     /// outside the link (0 when none is).
     pub fn sphere_excess(&self, s: &Sphere, stack: &mut Vec<u32>) -> f64 {
-        self.dirs
-            .iter()
-            .map(|d| self.signed(&(s.center + d * s.radius), stack))
-            .filter(|&(_, out)| out)
-            .map(|(d, _)| d)
-            .fold(0.0, f64::max)
+        self.excess_stats(s, stack).0
     }
 
-    /// The sphere of least excess for node `x` among the candidates (see the module), and its
-    /// excess.
-    pub fn best_sphere(&self, x: u32, stack: &mut Vec<u32>) -> (Sphere, f64) {
-        let base = self.spheres[x as usize];
-        let mut best = (base, self.sphere_excess(&base, stack));
-        let (sum, area) = self.facing[x as usize];
-        if !(sum.norm() >= FACING * area && area > 0.0) || base.radius <= 0.0 {
-            return best;
-        }
-        let inward = -sum.normalize();
-        let points = self.order.node_points(x);
-        for &k in &DEPTHS[1..] {
-            let center = base.center + inward * (k * base.radius);
-            let radius = points
-                .iter()
-                .map(|p| (p - center).norm())
-                .fold(0.0, f64::max);
-            let s = Sphere { center, radius };
-            let e = self.sphere_excess(&s, stack);
-            if e < best.1 {
-                best = (s, e);
+    /// The largest and the mean distance to the surface of the sample points of `s` outside
+    /// the link (0 when none is), the mean over all samples.
+    fn excess_stats(&self, s: &Sphere, stack: &mut Vec<u32>) -> (f64, f64) {
+        let (mut max, mut sum) = (0.0f64, 0.0);
+        for d in &self.dirs {
+            let (dist, out) = self.signed(&(s.center + d * s.radius), stack);
+            if out {
+                max = max.max(dist);
+                sum += dist;
             }
         }
-        best
+        (max, sum / self.dirs.len().max(1) as f64)
+    }
+
+    /// The sphere for node `x` among the candidates (see the module) and its excess: of those
+    /// within [`MEAN_SLACK`] of the least excess, the one of least mean distance outside.
+    pub fn best_sphere(&self, x: u32, stack: &mut Vec<u32>) -> (Sphere, f64) {
+        let base = self.spheres[x as usize];
+        let mut found = vec![(base, self.excess_stats(&base, stack))];
+        let (sum, area) = self.facing[x as usize];
+        if sum.norm() >= FACING * area && area > 0.0 && base.radius > 0.0 {
+            let inward = -sum.normalize();
+            let points = self.order.node_points(x);
+            for &k in &DEPTHS[1..] {
+                let center = base.center + inward * (k * base.radius);
+                let radius = points
+                    .iter()
+                    .map(|p| (p - center).norm())
+                    .fold(0.0, f64::max);
+                let s = Sphere { center, radius };
+                found.push((s, self.excess_stats(&s, stack)));
+            }
+        }
+        let least = found.iter().map(|f| f.1.0).fold(f64::INFINITY, f64::min);
+        let (s, (max, _)) = found
+            .into_iter()
+            .filter(|f| f.1.0 <= least * (1.0 + MEAN_SLACK))
+            .min_by(|a, b| a.1.1.total_cmp(&b.1.1))
+            .expect("the least is among them");
+        (s, max)
     }
 
     /// Measures the excess of every node of `nodes` not measured yet, in parallel, keeping
