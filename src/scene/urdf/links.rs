@@ -1,5 +1,5 @@
 //! A robot's links each in its own frame: the geometry the URDF loader yields (posed by the
-//! joints, [`super::read`]), moved back by the inverse of each link's pose. Whatever mesh
+//! joints), moved back by the inverse of each link's pose. Whatever mesh
 //! formats the loader reads, this reads too.
 
 use std::path::{Path, PathBuf};
