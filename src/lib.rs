@@ -16,6 +16,7 @@
 //! | `bench` | [`metrics::compare::evaluate`], [`metrics::bench`] | [`metrics::report::bench_table`], [`metrics::report::target_line`], … |
 //! | `sweep` | [`metrics::sweep::sweep`] | [`metrics::report::sweep_table`] |
 //! | `stress` | [`metrics::stress::run`] | [`metrics::report::stress_table`] |
+//! | `spherize` | [`spherize::spherize`], [`spherize::score_set`], [`record::spherize::record_spherized`] | [`spherize::Report::text`], [`spherize::score_text`] |
 //! | `scene` | [`scene::generate::by_name`] | |
 //!
 //! Group a scene and ask the tree for the distance from a point (as `examples/query_tree.rs`):
@@ -47,5 +48,6 @@ pub mod refine;
 pub mod render;
 pub mod replay;
 pub mod scene;
+pub mod spherize;
 pub mod stop;
 pub mod wrap;

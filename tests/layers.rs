@@ -13,6 +13,7 @@ const LAYERS: &[&[&str]] = &[
     &["refine"],
     &["wrap"],
     &["query"],
+    &["spherize"],
     &["peers"],
     &["record"],
     &["replay"],

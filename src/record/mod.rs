@@ -13,6 +13,7 @@ pub mod mcap;
 mod options;
 pub mod rrd;
 mod run;
+pub mod spherize;
 mod summary;
 
 pub use run::{RecordOptions, Written, record};

@@ -23,6 +23,7 @@
 //! missing link, a link with two parents, a loop, no or several roots, a `--joint` naming no
 //! joint or a fixed one, a mesh that cannot be found or read (naming the link and the mesh).
 
+pub mod links;
 pub mod shapes;
 
 use std::collections::HashMap;

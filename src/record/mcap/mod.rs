@@ -19,6 +19,7 @@ pub mod messages;
 pub mod metadata;
 mod read;
 pub mod scene_msgs;
+pub(crate) mod spherize;
 
 pub use compare::write_comparison_mcap;
 pub use read::{Recorded, read_recording, read_with_scene, read_with_scene_until};

@@ -29,6 +29,7 @@ mod parts;
 mod refine;
 mod series_file;
 mod sink;
+pub(crate) mod spherize;
 
 pub use compare::write_comparison_rrd;
 pub use series_file::SeriesFile;

@@ -1,0 +1,82 @@
+//! The `.rrd` of a spherize run ([`crate::record::spherize`]): `robot/<link>/mesh`,
+//! `robot/<link>/spheres` (static), `levels/<link>` on the `level` timeline and
+//! `allocation/threshold`, `allocation/spheres` on the `probe` timeline.
+
+use std::path::{Path, PathBuf};
+
+use rerun::components::FillMode;
+
+use super::series_file::SeriesFile;
+use super::{send_at, send_static};
+use crate::geom::Sphere;
+use crate::record::spherize::View;
+
+fn rgba(c: [f64; 4]) -> rerun::Color {
+    let b = |x: f64| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
+    rerun::Color::from_unmultiplied_rgba(b(c[0]), b(c[1]), b(c[2]), b(c[3]))
+}
+
+fn spheres(list: &[(Sphere, [f64; 4])]) -> rerun::Ellipsoids3D {
+    let centers: Vec<[f32; 3]> = list
+        .iter()
+        .map(|(s, _)| [s.center.x as f32, s.center.y as f32, s.center.z as f32])
+        .collect();
+    let radii: Vec<f32> = list.iter().map(|(s, _)| s.radius as f32).collect();
+    rerun::Ellipsoids3D::from_centers_and_radii(centers, radii)
+        .with_colors(list.iter().map(|(_, c)| rgba(*c)))
+        .with_fill_mode(FillMode::TransparentFillMajorWireframe)
+}
+
+/// Writes `view` to `dest` (replaced only with `force`); returns its path.
+pub fn write(view: &View, dest: &Path, force: bool) -> anyhow::Result<PathBuf> {
+    let file = SeriesFile::create(dest, "wraptree-spherize", force, None)?;
+    let rec = file.rec();
+    send_static(
+        rec,
+        "spherize/summary",
+        &rerun::TextLog::new(view.summary.clone()),
+    )?;
+    for l in &view.links {
+        let m = &l.mesh;
+        let positions: Vec<[f32; 3]> = m
+            .points
+            .iter()
+            .map(|p| [p.x as f32, p.y as f32, p.z as f32])
+            .collect();
+        let mesh = rerun::Mesh3D::new(positions)
+            .with_triangle_indices(m.tris.iter().copied())
+            .with_albedo_factor(rerun::Rgba32::from_unmultiplied_rgba(200, 200, 200, 255));
+        send_static(rec, &format!("robot/{}/mesh", l.name), &mesh)?;
+        send_static(
+            rec,
+            &format!("robot/{}/spheres", l.name),
+            &spheres(&l.cover),
+        )?;
+        for (d, level) in l.levels.iter().enumerate() {
+            send_at(
+                rec,
+                &format!("levels/{}", l.name),
+                &[("level", d as i64)],
+                &spheres(level),
+            )?;
+        }
+    }
+    for (k, (t, n)) in view.probes.iter().enumerate() {
+        let at = [("probe", k as i64)];
+        send_at(rec, "allocation/threshold", &at, &rerun::Scalars::new([*t]))?;
+        if let Some(n) = n {
+            send_at(
+                rec,
+                "allocation/spheres",
+                &at,
+                &rerun::Scalars::new([*n as f64]),
+            )?;
+        }
+        let text = match n {
+            Some(n) => format!("largest excess {t:.6}: {n} spheres, within the budget"),
+            None => format!("largest excess {t:.6}: over the budget"),
+        };
+        send_at(rec, "allocation/log", &at, &rerun::TextLog::new(text))?;
+    }
+    file.commit()
+}

@@ -1,0 +1,284 @@
+//! `wraptree spherize`: per-link spheres are conservative, the budget's allocation is exact
+//! (against brute force), the writers read back in independent readers (urdf_parser_py,
+//! PyYAML, Python's xml, run by `tests/spheres_reader.py`), and bad input is one error line.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use wraptree::scene::UrdfOptions;
+use wraptree::scene::urdf::links::read_links;
+use wraptree::spherize::allocate::by_budget;
+use wraptree::spherize::link_tree::LinkTree;
+use wraptree::spherize::{Limit, Settings, spherize};
+use wraptree::stop::Stop;
+
+fn r2d2() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/r2d2/r2d2.urdf")
+}
+
+fn collision() -> UrdfOptions {
+    UrdfOptions {
+        collision: true,
+        ..UrdfOptions::default()
+    }
+}
+
+#[test]
+fn every_vertex_of_every_link_is_inside_one_of_its_spheres() {
+    let links = read_links(&r2d2(), &collision()).unwrap();
+    assert!(links.links.len() >= 10, "{}", links.links.len());
+    for limit in [
+        Limit::Budget(links.links.len()),
+        Limit::Budget(40),
+        Limit::Tolerance(0.02),
+    ] {
+        let settings = Settings {
+            limit,
+            margin: 0.0,
+            min_radius: 0.0,
+        };
+        let s = spherize(links.links.clone(), settings, &Stop::new()).unwrap();
+        let cover = s.cover_spheres();
+        if let Limit::Budget(k) = limit {
+            let n: usize = cover.iter().map(|(_, v)| v.len()).sum();
+            assert!(n <= k, "{n} spheres for a budget of {k}");
+        }
+        for (l, (name, spheres)) in s.links.iter().zip(&cover) {
+            assert_eq!(&l.link.name, name);
+            let size = l.link.mesh.aabb().diameter();
+            for p in &l.link.mesh.points {
+                let inside = spheres.iter().any(|s| s.contains(p, 1e-9 * size));
+                assert!(inside, "{limit:?}: a vertex of {name} at {p} is outside");
+            }
+        }
+        let score = s.score(&cover);
+        assert_eq!(score.uncovered, 0.0, "{limit:?}");
+    }
+}
+
+#[test]
+fn margins_and_minimum_radii_are_applied_to_written_spheres() {
+    let links = read_links(&r2d2(), &collision()).unwrap();
+    let plain = Settings {
+        limit: Limit::Budget(30),
+        margin: 0.0,
+        min_radius: 0.0,
+    };
+    let padded = Settings {
+        margin: 0.01,
+        min_radius: 0.05,
+        ..plain
+    };
+    let a = spherize(links.links.clone(), plain, &Stop::new()).unwrap();
+    let b = spherize(links.links, padded, &Stop::new()).unwrap();
+    for ((_, x), (_, y)) in a.cover_spheres().iter().zip(&b.cover_spheres()) {
+        for (s, t) in x.iter().zip(y) {
+            assert_eq!(s.center, t.center);
+            assert_eq!(t.radius, (s.radius + 0.01).max(0.05));
+        }
+    }
+}
+
+/// Every cut of the subtree of `x`, as node lists.
+fn cuts(t: &LinkTree, x: u32) -> Vec<Vec<u32>> {
+    let mut out = vec![vec![x]];
+    if let Some([a, b]) = t.tree.children_of(x) {
+        for l in cuts(t, a) {
+            for r in cuts(t, b) {
+                out.push([l.clone(), r].concat());
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn the_budget_allocation_is_exact_against_brute_force() {
+    let stop = Stop::new();
+    let mut trees: Vec<LinkTree> = [(7, 3), (6, 11), (5, 29)]
+        .iter()
+        .map(|&(n, seed)| {
+            let mut t =
+                LinkTree::build(wraptree::scene::generate::soup(n, seed), 16, &stop).unwrap();
+            let all: Vec<u32> = (0..t.tree.len() as u32).collect();
+            t.measure(&all, &stop).unwrap();
+            t
+        })
+        .collect();
+    // Each link's cuts as (size, largest excess), the smallest excess per size.
+    let curves: Vec<Vec<(usize, f64)>> = trees
+        .iter()
+        .map(|t| {
+            cuts(t, t.tree.root())
+                .iter()
+                .map(|c| {
+                    let e = c.iter().map(|&x| t.excess[x as usize]).fold(0.0, f64::max);
+                    (c.len(), e)
+                })
+                .collect()
+        })
+        .collect();
+    let leaves: usize = trees.iter().map(|t| t.tree.leaves()).sum();
+    for k in 3..=leaves {
+        let mut brute = f64::INFINITY;
+        for a in &curves[0] {
+            for b in &curves[1] {
+                for c in &curves[2] {
+                    if a.0 + b.0 + c.0 <= k {
+                        brute = brute.min(a.1.max(b.1).max(c.1));
+                    }
+                }
+            }
+        }
+        let (covers, alloc) = by_budget(&mut trees, k, &stop).unwrap().unwrap();
+        assert_eq!(alloc.threshold, brute, "budget {k}");
+        let used: usize = covers.iter().map(Vec::len).sum();
+        assert!(used <= k);
+        assert_eq!(
+            alloc.per_link,
+            covers.iter().map(Vec::len).collect::<Vec<_>>()
+        );
+        for (t, c) in trees.iter().zip(&covers) {
+            assert!(c.iter().all(|&x| t.excess[x as usize] <= brute));
+        }
+    }
+    assert!(by_budget(&mut trees, 2, &stop).unwrap().is_err());
+}
+
+#[test]
+fn the_formats_read_back_in_independent_readers_and_score_the_same() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = r2d2().display().to_string();
+    let prefix = dir.path().join("r2");
+    let p = prefix.display().to_string();
+    common::printed(
+        &[
+            "spherize",
+            &robot,
+            "--urdf-collision",
+            "--budget",
+            "40",
+            "-o",
+            &p,
+        ],
+        dir.path(),
+    );
+    for ext in [
+        ".urdf", "_1.urdf", ".yml", ".srdf", ".json", ".rrd", ".mcap",
+    ] {
+        assert!(Path::new(&format!("{p}{ext}")).is_file(), "{ext}");
+    }
+    let out = common::python()
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/spheres_reader.py"))
+        .args([&robot, &p])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let read: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(format!("{p}.json")).unwrap()).unwrap();
+    // The same numbers in every format (a reader may give 0 where another gives 0.0).
+    let numbers = |v: &serde_json::Value| -> Vec<(String, Vec<Vec<f64>>)> {
+        v.as_object()
+            .unwrap()
+            .iter()
+            .map(|(k, s)| {
+                let s = s.as_array().unwrap();
+                let s = s.iter().map(|x| {
+                    x.as_array()
+                        .unwrap()
+                        .iter()
+                        .map(|n| n.as_f64().unwrap())
+                        .collect()
+                });
+                (k.clone(), s.collect())
+            })
+            .collect()
+    };
+    assert_eq!(numbers(&read["urdf"]), numbers(&read["curobo"]));
+    assert_eq!(numbers(&read["urdf"]), numbers(&read["srdf"]));
+    let n: usize = read["urdf"]
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|v| v.as_array().unwrap().len())
+        .sum();
+    assert_eq!(n as u64, report["score"]["spheres"].as_u64().unwrap());
+    assert!(n <= 40);
+    let input = urdf_rs::read_file(r2d2()).unwrap();
+    assert_eq!(
+        read["joints"].as_u64().unwrap() as usize,
+        input.joints.len()
+    );
+    let visuals: usize = input.links.iter().map(|l| l.visual.len()).sum();
+    assert_eq!(read["visuals"].as_u64().unwrap() as usize, visuals);
+    for (link, d) in read["outside"].as_object().unwrap() {
+        let d = d.as_f64().unwrap_or(f64::INFINITY);
+        assert!(
+            d <= 1e-9,
+            "{link}: a collision point {d} outside its spheres"
+        );
+    }
+    // Scoring the written sets gives the report's score.
+    for ext in [".urdf", ".yml"] {
+        let json = common::printed(
+            &[
+                "spherize",
+                &robot,
+                "--urdf-collision",
+                "--score",
+                &format!("{p}{ext}"),
+                "--json",
+            ],
+            dir.path(),
+        );
+        let s: serde_json::Value = serde_json::from_str(&json).unwrap();
+        assert_eq!(s["uncovered"], report["score"]["uncovered"], "{ext}");
+        assert_eq!(s["spheres"], report["score"]["spheres"], "{ext}");
+        let (a, b) = (
+            s["excess_max"].as_f64().unwrap(),
+            report["score"]["excess_max"].as_f64().unwrap(),
+        );
+        assert!((a - b).abs() <= 1e-9 + 0.05 * b, "{ext}: {a} vs {b}");
+    }
+    common::assert_rrd_verifies(Path::new(&format!("{p}.rrd")));
+}
+
+#[test]
+fn bad_input_is_one_error_line_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.urdf");
+    std::fs::write(&bad, "<robot name=\"x\"><link").unwrap();
+    let b = bad.display().to_string();
+    let out = common::wraptree(&["spherize", &b, "--budget", "5", "-o", "out"], dir.path());
+    common::assert_one_line_error(&out, "bad.urdf");
+    let robot = r2d2().display().to_string();
+    let out = common::wraptree(
+        &[
+            "spherize",
+            &robot,
+            "--urdf-collision",
+            "--budget",
+            "3",
+            "-o",
+            "out",
+        ],
+        dir.path(),
+    );
+    common::assert_one_line_error(&out, "budget of 3 spheres");
+    let out = common::wraptree(
+        &["spherize", &robot, "--urdf-collision", "--score", &b],
+        dir.path(),
+    );
+    common::assert_one_line_error(&out, "bad.urdf");
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 1, "{left:?}");
+}
