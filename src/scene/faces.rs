@@ -1,6 +1,6 @@
 //! Faces read from a mesh file (STL, PLY, OFF, glTF, a URDF's meshes and shapes) and how they
-//! become a [`Scene`]: the rules OBJ files follow ([`super::obj::polygon`],
-//! [`super::obj::polyhedron`]).
+//! become a [`Scene`]: the rules OBJ files follow ([`super::polygon`],
+//! [`super::polyhedron`]).
 //!
 //! [`build`] checks every coordinate (finite, within ±[`MAX_COORDINATE`]), turns the scene so
 //! that the file's up axis is +Z, merges vertices with bit-identical positions (in order of first
@@ -12,8 +12,8 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::Scene;
 use super::input::{LoadError, LoadErrorKind, LoadOptions, MAX_COORDINATE, Up};
-use super::obj::polygon::{self, PolygonStats};
-use super::obj::polyhedron::{self, PolyhedronStats};
+use super::polygon::{self, PolygonStats};
+use super::polyhedron::{self, PolyhedronStats};
 use crate::geom::P3;
 use crate::stop::Stop;
 

@@ -34,6 +34,8 @@ pub mod obj_writer;
 pub mod off;
 pub mod pathological;
 pub mod ply;
+pub mod polygon;
+pub mod polyhedron;
 pub mod soup;
 pub mod spec;
 pub mod split;

@@ -14,11 +14,11 @@
 
 use self::groups::{Group, INDEX_SPLIT, collect_groups};
 use self::pipe::Cleaned;
-use self::polygon::PolygonStats;
-use self::polyhedron::PolyhedronStats;
 use super::Scene;
 use super::faces::{Faces, turn_y_up};
 use super::input::{Format, Up};
+use super::polygon::{self, PolygonStats};
+use super::polyhedron::{self, PolyhedronStats};
 use crate::stop::Stop;
 // The loading API's types lived here before other formats came; these paths keep working.
 pub use super::input::{
@@ -27,8 +27,6 @@ pub use super::input::{
 
 mod groups;
 mod pipe;
-pub mod polygon;
-pub mod polyhedron;
 
 /// Loads OBJ `bytes` named `file_name` (the scene is named after its stem).
 pub(super) fn load(

@@ -12,7 +12,7 @@ use crate::geom::pca::Frame;
 use crate::geom::{P3, V3};
 
 /// Relative second extent below which a primitive counts as degenerate and is not split: like
-/// the loader's [`AREA_EPS`](super::obj::polygon::AREA_EPS), relative to the primitive's own size
+/// the loader's [`AREA_EPS`](super::polygon::AREA_EPS), relative to the primitive's own size
 /// (its first extent), never the scene's.
 pub const DEGENERATE_REL: f64 = 1e-12;
 
