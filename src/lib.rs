@@ -35,19 +35,12 @@
 //! ```
 #![deny(missing_docs)]
 
-pub mod events;
-pub mod geom;
-pub mod grouping;
+pub use wraptree_core::{
+    events, geom, grouping, output, par, query, refine, scene, spherize, stop, wrap,
+};
+
 pub mod metrics;
-pub mod output;
-mod par;
 pub mod peers;
-pub mod query;
 pub mod record;
-pub mod refine;
 pub mod render;
 pub mod replay;
-pub mod scene;
-pub mod spherize;
-pub mod stop;
-pub mod wrap;

@@ -10,18 +10,18 @@
 /// Fewest primitives for which a build is handed to the pool: below this the hand over alone
 /// would cost more than it saves, and the build runs on the caller's thread, which takes no
 /// parallel step when outside the pool ([`parallel_here`]).
-pub(crate) const POOL_MIN: usize = 1024;
+pub const POOL_MIN: usize = 1024;
 
 /// Whether parallel steps are worth taking here: on a thread of a pool of several threads. A
 /// thread outside the pool would hand each step over (see the module doc), and on a pool of one
 /// a `join` only costs.
-pub(crate) fn parallel_here() -> bool {
+pub fn parallel_here() -> bool {
     rayon::current_thread_index().is_some() && rayon::current_num_threads() > 1
 }
 
 /// A recursion's parallel grain here: `grain` where parallel steps are worth taking
 /// ([`parallel_here`]), else none (`u32::MAX`: no range is that large).
-pub(crate) fn grain(grain: u32) -> u32 {
+pub fn grain(grain: u32) -> u32 {
     if parallel_here() { grain } else { u32::MAX }
 }
 
@@ -29,7 +29,7 @@ pub(crate) fn grain(grain: u32) -> u32 {
 /// and returns what it returns; runs it on the caller's thread when that is one of the pool's
 /// already, or when `worth` is false. `f` must not wait for other threads that may need the
 /// pool (a recorder's channel, say): on a one-thread pool they would wait for it in turn.
-pub(crate) fn on_pool<R: Send>(worth: bool, f: impl FnOnce() -> R + Send) -> R {
+pub fn on_pool<R: Send>(worth: bool, f: impl FnOnce() -> R + Send) -> R {
     if !worth || rayon::current_thread_index().is_some() {
         f()
     } else {

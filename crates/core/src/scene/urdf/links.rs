@@ -9,8 +9,9 @@ use nalgebra::{Matrix3, Vector3};
 use super::{UrdfOptions, link_poses, read};
 use crate::geom::P3;
 use crate::scene::faces::build;
-use crate::scene::load::{LoadError, LoadErrorKind, LoadOptions, Up, read_file};
+use crate::scene::input::{LoadError, LoadErrorKind, LoadOptions, Up, read_file};
 use crate::scene::{PrimitiveKind, Scene};
+use crate::stop::Stop;
 
 /// One link with geometry: its name, its pose at the given joint values and its mesh in its
 /// own frame.
@@ -48,6 +49,11 @@ pub struct Links {
 /// folders) and gives each link's mesh in the link's frame. Errors are the loader's, one line
 /// naming the file.
 pub fn read_links(path: &Path, opts: &UrdfOptions) -> Result<Links, LoadError> {
+    read_links_until(path, opts, &Stop::new())
+}
+
+/// [`read_links`], its long loops checking `stop` (Err: kind [`LoadErrorKind::Interrupted`]).
+pub fn read_links_until(path: &Path, opts: &UrdfOptions, stop: &Stop) -> Result<Links, LoadError> {
     let shown = path.display().to_string();
     let err = |kind, problem: String| LoadError {
         file: shown.clone(),
@@ -75,7 +81,7 @@ pub fn read_links(path: &Path, opts: &UrdfOptions) -> Result<Links, LoadError> {
         )
     })?;
     let poses = link_poses(&robot, &opts.joints).map_err(|(k, p)| err(k, p))?;
-    let built = build(&shown, faces, &LoadOptions::default(), Up::Z)?;
+    let built = build(&shown, faces, &LoadOptions::default(), Up::Z, stop)?;
     warnings.extend(built.warnings);
     let scene = &built.scene;
     let mut links: Vec<Link> = Vec::new();
