@@ -27,7 +27,7 @@ pub(in crate::grouping) use keys::tie_tag;
 pub(in crate::grouping) use scan::pair_cost_any;
 
 /// Runs the grouping phase; see the module doc of [`super`] for the steps.
-pub(super) fn run<O: Observer>(
+pub(super) fn group_scene<O: Observer>(
     scene: &Scene,
     params: &ResolvedParams,
     observer: O,

@@ -5,12 +5,12 @@
 //! 1. DLimit and GLimit start at [`ResolvedParams::dlimit0`]/[`ResolvedParams::glimit0`]
 //!    ([`Params::resolve`]).
 //! 2. One parent-less body left is the root; otherwise those with diameter ≤ DLimit are active,
-//!    the rest dormant (`cluster::run`, top of its round loop).
+//!    the rest dormant (`cluster::group_scene`, top of its round loop).
 //! 3. Active centres go into a voxel hash of cell size DLimit + GLimit ([`voxel_hash::VoxelHash`]);
 //!    the scans around each body (`cluster::scan`) queue the eligible pairs in MPairs
 //!    ([`mpairs::MPairs`]) by Cost ([`Weights::cost`]).
 //! 4. Pop the cheapest pair and merge it; the new body is searched and queued if it obeys
-//!    DLimit, else it goes dormant (`cluster::run`, inner loop).
+//!    DLimit, else it goes dormant (`cluster::group_scene`, inner loop).
 //! 5. When MPairs is empty, double DLimit and GLimit and go to 2 (end of the round loop).
 //!
 //! MPairs holds each active body's cheapest partners, yet pops the global minimum ([`mpairs`]).
@@ -115,7 +115,7 @@ pub fn group_within<O: Observer>(
     observer: O,
     budget: &Budget<'_>,
 ) -> Result<Grouping, Stopped> {
-    run(scene, params, observer, budget)
+    group_on_pool(scene, params, observer, budget)
 }
 
 /// Runs the grouping phase on primitives known by their boxes alone (primitive `i` is
@@ -162,7 +162,7 @@ fn run_boxes<O: Observer>(
 
 /// Runs the grouping phase in the schedule and mode that `params` names: with an observer that
 /// ignores every event, in one piece on the rayon pool (`crate::par`).
-fn run<O: Observer>(
+fn group_on_pool<O: Observer>(
     scene: &Scene,
     params: &ResolvedParams,
     observer: O,
@@ -176,7 +176,7 @@ fn run<O: Observer>(
     run_here(scene, params, observer, budget)
 }
 
-/// [`run`] on the caller's thread.
+/// [`group_on_pool`] on the caller's thread.
 fn run_here<O: Observer>(
     scene: &Scene,
     params: &ResolvedParams,
@@ -184,10 +184,10 @@ fn run_here<O: Observer>(
     budget: &Budget<'_>,
 ) -> Result<Grouping, Stopped> {
     if params.mode.pregroup != Pregroup::None && params.pset == PSet::Aabb {
-        return pregroup::run(scene, params, observer, budget);
+        return pregroup::group_components(scene, params, observer, budget);
     }
     match params.mode.schedule {
-        Schedule::Exact => cluster::run(scene, params, observer, budget),
+        Schedule::Exact => cluster::group_scene(scene, params, observer, budget),
         Schedule::Partitioned(c) => partitioned::group_with(scene, params, &c, observer, budget),
     }
 }

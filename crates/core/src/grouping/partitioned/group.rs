@@ -38,7 +38,7 @@ pub fn group_with<O: Observer>(
 ) -> Result<Grouping, Stopped> {
     assert!(!scene.is_empty(), "grouping needs at least one primitive");
     if params.pset == PSet::Hull {
-        return cluster::run(scene, params, observer, budget);
+        return cluster::group_scene(scene, params, observer, budget);
     }
     let n = scene.len();
     // Room for the merged bodies from the start (no copy when they are added).

@@ -461,7 +461,7 @@ impl Assembly {
 
 /// Runs the grouping phase with pre-grouping (and instancing) as `params.mode` says; see the
 /// module doc. `params.pset` must be the AABB p-set.
-pub(super) fn run<O: Observer>(
+pub(super) fn group_components<O: Observer>(
     scene: &Scene,
     params: &ResolvedParams,
     mut observer: O,
