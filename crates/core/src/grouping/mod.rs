@@ -88,7 +88,7 @@ pub struct Grouping {
 ///
 /// Panics only if the scene is empty; loaders reject empty scenes first.
 pub fn group<O: Observer>(scene: &Scene, params: &Params, observer: O) -> Grouping {
-    run(scene, &params.resolve(scene), observer, &Budget::default())
+    group_on_pool(scene, &params.resolve(scene), observer, &Budget::default())
         .expect("an unlimited budget never stops")
 }
 
@@ -104,7 +104,7 @@ pub fn group_until<O: Observer>(
         stop: Some(stop),
         ..Budget::default()
     };
-    run(scene, params, observer, &budget)
+    group_on_pool(scene, params, observer, &budget)
 }
 
 /// Like [`group`] within `budget`: returns [`Stopped`] once a limit is exceeded (the observer
