@@ -76,7 +76,7 @@ impl Stop {
     /// at the top of a loop over items `i` keeps the look cheap however small each item is.
     #[inline]
     pub fn check_every(&self, i: usize) -> Result<(), Interrupted> {
-        if i % STRIDE == 0 {
+        if i.is_multiple_of(STRIDE) {
             self.check()
         } else {
             Ok(())

@@ -74,11 +74,14 @@ pub const PARTITIONED_KEYS: &[&str] = &[
     "chunk_twins",
 ];
 
+/// One value a recording without `format_version` leaves out: `(key, value, whether it
+/// applies to the record)`.
+type LegacyDefault = (&'static str, &'static str, fn(&Record) -> bool);
+
 /// The values recordings without `format_version` (made before it existed) leave out, each
-/// the setting they were made with: `(key, value, whether it applies to the record)`. These
-/// recordings are read by filling them in ([`current_form`]); it is the only place that
-/// knows older forms.
-const LEGACY_DEFAULTS: &[(&str, &str, fn(&Record) -> bool)] = &[
+/// the setting they were made with. These recordings are read by filling them in
+/// ([`current_form`]); it is the only place that knows older forms.
+const LEGACY_DEFAULTS: &[LegacyDefault] = &[
     // Made before modes existed: the default mode.
     ("schedule", "exact", always),
     ("pregroup", "none", always),

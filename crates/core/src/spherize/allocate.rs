@@ -126,6 +126,9 @@ pub fn by_tolerance(
     ))
 }
 
+/// Each link's cover (its chosen nodes) and the allocation that gave them.
+pub type Budgeted = (Vec<Vec<u32>>, Allocation);
+
 /// The least largest excess with at most `k` spheres over all links, and each link's cover
 /// (see the module's proof). Err: fewer spheres than links (each needs one). `stop` is checked
 /// as nodes are measured.
@@ -133,7 +136,7 @@ pub fn by_budget(
     links: &mut [LinkTree],
     k: usize,
     stop: &Stop,
-) -> Result<Result<(Vec<Vec<u32>>, Allocation), String>, Interrupted> {
+) -> Result<Result<Budgeted, String>, Interrupted> {
     if k < links.len() {
         return Ok(Err(format!(
             "a budget of {k} spheres is below the {} links with geometry (each needs one)",

@@ -23,7 +23,7 @@ pub fn split_long_edges(mesh: &Scene, max_edge: f64) -> Scene {
             let (a, b) = (verts[k], verts[(k + 1) % n]);
             !long(&mesh.points[a as usize], &mesh.points[b as usize])
         });
-        if within || !(max_edge > 0.0) {
+        if within || max_edge.is_nan() || max_edge <= 0.0 {
             out.push(PrimitiveKind::Polygon, verts, mesh.prim_tris(i));
             continue;
         }

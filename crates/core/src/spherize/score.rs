@@ -96,7 +96,7 @@ pub fn surface_samples(mesh: &Scene, n: usize) -> Vec<P3> {
         sum += area(t);
         cum.push(sum);
     }
-    if !(sum > 0.0) {
+    if sum.is_nan() || sum <= 0.0 {
         return Vec::new();
     }
     let mut rng = ChaCha8Rng::seed_from_u64(0);
@@ -183,7 +183,7 @@ pub fn score_link(
             .fold(f64::INFINITY, f64::min)
     };
     let depth: Vec<f64> = points.iter().map(outside).collect();
-    let uncovered = depth.iter().filter(|&&d| !(d <= SLACK)).count();
+    let uncovered = depth.iter().filter(|&&d| d.is_nan() || d > SLACK).count();
     let dirs = directions(SPHERE_SAMPLES);
     let mut stack = Vec::new();
     let (mut max, mut sum, mut count) = (0.0f64, 0.0, 0usize);
