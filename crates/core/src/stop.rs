@@ -2,7 +2,7 @@
 //! shared by every command; [`Interrupted`] is the error a run returns when it obeyed one.
 //!
 //! ```
-//! use wraptree::stop::{Interrupted, Stop};
+//! use wraptree_core::stop::{Interrupted, Stop};
 //! let stop = Stop::new();
 //! assert!(stop.check().is_ok());
 //! stop.request();

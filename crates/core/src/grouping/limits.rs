@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 /// Limits on the grouping phase, for runs that could run away (huge GLimit, dense soups).
 ///
 /// ```
-/// use wraptree::grouping::Limits;
+/// use wraptree_core::grouping::Limits;
 /// let limits = Limits { max_seconds: Some(2.5), max_pairs: None };
 /// assert!(limits.check().is_ok());
 /// assert!(Limits { max_seconds: Some(-1.0), ..limits }.check().is_err());

@@ -3,10 +3,10 @@
 //! not overlap (every cell holds its copy's bounding sphere). Deterministic for a seed.
 //!
 //! ```
-//! use wraptree::scene::assembly::{Part, assemble};
-//! let part = Part { scene: wraptree::scene::generate::lamp(), copies: 3 };
+//! use wraptree_core::scene::assembly::{Part, assemble};
+//! let part = Part { scene: wraptree_core::scene::generate::lamp(), copies: 3 };
 //! let (scene, names) = assemble(&[part], 7).unwrap();
-//! assert_eq!(scene.len(), 3 * wraptree::scene::generate::lamp().len());
+//! assert_eq!(scene.len(), 3 * wraptree_core::scene::generate::lamp().len());
 //! assert_eq!(names.len(), 3);
 //! ```
 

@@ -15,7 +15,7 @@ use std::path::Path;
 /// warnings.
 ///
 /// ```
-/// let (scene, warnings) = wraptree::scene::spec::scene_spec("soup:300").unwrap();
+/// let (scene, warnings) = wraptree_core::scene::spec::scene_spec("soup:300").unwrap();
 /// assert_eq!((scene.len(), scene.name.as_str()), (300, "soup-300"));
 /// assert!(warnings.is_empty());
 /// ```

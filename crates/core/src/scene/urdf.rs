@@ -65,7 +65,7 @@ impl UrdfOptions {
 /// Parses `NAME=VALUE` (a `--joint` argument).
 ///
 /// ```
-/// let (name, value) = wraptree::scene::urdf::parse_joint("elbow=-0.5").unwrap();
+/// let (name, value) = wraptree_core::scene::urdf::parse_joint("elbow=-0.5").unwrap();
 /// assert_eq!((name.as_str(), value), ("elbow", -0.5));
 /// ```
 pub fn parse_joint(s: &str) -> Result<(String, f64), String> {

@@ -86,13 +86,13 @@ impl WrapperKind {
 /// (index = node id). A kind not asked for is `None`.
 ///
 /// ```no_run
-/// # fn demo(tree: &wraptree::grouping::SubsetTree, scene: &wraptree::scene::Scene) {
-/// use wraptree::wrap::{SphereMethod, WrapperKind, Wrappers, hull_tree, level_tightness};
+/// # fn demo(tree: &wraptree_core::grouping::SubsetTree, scene: &wraptree_core::scene::Scene) {
+/// use wraptree_core::wrap::{SphereMethod, WrapperKind, Wrappers, hull_tree, level_tightness};
 /// let kinds = WrapperKind::parse_list("sphere,hull").unwrap();
 /// let w = Wrappers::build(tree, scene, &kinds, SphereMethod::Minimum);
 /// let hulls = w.hulls.as_deref().unwrap();
 /// for t in w.trees() {
-///     let (samples, stop) = (wraptree::wrap::DEFAULT_SAMPLES, wraptree::stop::Stop::new());
+///     let (samples, stop) = (wraptree_core::wrap::DEFAULT_SAMPLES, wraptree_core::stop::Stop::new());
 ///     let stats = level_tightness(tree, scene, t, hulls, samples, &stop).expect("not stopped");
 ///     println!("{}: {:?}", t.kind().name(), stats.last());
 /// }

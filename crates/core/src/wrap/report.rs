@@ -4,16 +4,16 @@
 //! same as text ([`report_text`]) or JSON ([`report_json`]).
 //!
 //! ```no_run
-//! use wraptree::wrap::report::{Measured, report};
-//! use wraptree::wrap::{DEFAULT_SAMPLES, NODES_PER_DEPTH, SphereMethod, WrapperKind};
-//! # fn demo(tree: &wraptree::grouping::SubsetTree, scene: &wraptree::scene::Scene) {
+//! use wraptree_core::wrap::report::{Measured, report};
+//! use wraptree_core::wrap::{DEFAULT_SAMPLES, NODES_PER_DEPTH, SphereMethod, WrapperKind};
+//! # fn demo(tree: &wraptree_core::grouping::SubsetTree, scene: &wraptree_core::scene::Scene) {
 //! let kinds = [WrapperKind::Sphere, WrapperKind::Obb];
 //! let how = Measured {
 //!     method: SphereMethod::Minimum,
 //!     samples: DEFAULT_SAMPLES,
 //!     per_depth: NODES_PER_DEPTH,
 //! };
-//! let stop = wraptree::stop::Stop::new();
+//! let stop = wraptree_core::stop::Stop::new();
 //! for r in report(tree, scene, &kinds, how, &stop).expect("nobody asked to stop") {
 //!     println!("{}: containment holds: {}", r.kind.name(), r.containment.holds);
 //! }

@@ -17,7 +17,7 @@ use std::time::Instant;
 /// A tolerance: a length in scene units, or a fraction of the scene diagonal.
 ///
 /// ```
-/// use wraptree::wrap::cover::solve::Tolerance;
+/// use wraptree_core::wrap::cover::solve::Tolerance;
 /// assert_eq!(Tolerance::parse("2%").unwrap().length(10.0), 0.2);
 /// assert_eq!(Tolerance::parse("0.5").unwrap().length(10.0), 0.5);
 /// assert!(Tolerance::parse("-1").is_err());
