@@ -259,7 +259,7 @@ impl std::fmt::Display for Step {
 /// Runs every method × wrapper of `opts` on `scene`: first the builds, `opts.repeat` rounds of
 /// every method in turn ([`fastest_builds`]), then on each method's fastest tree its wrappers,
 /// tightness and queries; calls `progress` before each step (each build of each round too) and
-/// checks `stop` before it (Err: [`Interrupted`](crate::stop::Interrupted), or why a build
+/// checks `stop` before it (Err: [`Interrupted`], or why a build
 /// failed).
 pub fn evaluate(
     scene: &Scene,

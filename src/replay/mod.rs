@@ -353,7 +353,7 @@ pub struct Compared {
 /// Writes `PREFIX.rrd` and `PREFIX.mcap`, the runs of `replays` (recordings of one scene) side
 /// by side ([`write_comparison`]); `labels` name them. Replaces existing files only with
 /// `force`. Err: recordings of different scenes, a write that fails (old files are kept), or
-/// [`Interrupted`](crate::stop::Interrupted) when `stop` is requested before both files are
+/// [`Interrupted`] when `stop` is requested before both files are
 /// complete (none written).
 pub fn compare(
     replays: &[&Replay],

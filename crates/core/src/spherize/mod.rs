@@ -10,7 +10,7 @@
 //! whole link: the spheres are conservative by construction.
 //!
 //! [`score`] measures a set the way the independent checker does, [`read_set`] reads existing
-//! sets to score them, and [`write`] writes URDF, cuRobo YAML, SRDF and `.sph` files.
+//! sets to score them, and [`write`](mod@write) writes URDF, cuRobo YAML, SRDF and `.sph` files.
 
 pub mod allocate;
 pub mod link_tree;
