@@ -26,7 +26,7 @@ fn collision() -> UrdfOptions {
 
 #[test]
 fn every_vertex_of_every_link_is_inside_one_of_its_spheres() {
-    let links = read_links(&r2d2(), &collision()).unwrap();
+    let links = read_links(&r2d2(), &collision(), &Stop::new()).unwrap();
     assert!(links.links.len() >= 10, "{}", links.links.len());
     for limit in [
         Limit::Budget(links.links.len()),
@@ -59,7 +59,7 @@ fn every_vertex_of_every_link_is_inside_one_of_its_spheres() {
 
 #[test]
 fn margins_and_minimum_radii_are_applied_to_written_spheres() {
-    let links = read_links(&r2d2(), &collision()).unwrap();
+    let links = read_links(&r2d2(), &collision(), &Stop::new()).unwrap();
     let plain = Settings {
         limit: Limit::Budget(30),
         margin: 0.0,

@@ -105,11 +105,11 @@ impl SpherizeCmd {
             joints: self.joint.clone(),
             package_path,
         };
-        let links = read_links(&self.robot, &opts)?;
+        let stop = wraptree::stop::Stop::on_signals();
+        let links = read_links(&self.robot, &opts, &stop)?;
         for w in &links.warnings {
             eprintln!("warning: {w}");
         }
-        let stop = wraptree::stop::Stop::on_signals();
         let file_name = self
             .robot
             .file_name()

@@ -9,8 +9,10 @@ use nalgebra::{Matrix3, Vector3};
 use super::{UrdfOptions, link_poses, read};
 use crate::geom::P3;
 use crate::scene::faces::build;
-use crate::scene::load::{LoadError, LoadErrorKind, LoadOptions, Up, read_file};
+use crate::scene::input::read_file;
+use crate::scene::load::{LoadError, LoadErrorKind, LoadOptions, Up};
 use crate::scene::{PrimitiveKind, Scene};
+use crate::stop::Stop;
 
 /// One link with geometry: its name, its pose at the given joint values and its mesh in its
 /// own frame.
@@ -46,8 +48,8 @@ pub struct Links {
 
 /// Reads the URDF at `path` with `opts` (collision or visual geometry, joint values, package
 /// folders) and gives each link's mesh in the link's frame. Errors are the loader's, one line
-/// naming the file.
-pub fn read_links(path: &Path, opts: &UrdfOptions) -> Result<Links, LoadError> {
+/// naming the file; stops with an interrupted error when `stop` is requested.
+pub fn read_links(path: &Path, opts: &UrdfOptions, stop: &Stop) -> Result<Links, LoadError> {
     let shown = path.display().to_string();
     let err = |kind, problem: String| LoadError {
         file: shown.clone(),
@@ -75,7 +77,7 @@ pub fn read_links(path: &Path, opts: &UrdfOptions) -> Result<Links, LoadError> {
         )
     })?;
     let poses = link_poses(&robot, &opts.joints).map_err(|(k, p)| err(k, p))?;
-    let built = build(&shown, faces, &LoadOptions::default(), Up::Z)?;
+    let built = build(&shown, faces, &LoadOptions::default(), Up::Z, stop)?;
     warnings.extend(built.warnings);
     let scene = &built.scene;
     let mut links: Vec<Link> = Vec::new();
