@@ -349,6 +349,21 @@ fn bad_input_is_one_error_line_and_writes_nothing() {
     );
     common::assert_one_line_error(&out, "budget of 3 spheres");
     let out = common::wraptree(
+        &[
+            "spherize",
+            &robot,
+            "--urdf-collision",
+            "--budget",
+            "30",
+            "--slack",
+            "nan",
+            "-o",
+            "out",
+        ],
+        dir.path(),
+    );
+    common::assert_one_line_error(&out, "--slack");
+    let out = common::wraptree(
         &["spherize", &robot, "--urdf-collision", "--score", &b],
         dir.path(),
     );

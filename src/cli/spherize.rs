@@ -95,7 +95,9 @@ impl SpherizeCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         let margin = length("margin", self.margin)?;
-        length("slack", self.slack)?;
+        if !(self.slack.is_finite() && self.slack >= 0.0) {
+            bail!("--slack must be a finite share ≥ 0, not {}", self.slack);
+        }
         let min_radius = length("min-radius", self.min_radius)?;
         let limit = match (self.tolerance, self.budget) {
             (Some(t), _) => Some(Limit::Tolerance(length("tolerance", t)?)),

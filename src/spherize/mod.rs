@@ -341,11 +341,19 @@ impl Report {
         };
         let _ = writeln!(
             out,
-            "{}: {} links, {limit}: {} spheres, largest node excess {:.4}",
+            "{}: {} links, {limit}: {} spheres, largest node excess {:.4}{}",
             self.robot,
             self.links.len(),
             self.score.spheres,
-            self.allocation.threshold
+            self.allocation.threshold,
+            match self.allocation.spent {
+                Some(x) if x.limit > self.allocation.threshold => format!(
+                    " (the least; spent on the mean within {:.4}, sampled mean {:.4})",
+                    x.limit, x.mean
+                ),
+                Some(x) => format!(" (sampled mean {:.4})", x.mean),
+                None => String::new(),
+            }
         );
         let _ = writeln!(
             out,

@@ -1,7 +1,7 @@
 //! The `.rrd` of a spherize run ([`crate::record::spherize`]): `robot/<link>/mesh`,
 //! `robot/<link>/spheres` (static), `levels/<link>` on the `level` timeline and
 //! `allocation/threshold`, `allocation/spheres` on the `probe` timeline. It opens on a layout
-//! ([`blueprint`](super::blueprint)): the robot and its cover large, framed on the whole robot,
+//! (`blueprint`): the robot and its cover large, framed on the whole robot,
 //! beside the tree levels; below, the budget's probes and the log; the time panel on `probe`.
 
 use std::path::{Path, PathBuf};
