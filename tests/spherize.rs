@@ -10,6 +10,7 @@ use wraptree::scene::UrdfOptions;
 use wraptree::scene::urdf::links::read_links;
 use wraptree::spherize::allocate::by_budget;
 use wraptree::spherize::link_tree::LinkTree;
+use wraptree::spherize::spend::by_mean;
 use wraptree::spherize::{Limit, Settings, spherize};
 use wraptree::stop::Stop;
 
@@ -26,7 +27,7 @@ fn collision() -> UrdfOptions {
 
 #[test]
 fn every_vertex_of_every_link_is_inside_one_of_its_spheres() {
-    let links = read_links(&r2d2(), &collision()).unwrap();
+    let links = read_links(&r2d2(), &collision(), &Stop::new()).unwrap();
     assert!(links.links.len() >= 10, "{}", links.links.len());
     for limit in [
         Limit::Budget(links.links.len()),
@@ -37,6 +38,7 @@ fn every_vertex_of_every_link_is_inside_one_of_its_spheres() {
             limit,
             margin: 0.0,
             min_radius: 0.0,
+            slack: 0.0,
         };
         let s = spherize(links.links.clone(), settings, &Stop::new()).unwrap();
         let cover = s.cover_spheres();
@@ -59,11 +61,12 @@ fn every_vertex_of_every_link_is_inside_one_of_its_spheres() {
 
 #[test]
 fn margins_and_minimum_radii_are_applied_to_written_spheres() {
-    let links = read_links(&r2d2(), &collision()).unwrap();
+    let links = read_links(&r2d2(), &collision(), &Stop::new()).unwrap();
     let plain = Settings {
         limit: Limit::Budget(30),
         margin: 0.0,
         min_radius: 0.0,
+        slack: 0.0,
     };
     let padded = Settings {
         margin: 0.01,
@@ -144,6 +147,80 @@ fn the_budget_allocation_is_exact_against_brute_force() {
         }
     }
     assert!(by_budget(&mut trees, 2, &stop).unwrap().is_err());
+}
+
+#[test]
+fn the_mean_spending_is_exact_against_brute_force() {
+    let stop = Stop::new();
+    let mut trees: Vec<LinkTree> = [(6, 5), (5, 17), (5, 23)]
+        .iter()
+        .map(|&(n, seed)| {
+            let mut t =
+                LinkTree::build(wraptree::scene::generate::soup(n, seed), 16, &stop).unwrap();
+            let all: Vec<u32> = (0..t.tree.len() as u32).collect();
+            t.measure(&all, &stop).unwrap();
+            t
+        })
+        .collect();
+    // Each link's cuts as (size, largest excess, Σ S, Σ N).
+    let curves: Vec<Vec<(usize, f64, f64, f64)>> = trees
+        .iter()
+        .map(|t| {
+            cuts(t, t.tree.root())
+                .iter()
+                .map(|c| {
+                    let e = c.iter().map(|&x| t.excess[x as usize]).fold(0.0, f64::max);
+                    let s = c.iter().map(|&x| t.outside[x as usize].0).sum();
+                    let n = c.iter().map(|&x| t.outside[x as usize].1 as f64).sum();
+                    (c.len(), e, s, n)
+                })
+                .collect()
+        })
+        .collect();
+    let ratio = |s: f64, n: f64| if n > 0.0 { s / n } else { 0.0 };
+    let leaves: usize = trees.iter().map(|t| t.tree.leaves()).sum();
+    let mut improved = 0;
+    for k in 3..=leaves {
+        let (start, alloc) = by_budget(&mut trees, k, &stop).unwrap().unwrap();
+        for slack in [0.0, 0.3, 1.0] {
+            let t = alloc.threshold * (1.0 + slack);
+            let mut brute = f64::INFINITY;
+            for a in &curves[0] {
+                for b in &curves[1] {
+                    for c in &curves[2] {
+                        if a.0 + b.0 + c.0 <= k && a.1.max(b.1).max(c.1) <= t {
+                            brute = brute.min(ratio(a.2 + b.2 + c.2, a.3 + b.3 + c.3));
+                        }
+                    }
+                }
+            }
+            let (covers, spent) = by_mean(&trees, k, t, start.clone(), &stop).unwrap();
+            assert!(
+                (spent.mean - brute).abs() <= 1e-12 * brute.max(1e-9),
+                "budget {k} slack {slack}: {} vs {brute}",
+                spent.mean
+            );
+            assert!(covers.iter().map(Vec::len).sum::<usize>() <= k);
+            let (mut s, mut n) = (0.0, 0.0);
+            for (tr, c) in trees.iter().zip(&covers) {
+                let is_cut = cuts(tr, tr.tree.root()).into_iter().any(|mut x| {
+                    x.sort_unstable();
+                    x == *c
+                });
+                assert!(is_cut, "a cut");
+                for &x in c {
+                    assert!(tr.excess[x as usize] <= t);
+                    s += tr.outside[x as usize].0;
+                    n += tr.outside[x as usize].1 as f64;
+                }
+            }
+            assert!((ratio(s, n) - spent.mean).abs() <= 1e-12 * brute.max(1e-9));
+            if spent.rounds > 1 {
+                improved += 1;
+            }
+        }
+    }
+    assert!(improved > 0, "the spending never changed a cover");
 }
 
 #[test]
@@ -271,6 +348,21 @@ fn bad_input_is_one_error_line_and_writes_nothing() {
         dir.path(),
     );
     common::assert_one_line_error(&out, "budget of 3 spheres");
+    let out = common::wraptree(
+        &[
+            "spherize",
+            &robot,
+            "--urdf-collision",
+            "--budget",
+            "30",
+            "--slack",
+            "nan",
+            "-o",
+            "out",
+        ],
+        dir.path(),
+    );
+    common::assert_one_line_error(&out, "--slack");
     let out = common::wraptree(
         &["spherize", &robot, "--urdf-collision", "--score", &b],
         dir.path(),

@@ -48,6 +48,10 @@ pub struct SpherizeCmd {
     /// At most this many spheres in all, allocated across links to minimise the largest excess.
     #[arg(long, value_name = "K")]
     budget: Option<usize>,
+    /// With --budget: the share by which the largest excess may exceed the least one the
+    /// budget allows while its spheres are spent to lower the mean excess (0: not at all).
+    #[arg(long, default_value_t = 0.1, value_name = "SHARE")]
+    slack: f64,
     /// Score an existing sphere set (a spherized URDF or a cuRobo YAML) against the robot
     /// instead, the same way.
     #[arg(long, value_name = "SPHERES")]
@@ -91,6 +95,9 @@ impl SpherizeCmd {
     /// Runs the command.
     pub fn run(self) -> Result<ExitCode> {
         let margin = length("margin", self.margin)?;
+        if !(self.slack.is_finite() && self.slack >= 0.0) {
+            bail!("--slack must be a finite share ≥ 0, not {}", self.slack);
+        }
         let min_radius = length("min-radius", self.min_radius)?;
         let limit = match (self.tolerance, self.budget) {
             (Some(t), _) => Some(Limit::Tolerance(length("tolerance", t)?)),
@@ -105,11 +112,11 @@ impl SpherizeCmd {
             joints: self.joint.clone(),
             package_path,
         };
-        let links = read_links(&self.robot, &opts)?;
+        let stop = wraptree::stop::Stop::on_signals();
+        let links = read_links(&self.robot, &opts, &stop)?;
         for w in &links.warnings {
             eprintln!("warning: {w}");
         }
-        let stop = wraptree::stop::Stop::on_signals();
         let file_name = self
             .robot
             .file_name()
@@ -150,6 +157,7 @@ impl SpherizeCmd {
             limit,
             margin,
             min_radius,
+            slack: self.slack,
         };
         let bar = super::progress::spinner("spherize");
         let done = spherize::spherize(links.links, settings, &stop);

@@ -1,6 +1,6 @@
 //! Recordings of a `wraptree spherize` run, `.rrd` and `.mcap`: each link's mesh and its
 //! spheres at the chosen cover, posed as the robot stands, every sphere coloured by its excess
-//! (green none, red the allocation's largest or more, grey unmeasured), each link's tree cut at
+//! (green none, red the largest the cover may have or more, grey unmeasured), each link's tree cut at
 //! depth d on the `level` timeline, and the budget's binary search probe by probe.
 
 use std::path::{Path, PathBuf};
@@ -60,7 +60,11 @@ fn posed(pose: impl Fn(&P3) -> P3, s: &Sphere) -> Sphere {
 impl View {
     /// The drawing of `s`.
     pub fn new(s: &Spherized) -> View {
-        let t = s.allocation.threshold;
+        // Colours run to the largest excess the cover may have (the budget's, with its slack).
+        let t = s
+            .allocation
+            .spent
+            .map_or(s.allocation.threshold, |x| x.limit);
         let links = s
             .links
             .iter()
@@ -108,7 +112,7 @@ impl View {
                 .map(|p| (p.threshold, p.spheres))
                 .collect(),
             summary: format!(
-                "{} links, {n} spheres, largest node excess {:.4}",
+                "{} links, {n} spheres, largest node excess at most {:.4}",
                 s.links.len(),
                 t
             ),

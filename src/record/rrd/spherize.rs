@@ -1,14 +1,17 @@
 //! The `.rrd` of a spherize run ([`crate::record::spherize`]): `robot/<link>/mesh`,
 //! `robot/<link>/spheres` (static), `levels/<link>` on the `level` timeline and
-//! `allocation/threshold`, `allocation/spheres` on the `probe` timeline.
+//! `allocation/threshold`, `allocation/spheres` on the `probe` timeline. It opens on a layout
+//! (`blueprint`): the robot and its cover large, framed on the whole robot,
+//! beside the tree levels; below, the budget's probes and the log; the time panel on `probe`.
 
 use std::path::{Path, PathBuf};
 
 use rerun::components::FillMode;
 
+use super::blueprint::{self, Layout, Node, View as Pane, ViewKind};
 use super::series_file::SeriesFile;
 use super::{send_at, send_static};
-use crate::geom::Sphere;
+use crate::geom::{Aabb, Sphere};
 use crate::record::spherize::View;
 
 fn rgba(c: [f64; 4]) -> rerun::Color {
@@ -27,10 +30,79 @@ fn spheres(list: &[(Sphere, [f64; 4])]) -> rerun::Ellipsoids3D {
         .with_fill_mode(FillMode::TransparentFillMajorWireframe)
 }
 
+/// A view of kind `kind` named `name` showing the entities `contents` (`+ /path/**`).
+fn pane(kind: ViewKind, name: &str, contents: &[&str]) -> Node {
+    Node::View(Pane {
+        kind,
+        name: name.into(),
+        origin: "/".into(),
+        contents: contents.iter().map(|c| c.to_string()).collect(),
+    })
+}
+
+/// The layout the recording opens on, its 3D views looking at `bbox`; probe ticks 0..=`last`.
+fn layout(bbox: &Aabb, last: i64) -> Layout {
+    let eye = blueprint::framing(bbox);
+    let x = Some((0, last.max(1)));
+    let top = Node::Row(
+        vec![
+            pane(
+                ViewKind::Spatial(eye),
+                "Robot and its spheres (colour: excess, green none to red the limit)",
+                &["+ /robot/**"],
+            ),
+            pane(
+                ViewKind::Spatial(eye),
+                "Each link's tree at depth `level`",
+                &["+ /robot/*/mesh", "+ /levels/**"],
+            ),
+        ],
+        vec![3.0, 2.0],
+    );
+    let bottom = Node::Row(
+        vec![
+            pane(
+                ViewKind::Plot { x, y: None },
+                "Budget search: spheres needed per probe",
+                &["+ /allocation/spheres"],
+            ),
+            pane(
+                ViewKind::Plot { x, y: None },
+                "Budget search: largest excess tried",
+                &["+ /allocation/threshold"],
+            ),
+            pane(
+                ViewKind::TextLog,
+                "Summary and probes",
+                &["+ /spherize/**", "+ /allocation/log"],
+            ),
+        ],
+        vec![1.0, 1.0, 1.5],
+    );
+    Layout {
+        root: Node::Column(vec![top, bottom], vec![3.0, 1.0]),
+        timeline: "probe",
+    }
+}
+
 /// Writes `view` to `dest` (replaced only with `force`); returns its path.
 pub fn write(view: &View, dest: &Path, force: bool) -> anyhow::Result<PathBuf> {
     let file = SeriesFile::create(dest, "wraptree-spherize", force, None)?;
     let rec = file.rec();
+    let mut bbox: Option<Aabb> = None;
+    for l in &view.links {
+        let b = Aabb::from_points(&l.mesh.points);
+        bbox = Some(bbox.map_or(b, |a| a.merge(&b)));
+        for (s, _) in &l.cover {
+            for sign in [-1.0, 1.0] {
+                let p = s.center + crate::geom::V3::repeat(sign * s.radius);
+                bbox = bbox.map(|a| a.grow(&p));
+            }
+        }
+    }
+    if let Some(b) = &bbox {
+        layout(b, view.probes.len() as i64 - 1).send(rec, "wraptree-spherize")?;
+    }
     send_static(
         rec,
         "spherize/summary",

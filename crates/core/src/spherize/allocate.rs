@@ -19,6 +19,7 @@
 //! visits, and a probe stops once its count passes K.
 
 use super::link_tree::LinkTree;
+use super::spend::Spent;
 use crate::stop::{Interrupted, Stop};
 
 /// Whether an excess is within the tolerance (NaN never is).
@@ -78,6 +79,8 @@ pub struct Allocation {
     pub per_link: Vec<usize>,
     /// The budget's binary search, probe by probe (empty for a tolerance).
     pub probes: Vec<Probe>,
+    /// The budget's spending on the mean ([`spend`](super::spend)), once made.
+    pub spent: Option<Spent>,
 }
 
 /// The links' smallest covers within `t`, if they total at most `k`.
@@ -122,6 +125,7 @@ pub fn by_tolerance(
             threshold: t,
             per_link,
             probes: Vec::new(),
+            spent: None,
         },
     ))
 }
@@ -180,6 +184,7 @@ pub fn by_budget(
             threshold,
             per_link,
             probes,
+            spent: None,
         },
     )))
 }

@@ -50,6 +50,9 @@ pub struct LinkTree {
     pub spheres: Vec<Sphere>,
     /// Every sphere's excess, NaN until measured.
     pub excess: Vec<f64>,
+    /// Every measured sphere's sample points outside the link: the sum of their distances to
+    /// the surface and their number (what [`spend`](super::spend) lowers the mean of).
+    pub outside: Vec<(f64, u32)>,
     /// Each piece's unit normal (zero when degenerate).
     normals: Vec<V3>,
     /// Every node's area-weighted normal sum and area.
@@ -134,6 +137,7 @@ impl LinkTree {
             facing,
             order,
             excess: vec![f64::NAN; spheres.len()],
+            outside: vec![(0.0, 0); spheres.len()],
             mesh,
             tree,
             spheres,
@@ -189,23 +193,24 @@ impl LinkTree {
         self.excess_stats(s, stack).0
     }
 
-    /// The largest and the mean distance to the surface of the sample points of `s` outside
-    /// the link (0 when none is), the mean over all samples.
-    fn excess_stats(&self, s: &Sphere, stack: &mut Vec<u32>) -> (f64, f64) {
-        let (mut max, mut sum) = (0.0f64, 0.0);
+    /// Over the sample points of `s` outside the link: their largest distance to the surface
+    /// (0 when none is), the sum of those distances and their number.
+    fn excess_stats(&self, s: &Sphere, stack: &mut Vec<u32>) -> (f64, f64, u32) {
+        let (mut max, mut sum, mut n) = (0.0f64, 0.0, 0u32);
         for d in &self.dirs {
             let (dist, out) = self.signed(&(s.center + d * s.radius), stack);
             if out {
                 max = max.max(dist);
                 sum += dist;
+                n += 1;
             }
         }
-        (max, sum / self.dirs.len().max(1) as f64)
+        (max, sum, n)
     }
 
     /// The sphere for node `x` among the candidates (see the module) and its excess: of those
     /// within [`MEAN_SLACK`] of the least excess, the one of least mean distance outside.
-    pub fn best_sphere(&self, x: u32, stack: &mut Vec<u32>) -> (Sphere, f64) {
+    pub fn best_sphere(&self, x: u32, stack: &mut Vec<u32>) -> (Sphere, f64, (f64, u32)) {
         let base = self.spheres[x as usize];
         let mut found = vec![(base, self.excess_stats(&base, stack))];
         let (sum, area) = self.facing[x as usize];
@@ -223,12 +228,12 @@ impl LinkTree {
             }
         }
         let least = found.iter().map(|f| f.1.0).fold(f64::INFINITY, f64::min);
-        let (s, (max, _)) = found
+        let (s, (max, sum, n)) = found
             .into_iter()
             .filter(|f| f.1.0 <= least * (1.0 + MEAN_SLACK))
             .min_by(|a, b| a.1.1.total_cmp(&b.1.1))
             .expect("the least is among them");
-        (s, max)
+        (s, max, (sum, n))
     }
 
     /// Measures the excess of every node of `nodes` not measured yet, in parallel, keeping
@@ -242,13 +247,14 @@ impl LinkTree {
         for chunk in todo.chunks(CHUNK) {
             stop.check()?;
             let this = &*self;
-            let values: Vec<(Sphere, f64)> = chunk
+            let values: Vec<(Sphere, f64, (f64, u32))> = chunk
                 .par_iter()
                 .map_init(Vec::new, |stack, &x| this.best_sphere(x, stack))
                 .collect();
-            for (&x, (s, e)) in chunk.iter().zip(values) {
+            for (&x, (s, e, o)) in chunk.iter().zip(values) {
                 self.spheres[x as usize] = s;
                 self.excess[x as usize] = e;
+                self.outside[x as usize] = o;
             }
         }
         Ok(())

@@ -17,6 +17,7 @@ pub mod link_tree;
 pub mod pieces;
 pub mod read_set;
 pub mod score;
+pub mod spend;
 pub mod write;
 
 use std::fmt::Write as _;
@@ -39,6 +40,8 @@ pub const NODE_SAMPLES: usize = 64;
 pub const PIECES_PER_DIAGONAL: f64 = 8.0;
 /// Levels of every tree measured for the recording (depth ≤ this).
 pub const SHOWN_DEPTH: u32 = 6;
+/// With a budget, the mean's spending may split every node down to this depth ([`spend`]).
+pub const MEAN_DEPTH: u32 = 8;
 /// Pieces are never cut below a link's box diagonal over this.
 pub const FINEST_PIECES: f64 = 256.0;
 
@@ -61,6 +64,9 @@ pub struct Settings {
     pub margin: f64,
     /// Smallest written radius.
     pub min_radius: f64,
+    /// With a budget: the share by which the largest excess may exceed the budget's least one
+    /// while its spheres are spent to lower the mean excess ([`spend`]).
+    pub slack: f64,
 }
 
 impl Settings {
@@ -191,7 +197,19 @@ pub fn spherize(links: Vec<Link>, settings: Settings, stop: &Stop) -> Result<Sph
     let (covers, allocation) = match settings.limit {
         Limit::Tolerance(t) => allocate::by_tolerance(&mut trees, t, stop)?,
         Limit::Budget(k) => {
-            allocate::by_budget(&mut trees, k, stop)?.map_err(anyhow::Error::msg)?
+            let (covers, mut allocation) =
+                allocate::by_budget(&mut trees, k, stop)?.map_err(anyhow::Error::msg)?;
+            for tree in trees.iter_mut() {
+                let upper: Vec<u32> = (0..tree.tree.len() as u32)
+                    .filter(|&x| depth_of(&tree.tree, x) <= MEAN_DEPTH)
+                    .collect();
+                tree.measure(&upper, stop)?;
+            }
+            let limit = allocation.threshold * (1.0 + settings.slack);
+            let (covers, spent) = spend::by_mean(&trees, k, limit, covers, stop)?;
+            allocation.per_link = covers.iter().map(Vec::len).collect();
+            allocation.spent = Some(spent);
+            (covers, allocation)
         }
     };
     let mut links = Vec::with_capacity(out.len());
@@ -323,11 +341,19 @@ impl Report {
         };
         let _ = writeln!(
             out,
-            "{}: {} links, {limit}: {} spheres, largest node excess {:.4}",
+            "{}: {} links, {limit}: {} spheres, largest node excess {:.4}{}",
             self.robot,
             self.links.len(),
             self.score.spheres,
-            self.allocation.threshold
+            self.allocation.threshold,
+            match self.allocation.spent {
+                Some(x) if x.limit > self.allocation.threshold => format!(
+                    " (the least; spent on the mean within {:.4}, sampled mean {:.4})",
+                    x.limit, x.mean
+                ),
+                Some(x) => format!(" (sampled mean {:.4})", x.mean),
+                None => String::new(),
+            }
         );
         let _ = writeln!(
             out,

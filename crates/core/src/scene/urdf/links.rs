@@ -47,13 +47,8 @@ pub struct Links {
 
 /// Reads the URDF at `path` with `opts` (collision or visual geometry, joint values, package
 /// folders) and gives each link's mesh in the link's frame. Errors are the loader's, one line
-/// naming the file.
-pub fn read_links(path: &Path, opts: &UrdfOptions) -> Result<Links, LoadError> {
-    read_links_until(path, opts, &Stop::new())
-}
-
-/// [`read_links`], its long loops checking `stop` (Err: kind [`LoadErrorKind::Interrupted`]).
-pub fn read_links_until(path: &Path, opts: &UrdfOptions, stop: &Stop) -> Result<Links, LoadError> {
+/// naming the file; stops with an interrupted error when `stop` is requested.
+pub fn read_links(path: &Path, opts: &UrdfOptions, stop: &Stop) -> Result<Links, LoadError> {
     let shown = path.display().to_string();
     let err = |kind, problem: String| LoadError {
         file: shown.clone(),
