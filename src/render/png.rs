@@ -2,7 +2,11 @@
 //! so the same SVG gives the same PNG bytes on every machine).
 
 use resvg::{tiny_skia, usvg};
+use std::sync::mpsc;
 use std::sync::{Arc, OnceLock};
+use std::time::Duration;
+
+use crate::stop::{Interrupted, Stop};
 
 /// DejaVu Sans 2.37 (see `assets/fonts/README.md` for its origin and licence).
 pub const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
@@ -26,6 +30,31 @@ pub fn options() -> usvg::Options<'static> {
     };
     opt.fontdb = fontdb();
     opt
+}
+
+/// [`svg_to_png`] on a thread of its own, waited for while `stop` is not requested: a large
+/// drawing renders in one call that cannot look at `stop`, so on a stop this returns
+/// [`Interrupted`] at once and leaves the thread to end with the process.
+pub fn svg_to_png_until(svg: String, stop: &Stop) -> Result<Result<Vec<u8>, String>, Interrupted> {
+    let (tx, rx) = mpsc::channel();
+    let spawned = std::thread::Builder::new()
+        .name("svg-to-png".into())
+        .spawn(move || {
+            let _ = tx.send(svg_to_png(&svg));
+        });
+    if let Err(e) = spawned {
+        return Ok(Err(format!("cannot start the rendering thread: {e}")));
+    }
+    loop {
+        stop.check()?;
+        match rx.recv_timeout(Duration::from_millis(20)) {
+            Ok(png) => return Ok(png),
+            Err(mpsc::RecvTimeoutError::Timeout) => {}
+            Err(mpsc::RecvTimeoutError::Disconnected) => {
+                return Ok(Err("the rendering thread failed".into()));
+            }
+        }
+    }
 }
 
 /// Renders an SVG document to PNG bytes at its own size (1 SVG unit = 1 pixel).

@@ -230,6 +230,7 @@ pub fn draw(
             .get(kind)
             .with_context(|| format!("no {} Wrapper Tree was built", kind.name()))?;
         for &d in &levels {
+            stop.check()?;
             let mut f = super::level_frame(scene, tree, d, &|x| super::wrapper_shape(w, x));
             let mut name = format!("frame-{:02}-level-{d}", frames.len());
             if kinds.len() > 1 || kind != WrapperKind::Sphere {
@@ -255,7 +256,12 @@ pub fn draw(
         scene.name,
         tree.depth_max()
     );
-    let mut svgs: Vec<String> = frames.iter().map(|f| super::frame_svg(f, &cam)).collect();
+    let mut svgs = Vec::with_capacity(frames.len() + 1);
+    for f in &frames {
+        stop.check()?;
+        svgs.push(super::frame_svg(f, &cam));
+    }
+    stop.check()?;
     svgs.push(super::sheet_svg(
         &frames,
         &cam,
@@ -266,7 +272,8 @@ pub fn draw(
     for ((png, _), text) in outs.iter().zip(&svgs) {
         stop.check()?;
         let dest = png.dest().display().to_string();
-        pngs.push(super::svg_to_png(text).map_err(|e| anyhow::anyhow!("{dest}: {e}"))?);
+        let png = super::png::svg_to_png_until(text.clone(), stop)?;
+        pngs.push(png.map_err(|e| anyhow::anyhow!("{dest}: {e}"))?);
     }
     let mut written = Vec::new();
     for (((png, svg), text), bytes) in outs.into_iter().zip(&svgs).zip(&pngs) {

@@ -11,7 +11,8 @@ use crate::scene::{PrimitiveKind, Scene};
 pub const MAX_PIECES: usize = 4096;
 
 /// `mesh` with every triangle whose longest edge exceeds `max_edge` halved across its longest
-/// edge until none does (or [`MAX_PIECES`] pieces); polygons already within it are kept whole.
+/// edge until none does (or [`MAX_PIECES`] pieces); polygons whose vertices are all within
+/// `max_edge` of each other are kept whole, the others are cut through their triangles.
 pub fn split_long_edges(mesh: &Scene, max_edge: f64) -> Scene {
     let mut out = Scene::new(mesh.name.clone());
     out.points = mesh.points.clone();
@@ -19,9 +20,13 @@ pub fn split_long_edges(mesh: &Scene, max_edge: f64) -> Scene {
     for i in 0..mesh.len() {
         let verts = mesh.prim(i);
         let n = verts.len();
-        let within = (0..n).all(|k| {
-            let (a, b) = (verts[k], verts[(k + 1) % n]);
-            !long(&mesh.points[a as usize], &mesh.points[b as usize])
+        // Every pair of vertices, not only the edges: a disc's many short edges span a wide
+        // polygon, whose own sphere would be as wide.
+        let within = (0..n).all(|a| {
+            (a + 1..n).all(|b| {
+                let (a, b) = (verts[a] as usize, verts[b] as usize);
+                !long(&mesh.points[a], &mesh.points[b])
+            })
         });
         if within || max_edge.is_nan() || max_edge <= 0.0 {
             out.push(PrimitiveKind::Polygon, verts, mesh.prim_tris(i));
@@ -83,5 +88,36 @@ mod tests {
         }
         assert!(out.len() > 4);
         assert_eq!(split_long_edges(&s, 10.0).len(), 1);
+    }
+
+    #[test]
+    fn a_disc_of_short_edges_is_cut_to_pieces_of_the_bound() {
+        // A 32-gon of radius 1: edges of about 0.2, but 2 across.
+        let n = 32u32;
+        let mut s = Scene::new("disc");
+        s.points = (0..n)
+            .map(|k| {
+                let t = f64::from(k) * std::f64::consts::TAU / f64::from(n);
+                P3::new(t.cos(), t.sin(), 0.0)
+            })
+            .collect();
+        let verts: Vec<u32> = (0..n).collect();
+        let fan: Vec<[u32; 3]> = (1..n - 1).map(|k| [0, k, k + 1]).collect();
+        s.push(PrimitiveKind::Polygon, &verts, &fan);
+        let out = split_long_edges(&s, 0.5);
+        assert!(out.len() > 8, "{} pieces", out.len());
+        for i in 0..out.len() {
+            let p: Vec<P3> = out.prim_vertices(i).copied().collect();
+            for a in &p {
+                for b in &p {
+                    assert!((a - b).norm() <= 0.5 + 1e-12);
+                }
+            }
+        }
+        assert_eq!(
+            split_long_edges(&s, 2.5).len(),
+            1,
+            "within the bound: kept whole"
+        );
     }
 }
