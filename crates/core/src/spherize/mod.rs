@@ -361,6 +361,14 @@ impl Report {
             "link", "spheres", "uncovered", "outside", "excess max", "mean", "volume"
         );
         let mm = |x: f64| format!("{:.1} mm", x * 1000.0);
+        // A flat link (a disc, a plate) has no volume to compare with.
+        let ratio = |x: f64| {
+            if x.is_finite() {
+                format!("{x:.2}×")
+            } else {
+                "—".into()
+            }
+        };
         let outside = |x: f64| {
             if x > score::SLACK {
                 mm(x)
@@ -371,27 +379,27 @@ impl Report {
         for l in self.score.per_link.iter() {
             let _ = writeln!(
                 out,
-                "{:<28} {:>7} {:>8.2}% {:>9} {:>10} {:>10} {:>6.2}×",
+                "{:<28} {:>7} {:>8.2}% {:>9} {:>10} {:>10} {:>7}",
                 l.link,
                 l.spheres,
                 l.uncovered * 100.0,
                 outside(l.outside_max),
                 mm(l.excess_max),
                 mm(l.excess_mean),
-                l.volume_ratio
+                ratio(l.volume_ratio)
             );
         }
         for (name, s) in [("all", &self.score), ("one per link (_1)", &self.top_score)] {
             let _ = writeln!(
                 out,
-                "{:<28} {:>7} {:>8.2}% {:>9} {:>10} {:>10} {:>6.2}×",
+                "{:<28} {:>7} {:>8.2}% {:>9} {:>10} {:>10} {:>7}",
                 name,
                 s.spheres,
                 s.uncovered * 100.0,
                 outside(s.outside_max),
                 mm(s.excess_max),
                 mm(s.excess_mean),
-                s.volume_ratio
+                ratio(s.volume_ratio)
             );
         }
         out
