@@ -51,7 +51,7 @@ pub struct LinkTree {
     /// Every sphere's excess, NaN until measured.
     pub excess: Vec<f64>,
     /// Every measured sphere's sample points outside the link: the sum of their distances to
-    /// the surface and their number (what [`spend`](super::spend) lowers the mean of).
+    /// the surface and their number (what `spend.rs` lowers the mean of).
     pub outside: Vec<(f64, u32)>,
     /// Each piece's unit normal (zero when degenerate).
     normals: Vec<V3>,

@@ -1,6 +1,6 @@
 //! Spending a budget on the mean excess, once its largest excess is settled.
 //!
-//! [`by_budget`](super::allocate::by_budget) finds the least robot-wide largest excess M* within
+//! `allocate::by_budget` finds the least robot-wide largest excess M* within
 //! K spheres, and each link's fewest spheres for it. [`by_mean`] then chooses, among the covers
 //! of at most K spheres in all whose every node's excess is ≤ a limit T ≥ M* (M* itself, or
 //! M* with a slack), those of least **sampled mean**: over every cover sphere's sample points
