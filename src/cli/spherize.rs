@@ -162,7 +162,14 @@ impl SpherizeCmd {
         let bar = super::progress::spinner("spherize");
         let done = spherize::spherize(links.links, settings, &stop);
         bar.finish_and_clear();
-        let done = done?;
+        // A setting the robot cannot meet (a budget below its links) names the robot.
+        let done = done.map_err(|e| {
+            if e.is::<wraptree::stop::Interrupted>() {
+                e
+            } else {
+                anyhow::anyhow!("{}: {e}", self.robot.display())
+            }
+        })?;
         let report = Report::new(&links.robot.name, &done);
         let cover = done.cover_spheres();
         let mut written = Vec::new();
