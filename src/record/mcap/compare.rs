@@ -101,14 +101,7 @@ fn write(file: &Pending, scene: &Scene, scene_name: &str, runs: &[CompareRun<'_>
         };
         emit(&mut w, buf, &mut log_topic, t, &log)?;
     }
-    w.mcap.finish()?;
-    let inner = w
-        .mcap
-        .into_inner()
-        .into_inner()
-        .map_err(|e| e.into_error())?;
-    inner.sync_all()?;
-    Ok(())
+    w.finish_file()
 }
 
 /// A run's merges, drawn boxes and divergence mark, on its `[merge, bodies, divergence]`

@@ -136,6 +136,20 @@ struct Out<W: Write + Seek> {
     live: Option<McapTee>,
 }
 
+impl Out<std::io::BufWriter<std::fs::File>> {
+    /// Ends the file (summary, footer), flushes it and syncs it to disk.
+    fn finish_file(mut self) -> anyhow::Result<()> {
+        self.mcap.finish()?;
+        let file = self
+            .mcap
+            .into_inner()
+            .into_inner()
+            .map_err(|e| e.into_error())?;
+        file.sync_all()?;
+        Ok(())
+    }
+}
+
 impl<W: Write + Seek> std::ops::Deref for Out<W> {
     type Target = mcap::Writer<W>;
     fn deref(&self) -> &mcap::Writer<W> {

@@ -86,12 +86,5 @@ fn write_file(view: &View, file: &Pending) -> Result<()> {
         };
         emit(&mut w, buf, &mut allocation, t, &log)?;
     }
-    w.mcap.finish()?;
-    let inner = w
-        .mcap
-        .into_inner()
-        .into_inner()
-        .map_err(|e| e.into_error())?;
-    inner.sync_all()?;
-    Ok(())
+    w.finish_file()
 }
