@@ -11,6 +11,7 @@ use wraptree::scene::urdf::links::read_links;
 use wraptree::spherize::allocate::by_budget;
 use wraptree::spherize::link_tree::LinkTree;
 use wraptree::spherize::spend::by_mean;
+use wraptree::spherize::tighten::tighten;
 use wraptree::spherize::{Limit, Settings, spherize};
 use wraptree::stop::Stop;
 
@@ -373,4 +374,38 @@ fn bad_input_is_one_error_line_and_writes_nothing() {
         .map(|e| e.unwrap().file_name())
         .collect();
     assert_eq!(left.len(), 1, "{left:?}");
+}
+
+#[test]
+fn tightening_keeps_every_piece_covered_and_never_loosens_a_sphere() {
+    let stop = Stop::new();
+    let mut changed = 0;
+    for seed in [3, 11, 29] {
+        let mut t = LinkTree::build(wraptree::scene::generate::soup(300, seed), 32, &stop).unwrap();
+        let cover = t.tree.level(3);
+        t.measure(&cover, &stop).unwrap();
+        let tight = tighten(&t, &cover, &stop).unwrap();
+        assert!(!tight.is_empty() && tight.len() <= cover.len());
+        let size = t.mesh.aabb().diameter();
+        for p in &t.mesh.points {
+            let out = tight
+                .iter()
+                .map(|s| (p - s.sphere.center).norm() - s.sphere.radius)
+                .fold(f64::INFINITY, f64::min);
+            assert!(out <= 1e-9 * size, "seed {seed}: a vertex {out} outside");
+        }
+        let largest = |e: &mut dyn Iterator<Item = f64>| e.fold(0.0, f64::max);
+        let before = largest(&mut cover.iter().map(|&x| t.excess[x as usize]));
+        let after = largest(&mut tight.iter().map(|s| s.excess));
+        assert!(
+            after <= before * (1.0 + 1e-9),
+            "seed {seed}: {after} > {before}"
+        );
+        let outside = |s: &mut dyn Iterator<Item = f64>| s.sum::<f64>();
+        let before = outside(&mut cover.iter().map(|&x| t.outside[x as usize].0));
+        let after = outside(&mut tight.iter().map(|s| s.outside.0));
+        assert!(after <= before * (1.0 + 1e-9), "seed {seed}");
+        changed += usize::from(tight.len() < cover.len() || after < before);
+    }
+    assert!(changed > 0, "tightening never changed a cover");
 }

@@ -73,13 +73,12 @@ impl View {
                 let mut mesh = l.link.mesh.clone();
                 mesh.points = mesh.points.iter().map(pose).collect();
                 let tree = &l.tree;
-                let drawn = |x: u32| {
-                    let sphere = s.settings.planner(&tree.spheres[x as usize]);
-                    (
-                        posed(pose, &sphere),
-                        excess_color(tree.excess[x as usize], t),
-                    )
+                let drawn_sphere = |sphere: &Sphere, excess: f64| {
+                    let sphere = s.settings.planner(sphere);
+                    (posed(pose, &sphere), excess_color(excess, t))
                 };
+                let drawn =
+                    |x: u32| drawn_sphere(&tree.spheres[x as usize], tree.excess[x as usize]);
                 let levels = (0..=SHOWN_DEPTH.min(tree.tree.depth_max()))
                     .map(|d| tree.tree.level(d).into_iter().map(drawn).collect())
                     .collect();
@@ -97,12 +96,16 @@ impl View {
                         })
                         .collect(),
                     mesh,
-                    cover: l.cover.iter().map(|&x| drawn(x)).collect(),
+                    cover: l
+                        .spheres
+                        .iter()
+                        .map(|c| drawn_sphere(&c.sphere, c.excess))
+                        .collect(),
                     levels,
                 }
             })
             .collect();
-        let n: usize = s.links.iter().map(|l| l.cover.len()).sum();
+        let n: usize = s.links.iter().map(|l| l.spheres.len()).sum();
         View {
             links,
             probes: s

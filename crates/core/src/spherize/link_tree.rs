@@ -211,12 +211,27 @@ impl LinkTree {
     /// The sphere for node `x` among the candidates (see the module) and its excess: of those
     /// within [`MEAN_SLACK`] of the least excess, the one of least mean distance outside.
     pub fn best_sphere(&self, x: u32, stack: &mut Vec<u32>) -> (Sphere, f64, (f64, u32)) {
-        let base = self.spheres[x as usize];
+        self.best_for(
+            self.spheres[x as usize],
+            self.order.node_points(x),
+            self.facing[x as usize],
+            stack,
+        )
+    }
+
+    /// The best sphere holding `points` (see the module), from their smallest enclosing sphere
+    /// `base` and their area-weighted normal sum and area, with its excess and the sum and
+    /// number of its samples outside.
+    pub fn best_for(
+        &self,
+        base: Sphere,
+        points: &[P3],
+        (sum, area): (V3, f64),
+        stack: &mut Vec<u32>,
+    ) -> (Sphere, f64, (f64, u32)) {
         let mut found = vec![(base, self.excess_stats(&base, stack))];
-        let (sum, area) = self.facing[x as usize];
         if sum.norm() >= FACING * area && area > 0.0 && base.radius > 0.0 {
             let inward = -sum.normalize();
-            let points = self.order.node_points(x);
             for &k in &DEPTHS[1..] {
                 let center = base.center + inward * (k * base.radius);
                 let radius = points
@@ -234,6 +249,17 @@ impl LinkTree {
             .min_by(|a, b| a.1.1.total_cmp(&b.1.1))
             .expect("the least is among them");
         (s, max, (sum, n))
+    }
+
+    /// The excess of `s`, and the sum and number of its samples outside the link.
+    pub fn stats(&self, s: &Sphere, stack: &mut Vec<u32>) -> (f64, (f64, u32)) {
+        let (max, sum, n) = self.excess_stats(s, stack);
+        (max, (sum, n))
+    }
+
+    /// Leaf `p`'s area-weighted normal and area.
+    pub fn piece_facing(&self, p: u32) -> (V3, f64) {
+        self.facing[p as usize]
     }
 
     /// Measures the excess of every node of `nodes` not measured yet, in parallel, keeping

@@ -5,9 +5,11 @@
 //! polygons cut into pieces of bounded edge ([`pieces`]), one Subset Tree over them with the
 //! smallest enclosing sphere and the sampled excess of every node ([`link_tree`]), and a cover —
 //! a cut of the tree — per link ([`allocate`]): the fewest spheres within a tolerance, or the
-//! least robot-wide largest excess within a budget, allocated exactly across links. Every
-//! node's sphere holds all of the node's vertices, hence its pieces, so every cover holds the
-//! whole link: the spheres are conservative by construction.
+//! least robot-wide largest excess within a budget, allocated exactly across links. Each cover
+//! is then [tightened](mod@tighten): its spheres give up the pieces other spheres hold, and the
+//! spheres a budget frees are spent again. Every node's sphere holds all of the node's
+//! vertices, hence its pieces, and tightening keeps every piece in some sphere, so every cover
+//! holds the whole link: the spheres are conservative by construction.
 //!
 //! [`score`] measures a set the way the independent checker does, [`read_set`] reads existing
 //! sets to score them, and [`write`](mod@write) writes URDF, cuRobo YAML, SRDF and `.sph` files.
@@ -18,6 +20,7 @@ pub mod pieces;
 pub mod read_set;
 pub mod score;
 pub mod spend;
+pub mod tighten;
 pub mod write;
 
 use std::fmt::Write as _;
@@ -31,19 +34,23 @@ use crate::scene::urdf::links::Link;
 use crate::stop::{Interrupted, Stop};
 use allocate::Allocation;
 use link_tree::LinkTree;
+use rayon::prelude::*;
 use read_set::SphereSet;
 use score::Score;
+use tighten::Tight;
 
 /// Boundary samples per sphere when measuring a node's excess.
 pub const NODE_SAMPLES: usize = 64;
 /// Pieces are cut to edges of at most a link's box diagonal over this.
-pub const PIECES_PER_DIAGONAL: f64 = 8.0;
+pub const PIECES_PER_DIAGONAL: f64 = 16.0;
 /// Levels of every tree measured for the recording (depth ≤ this).
 pub const SHOWN_DEPTH: u32 = 6;
 /// With a budget, the mean's spending may split every node down to this depth ([`spend`]).
 pub const MEAN_DEPTH: u32 = 8;
 /// Pieces are never cut below a link's box diagonal over this.
 pub const FINEST_PIECES: f64 = 256.0;
+/// With a budget, how often the spheres tightening frees are spent again.
+pub const RESPEND_ROUNDS: usize = 8;
 
 /// What bounds the spheres.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -90,15 +97,14 @@ pub struct LinkResult {
     pub tree: LinkTree,
     /// The chosen cut, node ids sorted.
     pub cover: Vec<u32>,
+    /// The cut's spheres, tightened ([`tighten`](mod@tighten)): as many or fewer.
+    pub spheres: Vec<tighten::Tight>,
 }
 
 impl LinkResult {
-    /// The largest node excess of the cover.
+    /// The largest excess of the cover's spheres.
     pub fn cover_excess(&self) -> f64 {
-        self.cover
-            .iter()
-            .map(|&x| self.tree.excess[x as usize])
-            .fold(0.0, f64::max)
+        self.spheres.iter().map(|t| t.excess).fold(0.0, f64::max)
     }
 }
 
@@ -124,11 +130,10 @@ impl Spherized {
         self.links
             .iter()
             .map(|l| {
-                let s = &l.tree.spheres;
                 let v = l
-                    .cover
+                    .spheres
                     .iter()
-                    .map(|&x| self.settings.planner(&s[x as usize]))
+                    .map(|t| self.settings.planner(&t.sphere))
                     .collect();
                 (l.link.name.clone(), v)
             })
@@ -194,8 +199,12 @@ pub fn spherize(links: Vec<Link>, settings: Settings, stop: &Stop) -> Result<Sph
         trees.push(LinkTree::build(pieces, NODE_SAMPLES, stop)?);
         out.push((link, max_edge));
     }
-    let (covers, allocation) = match settings.limit {
-        Limit::Tolerance(t) => allocate::by_tolerance(&mut trees, t, stop)?,
+    let (covers, tight, allocation) = match settings.limit {
+        Limit::Tolerance(t) => {
+            let (covers, allocation) = allocate::by_tolerance(&mut trees, t, stop)?;
+            let tight = tighten_all(&trees, &covers, stop)?;
+            (covers, tight, allocation)
+        }
         Limit::Budget(k) => {
             let (covers, mut allocation) =
                 allocate::by_budget(&mut trees, k, stop)?.map_err(anyhow::Error::msg)?;
@@ -206,14 +215,35 @@ pub fn spherize(links: Vec<Link>, settings: Settings, stop: &Stop) -> Result<Sph
                 tree.measure(&upper, stop)?;
             }
             let limit = allocation.threshold * (1.0 + settings.slack);
-            let (covers, spent) = spend::by_mean(&trees, k, limit, covers, stop)?;
-            allocation.per_link = covers.iter().map(Vec::len).collect();
+            // Tightening drops spheres; the budget they free is spent again, while it fits.
+            let mut best: Option<(Vec<Vec<u32>>, Vec<Vec<Tight>>, spend::Spent)> = None;
+            let mut spend_k = k;
+            for _ in 0..RESPEND_ROUNDS {
+                let (covers, spent) = spend::by_mean(&trees, spend_k, limit, covers.clone(), stop)?;
+                if best.as_ref().is_some_and(|b| b.0 == covers) {
+                    break;
+                }
+                let tight = tighten_all(&trees, &covers, stop)?;
+                let n: usize = tight.iter().map(Vec::len).sum();
+                if n > k {
+                    break;
+                }
+                best = Some((covers, tight, spent));
+                if n == k {
+                    break;
+                }
+                spend_k += k - n;
+            }
+            let (covers, tight, spent) = best.expect("the first spending fits the budget");
+            allocation.per_link = tight.iter().map(Vec::len).collect();
             allocation.spent = Some(spent);
-            (covers, allocation)
+            (covers, tight, allocation)
         }
     };
     let mut links = Vec::with_capacity(out.len());
-    for (((link, max_edge), mut tree), cover) in out.into_iter().zip(trees).zip(covers) {
+    for ((((link, max_edge), mut tree), cover), spheres) in
+        out.into_iter().zip(trees).zip(covers).zip(tight)
+    {
         let shown: Vec<u32> = (0..tree.tree.len() as u32)
             .filter(|&x| depth_of(&tree.tree, x) <= SHOWN_DEPTH)
             .collect();
@@ -223,6 +253,7 @@ pub fn spherize(links: Vec<Link>, settings: Settings, stop: &Stop) -> Result<Sph
             max_edge,
             tree,
             cover,
+            spheres,
         });
     }
     let out = links;
@@ -232,6 +263,19 @@ pub fn spherize(links: Vec<Link>, settings: Settings, stop: &Stop) -> Result<Sph
         allocation,
         seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// Every link's cover tightened, in parallel.
+fn tighten_all(
+    trees: &[LinkTree],
+    covers: &[Vec<u32>],
+    stop: &Stop,
+) -> Result<Vec<Vec<Tight>>, Interrupted> {
+    trees
+        .par_iter()
+        .zip(covers)
+        .map(|(t, c)| tighten::tighten(t, c, stop))
+        .collect()
 }
 
 /// The depth of node `x` (the root's is 0).
@@ -323,7 +367,7 @@ impl Report {
                     pieces: l.tree.mesh.len(),
                     max_edge: l.max_edge,
                     depth: l.tree.tree.depth_max(),
-                    spheres: l.cover.len(),
+                    spheres: l.spheres.len(),
                     cover_excess: l.cover_excess(),
                 })
                 .collect(),
