@@ -171,7 +171,29 @@ def partitioned_by_size(name):
     return markdown(header, rows)
 
 
+def agreement(name):
+    """Median fast / PLOC over the meshes, per measuring program and run."""
+    data = load(name)
+    header = ["measured by", "run 1", "run 2", "run 3"]
+    table = statistics.median(num(r["table (2026-11-28)"]) for r in data)
+    rows = [["the fast-path table above", times(table), "", ""]]
+    for label, prefix in [
+        ("`method_timing` at the table's commit (313a445)", "method_timing at 313a445"),
+        ("`method_timing` now", "method_timing"),
+        ("`wraptree bench` now", "wraptree bench"),
+    ]:
+        rows.append(
+            [label]
+            + [
+                times(statistics.median(num(r[f"{prefix}, run {i}"]) for r in data))
+                for i in (1, 2, 3)
+            ]
+        )
+    return markdown(header, rows)
+
+
 TABLES = {
+    "bench-vs-table": lambda: agreement("bench-vs-table-13"),
     "fast-path": lambda: fast_summary("fast-path-69"),
     "fast-path-threads": lambda: thread_summary("fast-path-threads-69"),
     "soup-threads": lambda: select(

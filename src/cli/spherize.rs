@@ -1,12 +1,14 @@
 //! `wraptree spherize`: per-link collision spheres for a robot (see [`wraptree::spherize`]);
 //! writes the spherized URDF, its one-sphere-per-link `_1` level, cuRobo YAML, MoveIt SRDF,
-//! the per-link trees as `.sph`, the scores as JSON, and the run as `.rrd` and `.mcap`.
+//! the per-link trees as `.sph`, the scores as JSON, the run as `.rrd` and `.mcap`, and
+//! figures of it with `--snapshot`.
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use wraptree::output::{check_new, output_prefix, with_ext, write_atomic};
+use wraptree::render::frames::Look;
 use wraptree::scene::UrdfOptions;
 use wraptree::scene::urdf::links::read_links;
 use wraptree::spherize::{self, Limit, Report, Settings, write};
@@ -76,6 +78,10 @@ pub struct SpherizeCmd {
     /// Do not record the run (PREFIX.rrd, PREFIX.mcap).
     #[arg(long)]
     no_record: bool,
+    /// Also draw the robot, its links' sphere trees at a few depths and the cover as PNG + SVG
+    /// figures into this directory (created if missing; iso view).
+    #[arg(long, value_name = "DIR")]
+    snapshot: Option<PathBuf>,
     /// Replace existing files.
     #[arg(long)]
     force: bool,
@@ -150,6 +156,9 @@ impl SpherizeCmd {
         if !self.no_record {
             paths.push(with_ext(&prefix, ".rrd"));
             paths.push(with_ext(&prefix, ".mcap"));
+        }
+        if let Some(dir) = &self.snapshot {
+            paths.push(dir.join("figure.png"));
         }
         let refs: Vec<&Path> = paths.iter().map(PathBuf::as_path).collect();
         check_new(&refs, &self.robot, self.force)?;
@@ -234,6 +243,19 @@ impl SpherizeCmd {
                 Some(&mcap),
                 self.force,
             )?);
+        }
+        if let Some(dir) = &self.snapshot {
+            let (az, el) = wraptree::render::View::Iso.angles();
+            let look = Look {
+                azimuth: az,
+                elevation: el,
+                size: (800, 600),
+                force: self.force,
+            };
+            let view = wraptree::record::spherize::View::new(&done);
+            let (pairs, _) =
+                wraptree::render::spheres::draw(&links.robot.name, &view, &look, dir, &stop)?;
+            written.extend(pairs.into_iter().map(|(png, _)| png));
         }
         if self.json {
             println!("{}", serde_json::to_string_pretty(&report)?);

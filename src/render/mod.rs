@@ -5,14 +5,17 @@
 //! inside a wrapper shows through) and written as SVG ([`svg`]); PNG is the same SVG rendered by
 //! `resvg` with the bundled DejaVu Sans font ([`png`]). [`figure`] builds the frames of a Subset
 //! Tree: the input, then levels with leaves as polygons and interior nodes as wrappers;
-//! [`snapshot`] draws and writes them all (`wraptree snapshot`).
+//! [`snapshot`] draws and writes them all (`wraptree snapshot`), [`spheres`] a spherized robot
+//! (`wraptree spherize --snapshot`), both through [`frames`].
 
 pub mod camera;
 pub mod chart;
 pub mod figure;
+pub mod frames;
 pub mod png;
 pub mod shape;
 pub mod snapshot;
+pub mod spheres;
 pub mod svg;
 
 pub use camera::{Camera, View};

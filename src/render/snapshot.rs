@@ -14,9 +14,9 @@
 //! # Ok::<(), anyhow::Error>(())
 //! ```
 
+use super::frames::{Look, write_frames};
 use super::{Frame, View};
 use crate::grouping::{self, EventLog, Grouping, Merge, ResolvedParams, SubsetTree};
-use crate::output::Pending;
 use crate::replay;
 use crate::scene::Scene;
 use crate::stop::{Interrupted, Stop};
@@ -130,29 +130,6 @@ pub fn choose_levels(tree: &SubsetTree, levels: &[u32], nodes: &[usize]) -> Resu
     Ok(levels)
 }
 
-/// The destinations of `names` in `dir`, each as a `.png`/`.svg` pair, all checked before any
-/// is written so an existing file without `force` stops the run before it writes anything.
-fn pendings(dir: &Path, names: &[String], force: bool) -> Result<Vec<(Pending, Pending)>> {
-    names
-        .iter()
-        .map(|n| {
-            Ok((
-                Pending::create(&dir.join(format!("{n}.png")), force)?,
-                Pending::create(&dir.join(format!("{n}.svg")), force)?,
-            ))
-        })
-        .collect()
-}
-
-fn write(p: Pending, bytes: &[u8]) -> Result<PathBuf> {
-    use std::io::Write;
-    let dest = p.dest().to_path_buf();
-    p.file()?
-        .write_all(bytes)
-        .with_context(|| format!("{}: write failed", dest.display()))?;
-    p.commit()
-}
-
 /// What [`draw`] wrote.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Snapshot {
@@ -241,11 +218,6 @@ pub fn draw(
             names.push(name);
         }
     }
-    names.push("figure".into());
-    let cam = super::fit_camera(&frames, opts.azimuth, opts.elevation, opts.size);
-    // Taken away again, if still empty, when the snapshot fails or is stopped.
-    let _dir = crate::output::output_dir(Some(dir), "")?;
-    let outs = pendings(dir, &names, opts.force)?;
     let kind = kinds
         .iter()
         .map(|&k| kind_title(k))
@@ -256,33 +228,13 @@ pub fn draw(
         scene.name,
         tree.depth_max()
     );
-    let mut svgs = Vec::with_capacity(frames.len() + 1);
-    for f in &frames {
-        stop.check()?;
-        svgs.push(super::frame_svg(f, &cam));
-    }
-    stop.check()?;
-    svgs.push(super::sheet_svg(
-        &frames,
-        &cam,
-        super::sheet_columns(frames.len()),
-        &title,
-    ));
-    let mut pngs = Vec::with_capacity(svgs.len());
-    for ((png, _), text) in outs.iter().zip(&svgs) {
-        stop.check()?;
-        let dest = png.dest().display().to_string();
-        let png = super::png::svg_to_png_until(text.clone(), stop)?;
-        pngs.push(png.map_err(|e| anyhow::anyhow!("{dest}: {e}"))?);
-    }
-    let mut written = Vec::new();
-    for (((png, svg), text), bytes) in outs.into_iter().zip(&svgs).zip(&pngs) {
-        let p = write(png, bytes)?;
-        let s = write(svg, text.as_bytes())?;
-        written.push((p, s));
-    }
-    Ok(Snapshot {
-        written,
-        captions: frames.into_iter().map(|f| f.caption).collect(),
-    })
+    let look = Look {
+        azimuth: opts.azimuth,
+        elevation: opts.elevation,
+        size: opts.size,
+        force: opts.force,
+    };
+    let captions = frames.iter().map(|f| f.caption.clone()).collect();
+    let written = write_frames(frames, names, &title, &look, dir, stop)?;
+    Ok(Snapshot { written, captions })
 }

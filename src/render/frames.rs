@@ -1,0 +1,90 @@
+//! Writing drawn frames: each as a PNG + SVG pair and all of them on one figure sheet, under
+//! one camera, every picture drawn before any file is moved into place.
+
+use super::Frame;
+use crate::output::Pending;
+use crate::stop::Stop;
+use anyhow::{Context, Result};
+use std::path::{Path, PathBuf};
+
+/// How the frames are looked at and written.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Look {
+    /// Eye azimuth in degrees around +Z, from −Y.
+    pub azimuth: f64,
+    /// Eye elevation in degrees above the XY plane.
+    pub elevation: f64,
+    /// Size of one frame's picture in pixels (the caption band is added below).
+    pub size: (u32, u32),
+    /// Replace existing images.
+    pub force: bool,
+}
+
+/// The destinations of `names` in `dir`, each as a `.png`/`.svg` pair, all checked before any
+/// is written so an existing file without `force` stops the run before it writes anything.
+fn pendings(dir: &Path, names: &[String], force: bool) -> Result<Vec<(Pending, Pending)>> {
+    names
+        .iter()
+        .map(|n| {
+            Ok((
+                Pending::create(&dir.join(format!("{n}.png")), force)?,
+                Pending::create(&dir.join(format!("{n}.svg")), force)?,
+            ))
+        })
+        .collect()
+}
+
+fn write(p: Pending, bytes: &[u8]) -> Result<PathBuf> {
+    use std::io::Write;
+    let dest = p.dest().to_path_buf();
+    p.file()?
+        .write_all(bytes)
+        .with_context(|| format!("{}: write failed", dest.display()))?;
+    p.commit()
+}
+
+/// Writes `frames` into `dir` (created with its parents if missing) as `NAME.{png,svg}`, one
+/// per frame with `names` in order, and `figure.{png,svg}`, the sheet of them all under
+/// `title`; returns the (PNG, SVG) pairs written, the sheet's last. `stop` is obeyed between
+/// the pictures and while each is rasterised ([`Interrupted`](crate::stop::Interrupted),
+/// nothing written).
+pub fn write_frames(
+    frames: Vec<Frame>,
+    mut names: Vec<String>,
+    title: &str,
+    look: &Look,
+    dir: &Path,
+    stop: &Stop,
+) -> Result<Vec<(PathBuf, PathBuf)>> {
+    names.push("figure".into());
+    let cam = super::fit_camera(&frames, look.azimuth, look.elevation, look.size);
+    // Taken away again, if still empty, when the drawing fails or is stopped.
+    let _dir = crate::output::output_dir(Some(dir), "")?;
+    let outs = pendings(dir, &names, look.force)?;
+    let mut svgs = Vec::with_capacity(frames.len() + 1);
+    for f in &frames {
+        stop.check()?;
+        svgs.push(super::frame_svg(f, &cam));
+    }
+    stop.check()?;
+    svgs.push(super::sheet_svg(
+        &frames,
+        &cam,
+        super::sheet_columns(frames.len()),
+        title,
+    ));
+    let mut pngs = Vec::with_capacity(svgs.len());
+    for ((png, _), text) in outs.iter().zip(&svgs) {
+        stop.check()?;
+        let dest = png.dest().display().to_string();
+        let png = super::png::svg_to_png_until(text.clone(), stop)?;
+        pngs.push(png.map_err(|e| anyhow::anyhow!("{dest}: {e}"))?);
+    }
+    let mut written = Vec::new();
+    for (((png, svg), text), bytes) in outs.into_iter().zip(&svgs).zip(&pngs) {
+        let p = write(png, bytes)?;
+        let s = write(svg, text.as_bytes())?;
+        written.push((p, s));
+    }
+    Ok(written)
+}
