@@ -409,3 +409,62 @@ fn tightening_keeps_every_piece_covered_and_never_loosens_a_sphere() {
     }
     assert!(changed > 0, "tightening never changed a cover");
 }
+
+#[test]
+fn the_snapshot_draws_the_robot_its_trees_and_its_cover() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = r2d2().display().to_string();
+    let p = dir.path().join("r2").display().to_string();
+    let figs = dir.path().join("figs");
+    let f = figs.display().to_string();
+    let args = [
+        "spherize",
+        &robot,
+        "--urdf-collision",
+        "--budget",
+        "30",
+        "--format",
+        "urdf",
+        "--no-record",
+        "-o",
+        &p,
+        "--snapshot",
+        &f,
+    ];
+    common::printed(&args, dir.path());
+    let svg = |n: &str| std::fs::read_to_string(figs.join(format!("{n}.svg"))).unwrap();
+    let circles = |s: &str| s.matches("<circle").count();
+    let read: Vec<String> = std::fs::read_dir(&figs)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    let cover = read
+        .iter()
+        .find(|n| n.ends_with("-cover.svg"))
+        .expect("a cover frame")
+        .trim_end_matches(".svg")
+        .to_string();
+    // The robot alone, then exactly the written spheres over it.
+    assert_eq!(circles(&svg("frame-00-robot")), 0);
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(format!("{p}.json")).unwrap()).unwrap();
+    let spheres = report["score"]["spheres"].as_u64().unwrap() as usize;
+    assert!(spheres > 2 && spheres <= 30, "{spheres}");
+    assert_eq!(circles(&svg(&cover)), spheres);
+    let links = circles(&svg("frame-01-depth-0"));
+    assert!(links > 1 && links < circles(&svg(&cover)), "{links}");
+    for name in ["frame-00-robot", &cover, "figure"] {
+        let png = std::fs::read(figs.join(format!("{name}.png"))).unwrap();
+        assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"), "{name}");
+    }
+    // Again, to another prefix but the same figures, without --force: one error line, the
+    // figures kept and nothing else written.
+    let before = std::fs::read(figs.join("figure.png")).unwrap();
+    let other = dir.path().join("again").display().to_string();
+    let mut args = args;
+    args[9] = &other;
+    let out = common::wraptree(&args, dir.path());
+    assert!(!Path::new(&format!("{other}.json")).exists());
+    common::assert_one_line_error(&out, "figure.png");
+    assert_eq!(std::fs::read(figs.join("figure.png")).unwrap(), before);
+}

@@ -97,5 +97,8 @@ pub fn draw(
     ));
     let captions = frames.iter().map(|f| f.caption.clone()).collect();
     let title = format!("{robot} · collision spheres · {}", view.summary);
-    Ok((write_frames(frames, names, &title, look, dir, stop)?, captions))
+    Ok((
+        write_frames(frames, names, &title, look, dir, stop)?,
+        captions,
+    ))
 }
