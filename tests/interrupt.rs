@@ -160,6 +160,20 @@ fn cases() -> Vec<Case> {
             "cover",
             words("cover {in}/assembly.obj --tolerance 0.001 -o cover"),
         ),
+        (
+            "spherize",
+            vec![
+                "spherize".into(),
+                format!("{scenes}/r2d2/r2d2.urdf"),
+                "--urdf-collision".into(),
+                "--budget".into(),
+                "40".into(),
+                "-o".into(),
+                "spheres".into(),
+                "--snapshot".into(),
+                "figures".into(),
+            ],
+        ),
     ];
     let mut v = Vec::new();
     for (name, args) in &commands {

@@ -5,9 +5,10 @@
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use wraptree::output::{check_new, output_prefix, with_ext, write_atomic};
+use wraptree::output::{Pending, check_new, output_dir, output_prefix, with_ext};
 use wraptree::render::frames::Look;
 use wraptree::scene::UrdfOptions;
 use wraptree::scene::urdf::links::read_links;
@@ -181,12 +182,18 @@ impl SpherizeCmd {
         })?;
         let report = Report::new(&links.robot.name, &done);
         let cover = done.cover_spheres();
-        let mut written = Vec::new();
+        // Every output is written whole first and moved into place only once all are ready,
+        // so a stop request before then leaves nothing.
+        let mut ready: Vec<Pending> = Vec::new();
         let mut put = |path: PathBuf, bytes: &[u8]| -> Result<()> {
-            write_atomic(&path, bytes, self.force)?;
-            written.push(path);
+            let p = Pending::create(&path, self.force)?;
+            p.file()?
+                .write_all(bytes)
+                .with_context(|| format!("{}: write failed", path.display()))?;
+            ready.push(p);
             Ok(())
         };
+        let mut dirs = Vec::new();
         put(
             with_ext(&prefix, ".json"),
             &serde_json::to_vec_pretty(&report).context("spherize: cannot serialise")?,
@@ -212,8 +219,7 @@ impl SpherizeCmd {
                 }
                 Format::Sph => {
                     let dir = with_ext(&prefix, ".sph");
-                    std::fs::create_dir_all(&dir)
-                        .with_context(|| format!("{}: cannot create", dir.display()))?;
+                    dirs.push(output_dir(Some(&dir), "")?);
                     for l in &done.links {
                         let spheres: Vec<_> =
                             l.tree.spheres.iter().map(|s| settings.planner(s)).collect();
@@ -235,28 +241,41 @@ impl SpherizeCmd {
                 }
             }
         }
+        stop.check()?;
         if !self.no_record {
             let (rrd, mcap) = (with_ext(&prefix, ".rrd"), with_ext(&prefix, ".mcap"));
-            written.extend(wraptree::record::spherize::record_spherized(
+            ready.extend(wraptree::record::spherize::record_spherized(
                 &done,
                 Some(&rrd),
                 Some(&mcap),
                 self.force,
             )?);
         }
-        if let Some(dir) = &self.snapshot {
-            let (az, el) = wraptree::render::View::Iso.angles();
-            let look = Look {
-                azimuth: az,
-                elevation: el,
-                size: (800, 600),
-                force: self.force,
-            };
-            let view = wraptree::record::spherize::View::new(&done);
-            let (pairs, _) =
-                wraptree::render::spheres::draw(&links.robot.name, &view, &look, dir, &stop)?;
-            written.extend(pairs.into_iter().map(|(png, _)| png));
+        let figures = match &self.snapshot {
+            Some(dir) => {
+                let (az, el) = wraptree::render::View::Iso.angles();
+                let look = Look {
+                    azimuth: az,
+                    elevation: el,
+                    size: (800, 600),
+                    force: self.force,
+                };
+                let view = wraptree::record::spherize::View::new(&done);
+                Some(
+                    wraptree::render::spheres::draw(&links.robot.name, &view, &look, dir, &stop)?.0,
+                )
+            }
+            None => None,
+        };
+        stop.check()?;
+        let mut written = Vec::with_capacity(ready.len());
+        for p in ready {
+            written.push(p.commit()?);
         }
+        if let Some(f) = figures {
+            written.extend(f.commit()?.into_iter().map(|(png, _)| png));
+        }
+        drop(dirs);
         if self.json {
             println!("{}", serde_json::to_string_pretty(&report)?);
         } else {

@@ -3,7 +3,7 @@
 //! (green none, red the largest the cover may have or more, grey unmeasured), each link's tree cut at
 //! depth d on the `level` timeline, and the budget's binary search probe by probe.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::Result;
 
@@ -123,14 +123,14 @@ impl View {
     }
 }
 
-/// Writes the run `s` to `rrd` and `mcap` (each if given), atomically; returns the paths
-/// written.
+/// Writes the run `s` to `rrd` and `mcap` (each if given), whole, but not yet moved into place:
+/// the caller commits them ([`Pending::commit`]) once every output of the run is ready.
 pub fn record_spherized(
     s: &Spherized,
     rrd: Option<&Path>,
     mcap: Option<&Path>,
     force: bool,
-) -> Result<Vec<PathBuf>> {
+) -> Result<Vec<Pending>> {
     let view = View::new(s);
     let mut out = Vec::new();
     if let Some(p) = rrd {
@@ -139,7 +139,7 @@ pub fn record_spherized(
     if let Some(p) = mcap {
         let file = Pending::create(p, force)?;
         super::mcap::spherize::write(&view, &file)?;
-        out.push(file.commit()?);
+        out.push(file);
     }
     Ok(out)
 }

@@ -1,8 +1,8 @@
 //! Writing drawn frames: each as a PNG + SVG pair and all of them on one figure sheet, under
-//! one camera, every picture drawn before any file is moved into place.
+//! one camera, every picture drawn and written before any file is moved into place.
 
 use super::Frame;
-use crate::output::Pending;
+use crate::output::{OutDir, Pending};
 use crate::stop::Stop;
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
@@ -34,32 +34,46 @@ fn pendings(dir: &Path, names: &[String], force: bool) -> Result<Vec<(Pending, P
         .collect()
 }
 
-fn write(p: Pending, bytes: &[u8]) -> Result<PathBuf> {
+fn write(p: &Pending, bytes: &[u8]) -> Result<()> {
     use std::io::Write;
-    let dest = p.dest().to_path_buf();
     p.file()?
         .write_all(bytes)
-        .with_context(|| format!("{}: write failed", dest.display()))?;
-    p.commit()
+        .with_context(|| format!("{}: write failed", p.dest().display()))
 }
 
-/// Writes `frames` into `dir` (created with its parents if missing) as `NAME.{png,svg}`, one
-/// per frame with `names` in order, and `figure.{png,svg}`, the sheet of them all under
-/// `title`; returns the (PNG, SVG) pairs written, the sheet's last. `stop` is obeyed between
-/// the pictures and while each is rasterised ([`Interrupted`](crate::stop::Interrupted),
-/// nothing written).
-pub fn write_frames(
+/// Frames drawn and written to temporary files beside their destinations, not yet in place;
+/// dropped, they leave nothing behind (nor the directories made for them).
+pub struct Drawn {
+    _dir: OutDir,
+    files: Vec<(Pending, Pending)>,
+}
+
+impl Drawn {
+    /// Moves every picture into place; returns the (PNG, SVG) pairs, the sheet's last.
+    pub fn commit(self) -> Result<Vec<(PathBuf, PathBuf)>> {
+        let Drawn { _dir, files } = self;
+        files
+            .into_iter()
+            .map(|(png, svg)| Ok((png.commit()?, svg.commit()?)))
+            .collect()
+    }
+}
+
+/// Draws `frames` for `dir` (created with its parents if missing) as `NAME.{png,svg}`, one per
+/// frame with `names` in order, and `figure.{png,svg}`, the sheet of them all under `title`,
+/// ready to [commit](Drawn::commit). `stop` is obeyed between the pictures and while each is
+/// rasterised ([`Interrupted`](crate::stop::Interrupted), nothing written).
+pub fn draw_frames(
     frames: Vec<Frame>,
     mut names: Vec<String>,
     title: &str,
     look: &Look,
     dir: &Path,
     stop: &Stop,
-) -> Result<Vec<(PathBuf, PathBuf)>> {
+) -> Result<Drawn> {
     names.push("figure".into());
     let cam = super::fit_camera(&frames, look.azimuth, look.elevation, look.size);
-    // Taken away again, if still empty, when the drawing fails or is stopped.
-    let _dir = crate::output::output_dir(Some(dir), "")?;
+    let out_dir = crate::output::output_dir(Some(dir), "")?;
     let outs = pendings(dir, &names, look.force)?;
     let mut svgs = Vec::with_capacity(frames.len() + 1);
     for f in &frames {
@@ -73,18 +87,29 @@ pub fn write_frames(
         super::sheet_columns(frames.len()),
         title,
     ));
-    let mut pngs = Vec::with_capacity(svgs.len());
-    for ((png, _), text) in outs.iter().zip(&svgs) {
+    for ((png, svg), text) in outs.iter().zip(&svgs) {
         stop.check()?;
         let dest = png.dest().display().to_string();
-        let png = super::png::svg_to_png_until(text.clone(), stop)?;
-        pngs.push(png.map_err(|e| anyhow::anyhow!("{dest}: {e}"))?);
+        let bytes = super::png::svg_to_png_until(text.clone(), stop)?
+            .map_err(|e| anyhow::anyhow!("{dest}: {e}"))?;
+        write(png, &bytes)?;
+        write(svg, text.as_bytes())?;
     }
-    let mut written = Vec::new();
-    for (((png, svg), text), bytes) in outs.into_iter().zip(&svgs).zip(&pngs) {
-        let p = write(png, bytes)?;
-        let s = write(svg, text.as_bytes())?;
-        written.push((p, s));
-    }
-    Ok(written)
+    Ok(Drawn {
+        _dir: out_dir,
+        files: outs,
+    })
+}
+
+/// [`draw_frames`], then every picture moved into place; returns the (PNG, SVG) pairs
+/// written, the sheet's last.
+pub fn write_frames(
+    frames: Vec<Frame>,
+    names: Vec<String>,
+    title: &str,
+    look: &Look,
+    dir: &Path,
+    stop: &Stop,
+) -> Result<Vec<(PathBuf, PathBuf)>> {
+    draw_frames(frames, names, title, look, dir, stop)?.commit()
 }

@@ -2,11 +2,11 @@
 //! stands, then its links' sphere trees at a few depths (one sphere per link first) and the
 //! chosen cover, every sphere over the meshes and coloured by its excess like the recordings.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::Result;
 
-use super::frames::{Look, write_frames};
+use super::frames::{Drawn, Look, draw_frames};
 use super::{Frame, Shape, Style, input_frame};
 use crate::geom::Sphere;
 use crate::record::spherize::View;
@@ -47,16 +47,16 @@ fn count(n: usize, one: &str) -> String {
     format!("{n} {one}{}", if n == 1 { "" } else { "s" })
 }
 
-/// Draws `view` of the robot `robot` into `dir` (see [`write_frames`]): `frame-00-robot`,
+/// Draws `view` of the robot `robot` for `dir` (see [`draw_frames`]): `frame-00-robot`,
 /// `frame-NN-depth-D` for each of [`DEPTHS`] the trees reach, `frame-NN-cover` and the
-/// `figure` sheet; returns the (PNG, SVG) pairs written and the frames' captions.
+/// `figure` sheet, ready to commit; also returns the frames' captions.
 pub fn draw(
     robot: &str,
     view: &View,
     look: &Look,
     dir: &Path,
     stop: &Stop,
-) -> Result<(Vec<(PathBuf, PathBuf)>, Vec<String>)> {
+) -> Result<(Drawn, Vec<String>)> {
     let triangles: usize = view.links.iter().map(|l| l.mesh.len()).sum();
     let mut frames = vec![frame(
         view,
@@ -98,7 +98,7 @@ pub fn draw(
     let captions = frames.iter().map(|f| f.caption.clone()).collect();
     let title = format!("{robot} · collision spheres · {}", view.summary);
     Ok((
-        write_frames(frames, names, &title, look, dir, stop)?,
+        draw_frames(frames, names, &title, look, dir, stop)?,
         captions,
     ))
 }

@@ -45,9 +45,14 @@ impl SeriesFile {
 
     /// Flushes and closes the file and moves it into place; returns its path.
     pub fn commit(self) -> anyhow::Result<PathBuf> {
+        self.finish()?.commit()
+    }
+
+    /// Flushes and closes the file, not yet moved into place.
+    pub fn finish(self) -> anyhow::Result<Pending> {
         let dest = self.pending.dest().to_path_buf();
         sink::close(self.rec, &self.status, self.pending.path())
             .map_err(|e| anyhow::anyhow!("{}: {e}", dest.display()))?;
-        self.pending.commit()
+        Ok(self.pending)
     }
 }

@@ -4,7 +4,7 @@
 //! (`blueprint`): the robot and its cover large, framed on the whole robot,
 //! beside the tree levels; below, the budget's probes and the log; the time panel on `probe`.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use rerun::components::FillMode;
 
@@ -12,6 +12,7 @@ use super::blueprint::{self, Layout, Node, View as Pane, ViewKind};
 use super::series_file::SeriesFile;
 use super::{send_at, send_static};
 use crate::geom::{Aabb, Sphere};
+use crate::output::Pending;
 use crate::record::spherize::View;
 
 fn rgba(c: [f64; 4]) -> rerun::Color {
@@ -85,8 +86,8 @@ fn layout(bbox: &Aabb, last: i64) -> Layout {
     }
 }
 
-/// Writes `view` to `dest` (replaced only with `force`); returns its path.
-pub fn write(view: &View, dest: &Path, force: bool) -> anyhow::Result<PathBuf> {
+/// Writes `view` for `dest` (replaced only with `force`), not yet moved into place.
+pub fn write(view: &View, dest: &Path, force: bool) -> anyhow::Result<Pending> {
     let file = SeriesFile::create(dest, "wraptree-spherize", force, None)?;
     let rec = file.rec();
     let mut bbox: Option<Aabb> = None;
@@ -150,5 +151,5 @@ pub fn write(view: &View, dest: &Path, force: bool) -> anyhow::Result<PathBuf> {
         };
         send_at(rec, "allocation/log", &at, &rerun::TextLog::new(text))?;
     }
-    file.commit()
+    file.finish()
 }
