@@ -210,17 +210,17 @@ pub fn spherize(links: Vec<Link>, settings: Settings, stop: &Stop) -> Result<Sph
                 allocate::by_budget(&mut trees, k, stop)?.map_err(anyhow::Error::msg)?;
             for tree in trees.iter_mut() {
                 let upper: Vec<u32> = (0..tree.tree.len() as u32)
-                    .filter(|&x| depth_of(&tree.tree, x) <= MEAN_DEPTH)
+                    .filter(|&x| tree.tree.depth[x as usize] <= MEAN_DEPTH)
                     .collect();
                 tree.measure(&upper, stop)?;
             }
             let limit = allocation.threshold * (1.0 + settings.slack);
             // Tightening drops spheres; the budget they free is spent again, while it fits.
-            let mut best: Option<(Vec<Vec<u32>>, Vec<Vec<Tight>>, spend::Spent)> = None;
+            let mut best: Option<Chosen> = None;
             let mut spend_k = k;
             for _ in 0..RESPEND_ROUNDS {
                 let (covers, spent) = spend::by_mean(&trees, spend_k, limit, covers.clone(), stop)?;
-                if best.as_ref().is_some_and(|b| b.0 == covers) {
+                if best.as_ref().is_some_and(|b| b.covers == covers) {
                     break;
                 }
                 let tight = tighten_all(&trees, &covers, stop)?;
@@ -228,13 +228,21 @@ pub fn spherize(links: Vec<Link>, settings: Settings, stop: &Stop) -> Result<Sph
                 if n > k {
                     break;
                 }
-                best = Some((covers, tight, spent));
+                best = Some(Chosen {
+                    covers,
+                    tight,
+                    spent,
+                });
                 if n == k {
                     break;
                 }
                 spend_k += k - n;
             }
-            let (covers, tight, spent) = best.expect("the first spending fits the budget");
+            let Chosen {
+                covers,
+                tight,
+                spent,
+            } = best.expect("the first spending fits the budget");
             allocation.per_link = tight.iter().map(Vec::len).collect();
             allocation.spent = Some(spent);
             (covers, tight, allocation)
@@ -245,7 +253,7 @@ pub fn spherize(links: Vec<Link>, settings: Settings, stop: &Stop) -> Result<Sph
         out.into_iter().zip(trees).zip(covers).zip(tight)
     {
         let shown: Vec<u32> = (0..tree.tree.len() as u32)
-            .filter(|&x| depth_of(&tree.tree, x) <= SHOWN_DEPTH)
+            .filter(|&x| tree.tree.depth[x as usize] <= SHOWN_DEPTH)
             .collect();
         tree.measure(&shown, stop)?;
         links.push(LinkResult {
@@ -265,6 +273,13 @@ pub fn spherize(links: Vec<Link>, settings: Settings, stop: &Stop) -> Result<Sph
     })
 }
 
+/// Covers chosen within a budget: the cuts, tightened, and what their spending reached.
+struct Chosen {
+    covers: Vec<Vec<u32>>,
+    tight: Vec<Vec<Tight>>,
+    spent: spend::Spent,
+}
+
 /// Every link's cover tightened, in parallel.
 fn tighten_all(
     trees: &[LinkTree],
@@ -276,16 +291,6 @@ fn tighten_all(
         .zip(covers)
         .map(|(t, c)| tighten::tighten(t, c, stop))
         .collect()
-}
-
-/// The depth of node `x` (the root's is 0).
-pub fn depth_of(tree: &crate::grouping::SubsetTree, x: u32) -> u32 {
-    let (mut d, mut y) = (0, x);
-    while tree.parent[y as usize] != crate::grouping::NONE {
-        y = tree.parent[y as usize];
-        d += 1;
-    }
-    d
 }
 
 /// Scores an existing `set` against `links` (each link's mesh grouped for its distances);
