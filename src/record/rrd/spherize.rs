@@ -1,5 +1,6 @@
 //! The `.rrd` of a spherize run ([`crate::record::spherize`]): `robot/<link>/mesh`,
-//! `robot/<link>/spheres` (static), `levels/<link>` on the `level` timeline and
+//! `robot/<link>/spheres` (static), `levels/<link>` on the `level` timeline (and at
+//! [`OPENING_DEPTH`] on `probe`, so the view is not empty on opening) and
 //! `allocation/threshold`, `allocation/spheres` on the `probe` timeline. It opens on a layout
 //! (`blueprint`): the robot and its cover large, framed on the whole robot,
 //! beside the tree levels; below, the budget's probes and the log; the time panel on `probe`.
@@ -14,6 +15,9 @@ use super::{send_at, send_static};
 use crate::geom::{Aabb, Sphere};
 use crate::output::Pending;
 use crate::record::spherize::View;
+
+/// The depth of the links' trees the level view shows on opening (the `probe` timeline).
+const OPENING_DEPTH: usize = 2;
 
 fn rgba(c: [f64; 4]) -> rerun::Color {
     let b = |x: f64| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
@@ -54,7 +58,9 @@ fn layout(bbox: &Aabb, last: i64) -> Layout {
             ),
             pane(
                 ViewKind::Spatial(eye),
-                "Each link's tree at depth `level`",
+                &format!(
+                    "Each link's tree at depth {OPENING_DEPTH} (every depth on the `level` timeline)"
+                ),
                 &["+ /robot/*/mesh", "+ /levels/**"],
             ),
         ],
@@ -130,6 +136,15 @@ pub fn write(view: &View, dest: &Path, force: bool) -> anyhow::Result<Pending> {
                 rec,
                 &format!("levels/{}", l.name),
                 &[("level", d as i64)],
+                &spheres(level),
+            )?;
+        }
+        // What the view shows on the `probe` timeline, where the file opens.
+        if let Some(level) = l.levels.get(OPENING_DEPTH).or(l.levels.last()) {
+            send_at(
+                rec,
+                &format!("levels/{}", l.name),
+                &[("probe", 0)],
                 &spheres(level),
             )?;
         }
