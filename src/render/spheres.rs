@@ -23,6 +23,9 @@ pub const UNDER_SPHERES_CELL: f64 = 2.0;
 /// Depths of the links' trees drawn between the robot and its cover.
 pub const DEPTHS: [usize; 3] = [0, 2, 4];
 
+/// Spheres with their colours (RGBA in 0..=1), as recorded.
+type Coloured = Vec<(Sphere, [f64; 4])>;
+
 /// The style of a sphere of colour `c` (RGBA in 0..=1, as recorded).
 fn sphere_style(c: [f64; 4]) -> Style {
     let byte = |x: f64| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
@@ -40,7 +43,7 @@ fn sphere_style(c: [f64; 4]) -> Style {
 /// one cell of a grid of that size become their mean, and triangles that collapse or repeat
 /// are left out. Below a pixel, the picture does not change; the files shrink with dense meshes.
 pub fn clustered(mesh: &Scene, cell: f64) -> Vec<Shape> {
-    if !(cell > 0.0) {
+    if cell.is_nan() || cell <= 0.0 {
         return input_frame(mesh).shapes;
     }
     let key = |p: &P3| (p / cell).map(|x| x.floor() as i64);
@@ -56,7 +59,8 @@ pub fn clustered(mesh: &Scene, cell: f64) -> Vec<Shape> {
                 sums.len() as u32 - 1
             });
             let s = &mut sums[id as usize];
-            (s.0 += p.coords, s.1 += 1.0);
+            s.0 += p.coords;
+            s.1 += 1.0;
             id
         })
         .collect();
@@ -107,7 +111,7 @@ pub fn draw(
 ) -> Result<(Drawn, Vec<String>)> {
     let triangles: usize = view.links.iter().map(|l| l.mesh.len()).sum();
     let mut names = vec!["frame-00-robot".to_string()];
-    let mut plans: Vec<(Vec<(Sphere, [f64; 4])>, String)> = vec![(
+    let mut plans: Vec<(Coloured, String)> = vec![(
         Vec::new(),
         format!(
             "robot · {} · {}",
@@ -117,7 +121,7 @@ pub fn draw(
     )];
     let deepest = view.links.iter().map(|l| l.levels.len()).max().unwrap_or(0);
     for d in DEPTHS.into_iter().filter(|&d| d < deepest) {
-        let spheres: Vec<(Sphere, [f64; 4])> = view
+        let spheres: Coloured = view
             .links
             .iter()
             .flat_map(|l| l.levels[d.min(l.levels.len() - 1)].iter().copied())
@@ -130,7 +134,7 @@ pub fn draw(
         names.push(format!("frame-{:02}-depth-{d}", plans.len()));
         plans.push((spheres, caption));
     }
-    let cover: Vec<(Sphere, [f64; 4])> = view
+    let cover: Coloured = view
         .links
         .iter()
         .flat_map(|l| l.cover.iter().copied())
