@@ -30,16 +30,19 @@ fn collision() -> UrdfOptions {
 fn every_vertex_of_every_link_is_inside_one_of_its_spheres() {
     let links = read_links(&r2d2(), &collision(), &Stop::new()).unwrap();
     assert!(links.links.len() >= 10, "{}", links.links.len());
-    for limit in [
-        Limit::Budget(links.links.len()),
-        Limit::Budget(40),
-        Limit::Tolerance(0.02),
+    for (limit, refine) in [
+        (Limit::Budget(links.links.len()), false),
+        (Limit::Budget(40), false),
+        (Limit::Budget(40), true),
+        (Limit::Tolerance(0.02), false),
+        (Limit::Tolerance(0.02), true),
     ] {
         let settings = Settings {
             limit,
             margin: 0.0,
             min_radius: 0.0,
             slack: 0.0,
+            refine,
         };
         let s = spherize(links.links.clone(), settings, &Stop::new()).unwrap();
         let cover = s.cover_spheres();
@@ -52,7 +55,10 @@ fn every_vertex_of_every_link_is_inside_one_of_its_spheres() {
             let size = l.link.mesh.aabb().diameter();
             for p in &l.link.mesh.points {
                 let inside = spheres.iter().any(|s| s.contains(p, 1e-9 * size));
-                assert!(inside, "{limit:?}: a vertex of {name} at {p} is outside");
+                assert!(
+                    inside,
+                    "{limit:?} (refine {refine}): a vertex of {name} at {p} is outside"
+                );
             }
         }
         let score = s.score(&cover);
@@ -68,6 +74,7 @@ fn margins_and_minimum_radii_are_applied_to_written_spheres() {
         margin: 0.0,
         min_radius: 0.0,
         slack: 0.0,
+        refine: false,
     };
     let padded = Settings {
         margin: 0.01,
@@ -103,8 +110,8 @@ fn the_budget_allocation_is_exact_against_brute_force() {
     let mut trees: Vec<LinkTree> = [(7, 3), (6, 11), (5, 29)]
         .iter()
         .map(|&(n, seed)| {
-            let mut t =
-                LinkTree::build(wraptree::scene::generate::soup(n, seed), 16, &stop).unwrap();
+            let mut t = LinkTree::build(wraptree::scene::generate::soup(n, seed), 16, false, &stop)
+                .unwrap();
             let all: Vec<u32> = (0..t.tree.len() as u32).collect();
             t.measure(&all, &stop).unwrap();
             t
@@ -156,8 +163,8 @@ fn the_mean_spending_is_exact_against_brute_force() {
     let mut trees: Vec<LinkTree> = [(6, 5), (5, 17), (5, 23)]
         .iter()
         .map(|&(n, seed)| {
-            let mut t =
-                LinkTree::build(wraptree::scene::generate::soup(n, seed), 16, &stop).unwrap();
+            let mut t = LinkTree::build(wraptree::scene::generate::soup(n, seed), 16, false, &stop)
+                .unwrap();
             let all: Vec<u32> = (0..t.tree.len() as u32).collect();
             t.measure(&all, &stop).unwrap();
             t
@@ -381,7 +388,8 @@ fn tightening_keeps_every_piece_covered_and_never_loosens_a_sphere() {
     let stop = Stop::new();
     let mut changed = 0;
     for seed in [3, 11, 29] {
-        let mut t = LinkTree::build(wraptree::scene::generate::soup(300, seed), 32, &stop).unwrap();
+        let mut t =
+            LinkTree::build(wraptree::scene::generate::soup(300, seed), 32, false, &stop).unwrap();
         let cover = t.tree.level(3);
         t.measure(&cover, &stop).unwrap();
         let tight = tighten(&t, &cover, &stop).unwrap();

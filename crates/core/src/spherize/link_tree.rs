@@ -100,14 +100,25 @@ fn prim_normals(mesh: &Scene) -> Vec<V3> {
 }
 
 impl LinkTree {
-    /// Groups `mesh` (default parameters) and computes every node's sphere; excess is measured
-    /// later with `samples` points per sphere. Stops with [`Interrupted`] when `stop` is
-    /// requested.
-    pub fn build(mesh: Scene, samples: usize, stop: &Stop) -> Result<LinkTree, Interrupted> {
+    /// Groups `mesh` (default parameters), refines the tree when `refine` (the fast path's
+    /// refinement, [`refine_fast`](crate::refine::refine_fast)) and computes every node's sphere;
+    /// excess is measured later with `samples` points per sphere. Stops with [`Interrupted`]
+    /// when `stop` is requested.
+    pub fn build(
+        mesh: Scene,
+        samples: usize,
+        refine: bool,
+        stop: &Stop,
+    ) -> Result<LinkTree, Interrupted> {
         let params = Params::default().resolve(&mesh);
         let tree = grouping::group_until(&mesh, &params, (), stop.flag())
             .map_err(|_| Interrupted)?
             .tree;
+        let tree = if refine {
+            crate::refine::refine_fast(tree).tree
+        } else {
+            tree
+        };
         stop.check()?;
         let spheres = sphere_tree(&tree, &mesh, SphereMethod::Minimum);
         let normals = prim_normals(&mesh);

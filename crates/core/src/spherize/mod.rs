@@ -74,6 +74,8 @@ pub struct Settings {
     /// With a budget: the share by which the largest excess may exceed the budget's least one
     /// while its spheres are spent to lower the mean excess ([`spend`]).
     pub slack: f64,
+    /// Refine each link's Subset Tree before its spheres are measured ([`LinkTree::build`]).
+    pub refine: bool,
 }
 
 impl Settings {
@@ -196,7 +198,12 @@ pub fn spherize(links: Vec<Link>, settings: Settings, stop: &Stop) -> Result<Sph
         }
         let max_edge = max_edge.max(diagonal / FINEST_PIECES);
         let pieces = pieces::split_long_edges(&link.mesh, max_edge);
-        trees.push(LinkTree::build(pieces, NODE_SAMPLES, stop)?);
+        trees.push(LinkTree::build(
+            pieces,
+            NODE_SAMPLES,
+            settings.refine,
+            stop,
+        )?);
         out.push((link, max_edge));
     }
     let (covers, tight, allocation) = match settings.limit {
