@@ -2,9 +2,9 @@
 //! one camera, every picture drawn and written before any file is moved into place.
 
 use super::Frame;
-use crate::output::{OutDir, Pending};
+use crate::output::{OutDir, Pending, check_absent};
 use crate::stop::Stop;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use std::path::{Path, PathBuf};
 
 /// How the frames are looked at and written.
@@ -18,27 +18,6 @@ pub struct Look {
     pub size: (u32, u32),
     /// Replace existing images.
     pub force: bool,
-}
-
-/// The destinations of `names` in `dir`, each as a `.png`/`.svg` pair, all checked before any
-/// is written so an existing file without `force` stops the run before it writes anything.
-fn pendings(dir: &Path, names: &[String], force: bool) -> Result<Vec<(Pending, Pending)>> {
-    names
-        .iter()
-        .map(|n| {
-            Ok((
-                Pending::create(&dir.join(format!("{n}.png")), force)?,
-                Pending::create(&dir.join(format!("{n}.svg")), force)?,
-            ))
-        })
-        .collect()
-}
-
-fn write(p: &Pending, bytes: &[u8]) -> Result<()> {
-    use std::io::Write;
-    p.file()?
-        .write_all(bytes)
-        .with_context(|| format!("{}: write failed", p.dest().display()))
 }
 
 /// Frames drawn and written to temporary files beside their destinations, not yet in place;
@@ -73,8 +52,13 @@ pub fn draw_frames(
 ) -> Result<Drawn> {
     names.push("figure".into());
     let cam = super::fit_camera(&frames, look.azimuth, look.elevation, look.size);
+    // Every destination is checked before anything is drawn.
+    let dests: Vec<[PathBuf; 2]> = names
+        .iter()
+        .map(|n| [dir.join(format!("{n}.png")), dir.join(format!("{n}.svg"))])
+        .collect();
+    check_absent(dests.as_flattened(), look.force)?;
     let out_dir = crate::output::output_dir(Some(dir), "")?;
-    let outs = pendings(dir, &names, look.force)?;
     let mut svgs = Vec::with_capacity(frames.len() + 1);
     for f in &frames {
         stop.check()?;
@@ -87,17 +71,19 @@ pub fn draw_frames(
         super::sheet_columns(frames.len()),
         title,
     ));
-    for ((png, svg), text) in outs.iter().zip(&svgs) {
+    let mut files = Vec::with_capacity(dests.len());
+    for ([png, svg], text) in dests.iter().zip(&svgs) {
         stop.check()?;
-        let dest = png.dest().display().to_string();
         let bytes = super::png::svg_to_png_until(text.clone(), stop)?
-            .map_err(|e| anyhow::anyhow!("{dest}: {e}"))?;
-        write(png, &bytes)?;
-        write(svg, text.as_bytes())?;
+            .map_err(|e| anyhow::anyhow!("{}: {e}", png.display()))?;
+        files.push((
+            Pending::with_bytes(png, &bytes, look.force)?,
+            Pending::with_bytes(svg, text.as_bytes(), look.force)?,
+        ));
     }
     Ok(Drawn {
         _dir: out_dir,
-        files: outs,
+        files,
     })
 }
 

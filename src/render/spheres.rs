@@ -2,14 +2,13 @@
 //! stands, then its links' sphere trees at a few depths (one sphere per link first) and the
 //! chosen cover, every sphere over the meshes and coloured by its excess like the recordings.
 
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
 use anyhow::Result;
 
 use super::frames::{Drawn, Look, draw_frames};
 use super::{Frame, Shape, Style, fit_camera, input_frame};
-use std::collections::{BTreeMap, BTreeSet};
-
 use crate::geom::{P3, Sphere, V3};
 use crate::record::spherize::View;
 use crate::scene::Scene;
@@ -26,16 +25,20 @@ pub const DEPTHS: [usize; 3] = [0, 2, 4];
 /// Spheres with their colours (RGBA in 0..=1), as recorded.
 type Coloured = Vec<(Sphere, [f64; 4])>;
 
-/// The style of a sphere of colour `c` (RGBA in 0..=1, as recorded).
-fn sphere_style(c: [f64; 4]) -> Style {
+/// A sphere as drawn, in its colour (RGBA in 0..=1, as recorded).
+fn sphere_shape((s, c): &(Sphere, [f64; 4])) -> Shape {
     let byte = |x: f64| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
     let fill = [byte(c[0]), byte(c[1]), byte(c[2])];
-    Style {
-        fill,
-        opacity: 0.4,
-        stroke: super::shape::tint(fill, 0.45),
-        stroke_opacity: 0.8,
-        stroke_width: 0.7,
+    Shape::Sphere {
+        center: s.center,
+        radius: s.radius,
+        style: Style {
+            fill,
+            opacity: 0.4,
+            stroke: super::shape::tint(fill, 0.45),
+            stroke_opacity: 0.8,
+            stroke_width: 0.7,
+        },
     }
 }
 
@@ -87,11 +90,7 @@ fn frame(view: &View, cell: f64, spheres: &[(Sphere, [f64; 4])], caption: String
         .iter()
         .flat_map(|l| clustered(&l.mesh, cell))
         .collect();
-    shapes.extend(spheres.iter().map(|(s, c)| Shape::Sphere {
-        center: s.center,
-        radius: s.radius,
-        style: sphere_style(*c),
-    }));
+    shapes.extend(spheres.iter().map(sphere_shape));
     Frame { shapes, caption }
 }
 
@@ -152,16 +151,7 @@ pub fn draw(
         shapes: bounds
             .iter()
             .map(|b| Shape::aabb(b, Style::INPUT))
-            .chain(
-                plans
-                    .iter()
-                    .flat_map(|(s, _)| s)
-                    .map(|(s, c)| Shape::Sphere {
-                        center: s.center,
-                        radius: s.radius,
-                        style: sphere_style(*c),
-                    }),
-            )
+            .chain(plans.iter().flat_map(|(s, _)| s).map(sphere_shape))
             .collect(),
         caption: String::new(),
     };

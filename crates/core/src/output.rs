@@ -109,6 +109,16 @@ impl Pending {
         })
     }
 
+    /// Starts writing `dest` ([`Pending::create`]) and writes `bytes`, not yet committed.
+    pub fn with_bytes(dest: &Path, bytes: &[u8], force: bool) -> Result<Pending> {
+        use std::io::Write;
+        let p = Pending::create(dest, force)?;
+        p.file()?
+            .write_all(bytes)
+            .with_context(|| format!("{}: write failed", dest.display()))?;
+        Ok(p)
+    }
+
     /// Path of the temporary file (for writers that open paths themselves).
     pub fn path(&self) -> &Path {
         self.tmp.path()
@@ -167,12 +177,7 @@ impl Pending {
 
 /// Writes `bytes` to `dest` atomically.
 pub fn write_atomic(dest: &Path, bytes: &[u8], force: bool) -> Result<()> {
-    use std::io::Write;
-    let p = Pending::create(dest, force)?;
-    p.file()?
-        .write_all(bytes)
-        .with_context(|| format!("{}: write failed", dest.display()))?;
-    p.commit()?;
+    Pending::with_bytes(dest, bytes, force)?.commit()?;
     Ok(())
 }
 

@@ -30,12 +30,11 @@ pub struct Tight {
     pub outside: (f64, u32),
 }
 
-/// Whether `s` holds every vertex of piece `p`.
+/// Whether `s` holds every vertex of piece `p` (up to rounding: its radius is their largest
+/// distance).
 fn holds(l: &LinkTree, s: &Sphere, p: usize) -> bool {
-    let r = s.radius * (1.0 + 1e-12) + 1e-15;
-    l.mesh
-        .prim_vertices(p)
-        .all(|v| (v - s.center).norm_squared() <= r * r)
+    let tol = 1e-12 * s.radius + 1e-15;
+    l.mesh.prim_vertices(p).all(|v| s.contains(v, tol))
 }
 
 /// The pieces `s` holds, found through the link's tree.
