@@ -104,10 +104,10 @@ fn cuts(t: &LinkTree, x: u32) -> Vec<Vec<u32>> {
     out
 }
 
-#[test]
-fn the_budget_allocation_is_exact_against_brute_force() {
+/// A tree per (triangles, seed) soup, every node measured.
+fn measured_soups(specs: &[(usize, u64)]) -> Vec<LinkTree> {
     let stop = Stop::new();
-    let mut trees: Vec<LinkTree> = [(7, 3), (6, 11), (5, 29)]
+    specs
         .iter()
         .map(|&(n, seed)| {
             let mut t = LinkTree::build(wraptree::scene::generate::soup(n, seed), 16, false, &stop)
@@ -116,7 +116,13 @@ fn the_budget_allocation_is_exact_against_brute_force() {
             t.measure(&all, &stop).unwrap();
             t
         })
-        .collect();
+        .collect()
+}
+
+#[test]
+fn the_budget_allocation_is_exact_against_brute_force() {
+    let stop = Stop::new();
+    let mut trees = measured_soups(&[(7, 3), (6, 11), (5, 29)]);
     // Each link's cuts as (size, largest excess), the smallest excess per size.
     let curves: Vec<Vec<(usize, f64)>> = trees
         .iter()
@@ -160,16 +166,7 @@ fn the_budget_allocation_is_exact_against_brute_force() {
 #[test]
 fn the_mean_spending_is_exact_against_brute_force() {
     let stop = Stop::new();
-    let mut trees: Vec<LinkTree> = [(6, 5), (5, 17), (5, 23)]
-        .iter()
-        .map(|&(n, seed)| {
-            let mut t = LinkTree::build(wraptree::scene::generate::soup(n, seed), 16, false, &stop)
-                .unwrap();
-            let all: Vec<u32> = (0..t.tree.len() as u32).collect();
-            t.measure(&all, &stop).unwrap();
-            t
-        })
-        .collect();
+    let mut trees = measured_soups(&[(6, 5), (5, 17), (5, 23)]);
     // Each link's cuts as (size, largest excess, Σ S, Σ N).
     let curves: Vec<Vec<(usize, f64, f64, f64)>> = trees
         .iter()
@@ -475,4 +472,28 @@ fn the_snapshot_draws_the_robot_its_trees_and_its_cover() {
     assert!(!Path::new(&format!("{other}.json")).exists());
     common::assert_one_line_error(&out, "figure.png");
     assert_eq!(std::fs::read(figs.join("figure.png")).unwrap(), before);
+    // Figures that cannot be written: one error line, and nothing else left (`.sph` included).
+    let fresh = tempfile::tempdir().unwrap();
+    std::fs::write(fresh.path().join("blocker"), "").unwrap();
+    let out = common::wraptree(
+        &[
+            "spherize",
+            &robot,
+            "--urdf-collision",
+            "--budget",
+            "30",
+            "--no-record",
+            "-o",
+            "r2",
+            "--snapshot",
+            "blocker/figs",
+        ],
+        fresh.path(),
+    );
+    common::assert_one_line_error(&out, "blocker/figs");
+    let left: Vec<_> = std::fs::read_dir(fresh.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left, ["blocker"], "{left:?}");
 }

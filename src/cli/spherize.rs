@@ -5,7 +5,6 @@
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use wraptree::output::{Pending, check_new, output_dir, output_prefix, with_ext};
@@ -189,16 +188,13 @@ impl SpherizeCmd {
         let cover = done.cover_spheres();
         // Every output is written whole first and moved into place only once all are ready,
         // so a stop request before then leaves nothing.
+        // Directories made for outputs go when empty, so they are dropped after the files.
+        let mut dirs = Vec::new();
         let mut ready: Vec<Pending> = Vec::new();
         let mut put = |path: PathBuf, bytes: &[u8]| -> Result<()> {
-            let p = Pending::create(&path, self.force)?;
-            p.file()?
-                .write_all(bytes)
-                .with_context(|| format!("{}: write failed", path.display()))?;
-            ready.push(p);
+            ready.push(Pending::with_bytes(&path, bytes, self.force)?);
             Ok(())
         };
-        let mut dirs = Vec::new();
         put(
             with_ext(&prefix, ".json"),
             &serde_json::to_vec_pretty(&report).context("spherize: cannot serialise")?,
